@@ -1,0 +1,447 @@
+//! Fitness of a fleet particle: seed 004 eq. (9)–(12) plus the constraint penalties that make the
+//! constrained problem unconstrained (§3.3.1). Lower is better.
+//!
+//! `F = λ1 Σ F_i(L) + λ2 Σ F_i(D) + λ3 Σ F_i(O) + λ4 Σ F_i(T) + λ5 Σ F_i(S) + W · P` (eq. (12)),
+//! every term dimensionless so the weights λ of §4.1.4 compare like with like:
+//!
+//! | term | definition | units before normalising | normalised by |
+//! |---|---|---|---|
+//! | F_i(L) | path length | m | straight-line distance start→goal |
+//! | F_i(D) | length-weighted mean depth below the surface | m | water-column height |
+//! | F_i(O) | length of path inside inflated soft spheres | m | straight-line distance |
+//! | F_i(T) | eq. (10) with `t_i` the mission time and `[t_min, t_max]` from eq. (2) | s | mission time |
+//! | F_i(S) | eq. (11) integrated over time: seconds closer than d_min to any other vehicle | s | 1 s ("one point per second") |
+//!
+//! The penalty `P` (weight `W = optimizer.penalty_weight`) counts what makes a plan infeasible:
+//! hard-obstacle intrusions, turns beyond the limit, pitch beyond the limit and separation breaches,
+//! each as `count + depth of the breach relative to its limit`, so the swarm feels both how many
+//! and how bad.
+
+use crate::geometry::{chord_inside_sphere, heading_change, pitch, segment_point_distance, Vec3};
+use crate::scenario::{Scenario, Vehicle};
+use crate::separation::pair_separation;
+use crate::trajectory::{common_arrival, retime, Layout, Path, Trajectory};
+
+/// A sphere the cost functions test against: centre and radius already inflated.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Sphere {
+    /// Centre, metres.
+    pub centre: Vec3,
+    /// Radius including the inflation margin, metres.
+    pub radius: f64,
+}
+
+/// F_i(L) of eq. (9): path length over straight-line distance (1 for a straight path).
+pub fn length_term(length: f64, straight: f64) -> f64 {
+    length / straight.max(1e-9)
+}
+
+/// F_i(D) of eq. (9): the length-weighted mean depth below `surface_z`, over the water-column
+/// height `column`. Depth is linear along a leg, so each leg contributes `l (d_a + d_b) / 2`.
+/// 0 for a path along the surface, 1 for one along the bottom of the box.
+pub fn depth_term(points: &[Vec3], surface_z: f64, column: f64) -> f64 {
+    let (mut weighted, mut total) = (0.0, 0.0);
+    for w in points.windows(2) {
+        let l = (w[1] - w[0]).norm();
+        weighted += l * 0.5 * ((surface_z - w[0].z) + (surface_z - w[1].z));
+        total += l;
+    }
+    if total <= 0.0 {
+        return points.first().map_or(0.0, |p| (surface_z - p.z) / column);
+    }
+    weighted / total / column
+}
+
+/// F_i(O) of eq. (9): metres of path inside inflated soft obstacles, over the straight-line
+/// distance. A path crossing a soft sphere through its centre pays its diameter; a graze pays
+/// almost nothing.
+pub fn soft_threat_term(points: &[Vec3], soft: &[Sphere], straight: f64) -> f64 {
+    let mut inside = 0.0;
+    for w in points.windows(2) {
+        for s in soft {
+            inside += chord_inside_sphere(&w[0], &w[1], &s.centre, s.radius);
+        }
+    }
+    inside / straight.max(1e-9)
+}
+
+/// F_i(T) of eq. (10), over the mission time: how far the mission time `t_e` lies outside the
+/// window `[L / v_max, L / v_min]` the path allows (eq. (2)). 0 when the vehicle can arrive on time.
+pub fn time_term(length: f64, vehicle: &Vehicle, mission_time: f64) -> f64 {
+    let t_min = length / vehicle.speed_max_mps;
+    let t_max = length / vehicle.speed_min_mps;
+    let miss = if mission_time < t_min {
+        t_min - mission_time
+    } else if mission_time > t_max {
+        mission_time - t_max
+    } else {
+        0.0
+    };
+    miss / mission_time
+}
+
+/// F_i(S) of eq. (11) on timed trajectories: eq. (11) is 1 at every instant a pair is closer than
+/// d_min; counted once per second, the sum is the breach time in seconds.
+pub fn space_term(breach_seconds: f64) -> f64 {
+    breach_seconds
+}
+
+/// Hard-obstacle penalty: for every (leg, obstacle) whose leg enters the inflated sphere, `1 + how
+/// deep it gets / inflated radius`. Returns the penalty and the number of such intrusions.
+pub fn hard_penalty(points: &[Vec3], hard: &[Sphere]) -> (f64, usize) {
+    let (mut p, mut hits) = (0.0, 0);
+    for w in points.windows(2) {
+        for s in hard {
+            let d = segment_point_distance(&w[0], &w[1], &s.centre);
+            if d < s.radius {
+                p += 1.0 + (s.radius - d) / s.radius;
+                hits += 1;
+            }
+        }
+    }
+    (p, hits)
+}
+
+/// Turn penalty: at every inner waypoint whose heading change exceeds `max_turn` (radians),
+/// `1 + excess / max_turn`. The cosine is compared first so only violations pay for `atan2`.
+pub fn turn_penalty(points: &[Vec3], max_turn: f64) -> f64 {
+    let cos_max = max_turn.cos();
+    let mut p = 0.0;
+    for w in points.windows(3) {
+        let (ux, uy) = (w[1].x - w[0].x, w[1].y - w[0].y);
+        let (vx, vy) = (w[2].x - w[1].x, w[2].y - w[1].y);
+        let norms = ((ux * ux + uy * uy) * (vx * vx + vy * vy)).sqrt();
+        if norms <= 1e-18 || (ux * vx + uy * vy) >= cos_max * norms {
+            continue;
+        }
+        let t = heading_change(&w[0], &w[1], &w[2]);
+        if t > max_turn {
+            p += 1.0 + (t - max_turn) / max_turn;
+        }
+    }
+    p
+}
+
+/// Pitch penalty: for every leg whose |pitch| exceeds `max_pitch` (radians),
+/// `1 + excess / max_pitch`. The slope is compared first so only violations pay for `atan2`.
+pub fn pitch_penalty(points: &[Vec3], max_pitch: f64) -> f64 {
+    let tan_max = max_pitch.tan();
+    let mut p = 0.0;
+    for w in points.windows(2) {
+        let d = w[1] - w[0];
+        let h = (d.x * d.x + d.y * d.y).sqrt();
+        if d.z.abs() <= tan_max * h {
+            continue;
+        }
+        let a = pitch(&w[0], &w[1]).abs();
+        if a > max_pitch {
+            p += 1.0 + (a - max_pitch) / max_pitch;
+        }
+    }
+    p
+}
+
+/// Separation penalty of one pair: `1 + (d_min − closest) / d_min` when the pair ever comes
+/// closer than d_min, else 0.
+pub fn separation_penalty(min_distance: f64, d_min: f64) -> f64 {
+    if min_distance < d_min && d_min > 0.0 {
+        1.0 + (d_min - min_distance) / d_min
+    } else {
+        0.0
+    }
+}
+
+/// Each term of one vehicle, unweighted.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct VehicleTerms {
+    /// F_i(L).
+    pub length: f64,
+    /// F_i(D).
+    pub depth: f64,
+    /// F_i(O).
+    pub soft: f64,
+    /// F_i(T).
+    pub time: f64,
+    /// F_i(S).
+    pub space: f64,
+    /// Hard-obstacle penalty (see [`hard_penalty`]).
+    pub hard: f64,
+    /// Turn plus pitch penalty.
+    pub motion: f64,
+    /// This vehicle's half of the separation penalty of every pair it belongs to.
+    pub separation: f64,
+    /// Hard-obstacle intrusions (leg × obstacle).
+    pub hard_hits: usize,
+}
+
+/// Everything the fitness computed for one fleet particle.
+#[derive(Debug, Clone)]
+pub struct FleetEvaluation {
+    /// Decoded paths, in vehicle order.
+    pub paths: Vec<Path>,
+    /// Timed trajectories (what the vehicles fly), in vehicle order.
+    pub trajectories: Vec<Trajectory>,
+    /// The arrival time every vehicle was timed for, seconds.
+    pub common_arrival: f64,
+    /// Unweighted terms per vehicle.
+    pub vehicles: Vec<VehicleTerms>,
+    /// Sum of the separation penalties over all pairs.
+    pub separation_penalty: f64,
+    /// eq. (12): the weighted sum of the five objective terms.
+    pub objective: f64,
+    /// Penalty sum P (unweighted).
+    pub penalty: f64,
+    /// objective + W · P.
+    pub total: f64,
+}
+
+/// The fleet planning problem of one scenario, precomputed for fast evaluation.
+#[derive(Debug, Clone)]
+pub struct FleetModel {
+    /// The scenario this model was built from.
+    pub scenario: Scenario,
+    /// Gene layout of a fleet particle.
+    pub layout: Layout,
+    /// Lower gene bounds.
+    pub lower: Vec<f64>,
+    /// Upper gene bounds.
+    pub upper: Vec<f64>,
+    /// Inflated hard spheres.
+    pub hard: Vec<Sphere>,
+    /// Inflated soft spheres.
+    pub soft: Vec<Sphere>,
+    /// Straight-line distance of every vehicle, metres.
+    pub straight: Vec<f64>,
+}
+
+impl FleetModel {
+    /// Builds the model of a (validated) scenario.
+    pub fn new(scenario: &Scenario) -> FleetModel {
+        let layout = Layout::of(scenario);
+        let (lower, upper) = layout.gene_bounds(scenario);
+        let sphere = |o: &crate::scenario::Obstacle| Sphere {
+            centre: o.centre(),
+            radius: o.inflated_radius(),
+        };
+        FleetModel {
+            layout,
+            lower,
+            upper,
+            hard: scenario.hard_obstacles().map(sphere).collect(),
+            soft: scenario.soft_obstacles().map(sphere).collect(),
+            straight: scenario
+                .vehicles
+                .iter()
+                .map(|v| (v.goal() - v.start()).norm())
+                .collect(),
+            scenario: scenario.clone(),
+        }
+    }
+
+    /// Vehicle-local terms of vehicle `i` (everything but F(S) and the separation penalty).
+    pub fn vehicle_terms(&self, i: usize, path: &Path) -> VehicleTerms {
+        let s = &self.scenario;
+        let v = &s.vehicles[i];
+        let length = path.length();
+        let surface = s.bounds.max[2];
+        let column = s.bounds.max[2] - s.bounds.min[2];
+        let (hard, hard_hits) = hard_penalty(&path.points, &self.hard);
+        VehicleTerms {
+            length: length_term(length, self.straight[i]),
+            depth: depth_term(&path.points, surface, column),
+            soft: soft_threat_term(&path.points, &self.soft, self.straight[i]),
+            time: time_term(length, v, s.fleet.mission_time_s),
+            space: 0.0,
+            separation: 0.0,
+            hard,
+            motion: turn_penalty(&path.points, v.max_turn_deg.to_radians())
+                + pitch_penalty(&path.points, v.max_pitch_deg.to_radians()),
+            hard_hits,
+        }
+    }
+
+    /// Vehicle `t`'s weighted share of eq. (12).
+    pub fn objective_of(&self, t: &VehicleTerms) -> f64 {
+        let w = &self.scenario.optimizer.weights;
+        w[0] * t.length + w[1] * t.depth + w[2] * t.soft + w[3] * t.time + w[4] * t.space
+    }
+
+    /// Vehicle `t`'s share of the total fitness: its eq. (12) terms plus its weighted penalties
+    /// (with half of each pair's separation penalty). The shares sum to the total.
+    pub fn share_of(&self, t: &VehicleTerms) -> f64 {
+        self.objective_of(t)
+            + self.scenario.optimizer.penalty_weight * (t.hard + t.motion + t.separation)
+    }
+
+    /// Decodes and scores a fleet particle.
+    pub fn evaluate(&self, x: &[f64]) -> FleetEvaluation {
+        let s = &self.scenario;
+        let paths: Vec<Path> = s
+            .vehicles
+            .iter()
+            .enumerate()
+            .map(|(i, v)| Path::decode(v, &x[self.layout.chromosome(i)]))
+            .collect();
+        let lengths: Vec<f64> = paths.iter().map(Path::length).collect();
+        let arrival = common_arrival(
+            s.fleet.mission_time_s,
+            lengths
+                .iter()
+                .zip(&s.vehicles)
+                .map(|(l, v)| l / v.speed_max_mps),
+        );
+        let trajectories: Vec<Trajectory> = paths
+            .iter()
+            .zip(&s.vehicles)
+            .map(|(p, v)| retime(p, v, arrival))
+            .collect();
+        let mut vehicles: Vec<VehicleTerms> = paths
+            .iter()
+            .enumerate()
+            .map(|(i, p)| self.vehicle_terms(i, p))
+            .collect();
+        let mut sep_penalty = 0.0;
+        for i in 0..trajectories.len() {
+            for j in i + 1..trajectories.len() {
+                let ps = pair_separation(&trajectories[i], &trajectories[j], s.fleet.d_min_m);
+                // eq. (12) sums F_i(S) over vehicles: a breach counts for both of the pair.
+                vehicles[i].space += space_term(ps.breach_s);
+                vehicles[j].space += space_term(ps.breach_s);
+                let sp = separation_penalty(ps.min_distance, s.fleet.d_min_m);
+                vehicles[i].separation += 0.5 * sp;
+                vehicles[j].separation += 0.5 * sp;
+                sep_penalty += sp;
+            }
+        }
+        let objective: f64 = vehicles.iter().map(|t| self.objective_of(t)).sum();
+        let penalty: f64 = vehicles.iter().map(|t| t.hard + t.motion).sum::<f64>() + sep_penalty;
+        FleetEvaluation {
+            paths,
+            trajectories,
+            common_arrival: arrival,
+            vehicles,
+            separation_penalty: sep_penalty,
+            objective,
+            penalty,
+            total: objective + s.optimizer.penalty_weight * penalty,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scenario::VehicleKind;
+    use approx::assert_abs_diff_eq;
+
+    fn v(x: f64, y: f64, z: f64) -> Vec3 {
+        Vec3::new(x, y, z)
+    }
+
+    fn vehicle() -> Vehicle {
+        Vehicle {
+            id: "a".into(),
+            kind: VehicleKind::Auv,
+            start: [0.0, 0.0, 0.0],
+            goal: [300.0, 0.0, 0.0],
+            speed_min_mps: 0.5,
+            speed_max_mps: 1.5,
+            max_turn_deg: 35.0,
+            max_pitch_deg: 20.0,
+        }
+    }
+
+    #[test]
+    fn length_term_by_hand() {
+        // A 3-4-5 detour: 5 + 5 = 10 m against a straight 8 m.
+        let pts = [v(0., 0., 0.), v(4., 3., 0.), v(8., 0., 0.)];
+        let len: f64 = pts.windows(2).map(|w| (w[1] - w[0]).norm()).sum();
+        assert_abs_diff_eq!(length_term(len, 8.0), 1.25, epsilon = 1e-12);
+    }
+
+    #[test]
+    fn depth_term_by_hand() {
+        // Surface at z = 100, column 100 m. Leg 1: 10 m at depth 50 → 50 average.
+        // Leg 2: 30 m from depth 50 to depth 80 (vertical) → average 65.
+        // Weighted mean (10·50 + 30·65) / 40 = 61.25 m → 0.6125.
+        let pts = [v(0., 0., 50.), v(10., 0., 50.), v(10., 0., 20.)];
+        assert_abs_diff_eq!(depth_term(&pts, 100.0, 100.0), 0.6125, epsilon = 1e-12);
+        // Along the surface: 0.
+        assert_abs_diff_eq!(
+            depth_term(&[v(0., 0., 100.), v(5., 0., 100.)], 100.0, 100.0),
+            0.0
+        );
+    }
+
+    #[test]
+    fn soft_threat_by_hand() {
+        // Straight through the centre of a soft sphere of inflated radius 20: 40 m inside,
+        // straight distance 100 → 0.4. A second sphere missed entirely adds nothing.
+        let soft = [
+            Sphere {
+                centre: v(50., 0., 0.),
+                radius: 20.0,
+            },
+            Sphere {
+                centre: v(50., 50., 0.),
+                radius: 20.0,
+            },
+        ];
+        let pts = [v(0., 0., 0.), v(100., 0., 0.)];
+        assert_abs_diff_eq!(soft_threat_term(&pts, &soft, 100.0), 0.4, epsilon = 1e-9);
+    }
+
+    #[test]
+    fn time_term_by_hand() {
+        let veh = vehicle();
+        // 300 m: window [200, 600] s. Mission 400 → 0; 150 → (200 − 150)/150; 900 → 300/900.
+        assert_abs_diff_eq!(time_term(300.0, &veh, 400.0), 0.0);
+        assert_abs_diff_eq!(time_term(300.0, &veh, 150.0), 50.0 / 150.0, epsilon = 1e-12);
+        assert_abs_diff_eq!(
+            time_term(300.0, &veh, 900.0),
+            300.0 / 900.0,
+            epsilon = 1e-12
+        );
+    }
+
+    #[test]
+    fn hard_penalty_counts_legs_that_cross_between_waypoints() {
+        // Both waypoints are outside the sphere (radius 10 at (50, 5, 0)); the leg passes 5 m
+        // from the centre: one hit, penalty 1 + 5/10.
+        let hard = [Sphere {
+            centre: v(50., 5., 0.),
+            radius: 10.0,
+        }];
+        let (p, n) = hard_penalty(&[v(0., 0., 0.), v(100., 0., 0.)], &hard);
+        assert_eq!(n, 1);
+        assert_abs_diff_eq!(p, 1.5, epsilon = 1e-12);
+        let (p, n) = hard_penalty(&[v(0., 20., 0.), v(100., 20., 0.)], &hard);
+        assert_eq!((p, n), (0.0, 0));
+    }
+
+    #[test]
+    fn turn_and_pitch_penalties_by_hand() {
+        let max = 35f64.to_radians();
+        // A 45° turn exceeds 35° by 10°: 1 + 10/35. A 30° turn is free.
+        let pts = [v(0., 0., 0.), v(1., 0., 0.), v(2., 1., 0.)];
+        assert_abs_diff_eq!(turn_penalty(&pts, max), 1.0 + 10.0 / 35.0, epsilon = 1e-9);
+        let c = 30f64.to_radians();
+        let pts = [v(0., 0., 0.), v(1., 0., 0.), v(1. + c.cos(), c.sin(), 0.)];
+        assert_abs_diff_eq!(turn_penalty(&pts, max), 0.0);
+        // A 45° climb exceeds 20° by 25°: 1 + 25/20; a 10° climb is free.
+        let pmax = 20f64.to_radians();
+        let pts = [
+            v(0., 0., 0.),
+            v(1., 0., 1.),
+            v(2., 0., 1.0 + 10f64.to_radians().tan()),
+        ];
+        assert_abs_diff_eq!(pitch_penalty(&pts, pmax), 1.0 + 25.0 / 20.0, epsilon = 1e-9);
+    }
+
+    #[test]
+    fn separation_penalty_by_hand() {
+        assert_abs_diff_eq!(separation_penalty(30.0, 50.0), 1.4, epsilon = 1e-12);
+        assert_abs_diff_eq!(separation_penalty(50.0, 50.0), 0.0);
+        assert_abs_diff_eq!(space_term(12.5), 12.5);
+    }
+}

@@ -1,0 +1,201 @@
+//! The fleet planning problem as a swarm [`Problem`]: a particle is every vehicle's chromosome
+//! (seed 004 Fig. 3), its cost the fitness of [`crate::cost`].
+
+use rand::rngs::StdRng;
+use rand::Rng;
+
+use crate::cost::FleetModel;
+use crate::geometry::Vec3;
+use crate::swarm::Problem;
+use crate::trajectory::GENES_PER_WAYPOINT;
+
+impl Problem for FleetModel {
+    fn lower(&self) -> &[f64] {
+        &self.lower
+    }
+
+    fn upper(&self) -> &[f64] {
+        &self.upper
+    }
+
+    fn cost(&self, x: &[f64]) -> f64 {
+        self.evaluate(x).total
+    }
+
+    /// One block per vehicle: eq. (12) is a sum over vehicles.
+    fn blocks(&self) -> usize {
+        self.layout.vehicles
+    }
+
+    fn block_range(&self, b: usize) -> std::ops::Range<usize> {
+        self.layout.chromosome(b)
+    }
+
+    /// A chromosome is one vehicle's path: it moves as a whole.
+    fn coherent_blocks(&self) -> bool {
+        true
+    }
+
+    fn cost_parts(&self, x: &[f64], parts: &mut [f64]) -> f64 {
+        let e = self.evaluate(x);
+        for (p, t) in parts.iter_mut().zip(&e.vehicles) {
+            *p = self.share_of(t);
+        }
+        e.total
+    }
+
+    /// Initial particles (seed 004 §3.1: uniform draws "adjusting the range"): each vehicle's
+    /// waypoints are the straight line start→goal bent by three sine harmonics (k = 1, 2, 3)
+    /// whose horizontal amplitudes are uniform in ±A/k (a tenth of that vertically), with A itself
+    /// uniform in [2 %, 50 %] of the straight distance, and depth changing in proportion to the
+    /// horizontal distance travelled; speeds are uniform in the vehicle's range. Uniform draws over the whole 2 km box
+    /// would start every path tens of kilometres long and kinked at every waypoint; smooth bends
+    /// of random size keep the population diverse and mostly flyable, and bends are what a
+    /// pitch-limited climb needs to gain horizontal distance.
+    fn sample(&self, rng: &mut StdRng) -> Vec<f64> {
+        let s = &self.scenario;
+        let m = self.layout.waypoints;
+        let mut x = Vec::with_capacity(self.layout.dim());
+        for (i, v) in s.vehicles.iter().enumerate() {
+            let (a, b) = (v.start(), v.goal());
+            let span = self.straight[i].max(1.0);
+            let amp = rng.random_range(0.02..=0.5) * span;
+            let harmonics: Vec<Vec3> = (1..=3)
+                .map(|k| {
+                    Vec3::new(
+                        rng.random_range(-amp..=amp),
+                        rng.random_range(-amp..=amp),
+                        0.1 * rng.random_range(-amp..=amp),
+                    ) / k as f64
+                })
+                .collect();
+            // The bent curve at M + 2 stations, start and goal included.
+            let mut pts: Vec<Vec3> = (0..=m + 1)
+                .map(|j| {
+                    let f = j as f64 / (m + 1) as f64;
+                    let mut p = a + (b - a) * f;
+                    for (k, h) in harmonics.iter().enumerate() {
+                        p += h * ((k + 1) as f64 * std::f64::consts::PI * f).sin();
+                    }
+                    p
+                })
+                .collect();
+            // Depth follows horizontal distance travelled, so the climb is spread evenly and the
+            // pitch is as gentle as this curve allows.
+            let mut along = vec![0.0; pts.len()];
+            for j in 1..pts.len() {
+                let d = pts[j] - pts[j - 1];
+                along[j] = along[j - 1] + (d.x * d.x + d.y * d.y).sqrt();
+            }
+            let total = along[m + 1].max(1e-9);
+            for j in 1..=m {
+                let base = a.z + (b.z - a.z) * along[j] / total;
+                let f = j as f64 / (m + 1) as f64;
+                pts[j].z = base + (pts[j].z - (a.z + (b.z - a.z) * f));
+            }
+            for p in &mut pts[1..=m] {
+                for d in 0..3 {
+                    p[d] = p[d].clamp(s.bounds.min[d], s.bounds.max[d]);
+                }
+                x.extend_from_slice(&[p.x, p.y, p.z]);
+                x.push(rng.random_range(v.speed_min_mps..=v.speed_max_mps));
+            }
+        }
+        debug_assert_eq!(x.len(), m * GENES_PER_WAYPOINT * s.vehicles.len());
+        x
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scenario::Scenario;
+    use rand::SeedableRng;
+
+    pub(crate) fn two_vehicle_scenario() -> Result<Scenario, crate::scenario::ScenarioError> {
+        Scenario::parse(
+            r#"
+name = "two"
+[bounds]
+min = [0.0, 0.0, 0.0]
+max = [1000.0, 1000.0, 500.0]
+[[obstacles]]
+id = "H"
+kind = "hard"
+centre = [500.0, 500.0, 250.0]
+radius_m = 100.0
+inflation_m = 20.0
+[[vehicles]]
+id = "a"
+kind = "auv"
+start = [100.0, 100.0, 250.0]
+goal = [900.0, 900.0, 250.0]
+speed_min_mps = 0.5
+speed_max_mps = 1.5
+max_turn_deg = 35.0
+max_pitch_deg = 20.0
+[[vehicles]]
+id = "b"
+kind = "auv"
+start = [100.0, 900.0, 250.0]
+goal = [900.0, 100.0, 250.0]
+speed_min_mps = 0.5
+speed_max_mps = 1.5
+max_turn_deg = 35.0
+max_pitch_deg = 20.0
+[fleet]
+d_min_m = 50.0
+mission_time_s = 1000.0
+[optimizer]
+waypoints = 6
+"#,
+            std::path::Path::new("two.toml"),
+        )
+    }
+
+    #[test]
+    fn samples_stay_in_bounds_and_have_the_layout_length() -> Result<(), Box<dyn std::error::Error>>
+    {
+        let model = FleetModel::new(&two_vehicle_scenario()?);
+        let mut rng = StdRng::seed_from_u64(5);
+        for _ in 0..50 {
+            let x = model.sample(&mut rng);
+            assert_eq!(x.len(), model.dim());
+            for ((v, lo), hi) in x.iter().zip(model.lower()).zip(model.upper()) {
+                assert!(lo <= v && v <= hi);
+            }
+            assert!(model.cost(&x).is_finite());
+        }
+        Ok(())
+    }
+
+    #[test]
+    fn straight_paths_through_the_obstacle_and_each_other_are_penalised(
+    ) -> Result<(), Box<dyn std::error::Error>> {
+        let model = FleetModel::new(&two_vehicle_scenario()?);
+        // Both fly their straight diagonals at one speed: they cross the hard sphere and meet
+        // in its centre at the same instant.
+        let mut x = Vec::new();
+        for v in &model.scenario.vehicles {
+            for j in 1..=6 {
+                let p = v.start() + (v.goal() - v.start()) * (j as f64 / 7.0);
+                x.extend_from_slice(&[p.x, p.y, p.z, 1.0]);
+            }
+        }
+        let e = model.evaluate(&x);
+        assert!(e.vehicles.iter().all(|t| t.hard_hits > 0));
+        assert!(e.separation_penalty > 1.0);
+        assert!(e.vehicles.iter().all(|t| t.space > 0.0));
+        // The straight path has F(L) = 1 and needs 1131 s at 1 m/s, inside [754, 2263] s.
+        assert!((e.vehicles[0].length - 1.0).abs() < 1e-9);
+        assert_eq!(e.vehicles[0].time, 0.0);
+        assert!((e.common_arrival - 1000.0).abs() < 1e-9);
+        assert!(e.total > e.objective + model.scenario.optimizer.penalty_weight * 2.0);
+        // The per-vehicle shares add up to the total.
+        let mut parts = vec![0.0; model.blocks()];
+        let total = model.cost_parts(&x, &mut parts);
+        assert!((parts.iter().sum::<f64>() - total).abs() < 1e-9 * total.abs().max(1.0));
+        assert!((total - e.total).abs() < 1e-12);
+        Ok(())
+    }
+}

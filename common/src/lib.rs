@@ -1,0 +1,14 @@
+//! Shoal's shared model and algorithms: scenarios, geometry, timed trajectories, the fleet
+//! fitness of seed 004 and the swarm optimizers.
+
+pub mod cost;
+pub mod fleet;
+pub mod geometry;
+pub mod plan;
+pub mod scenario;
+pub mod separation;
+pub mod swarm;
+pub mod trajectory;
+
+/// Version of the shared crate, reported by the binaries.
+pub const VERSION: &str = env!("CARGO_PKG_VERSION");

@@ -1,0 +1,451 @@
+//! The plan a planner hands out (`plan.json`) and the assessment that fills its figures.
+//!
+//! Every figure is computed from the timed trajectories alone — not from the particle or the
+//! fitness — so what `plan.json` says is exactly what the vehicles would fly, and an independent
+//! checker that reads only the trajectories must get the same numbers.
+
+use serde::{Deserialize, Serialize};
+
+use crate::geometry::{heading_change, pitch, segment_point_distance, Vec3};
+use crate::scenario::Scenario;
+use crate::separation::pair_separation;
+use crate::trajectory::Trajectory;
+
+/// Slack for float noise in limit checks (degrees, m/s, metres, seconds).
+const TOL: f64 = 1e-6;
+
+/// One vehicle's part of a plan.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+pub struct VehiclePlan {
+    /// Vehicle id from the scenario.
+    pub id: String,
+    /// `[t_s, x_m, y_m, z_m]` samples; straight lines at constant speed between them.
+    pub trajectory: Vec<[f64; 4]>,
+    /// Path length, metres.
+    pub length_m: f64,
+    /// Time of the last sample, seconds.
+    pub arrival_s: f64,
+    /// Largest heading change at a sample, degrees.
+    pub max_turn_deg: f64,
+    /// Largest |pitch| of a leg, degrees.
+    pub max_pitch_deg: f64,
+    /// Slowest leg speed, m/s.
+    pub min_speed_mps: f64,
+    /// Fastest leg speed, m/s.
+    pub max_speed_mps: f64,
+    /// Closest distance to a hard obstacle's physical surface (radius, without inflation),
+    /// metres; `null` when there is no hard obstacle. Below the inflation margin is a collision.
+    pub min_clearance_m: Option<f64>,
+    /// Legs entering a hard obstacle's inflated sphere (leg × obstacle).
+    pub hard_collisions: usize,
+    /// Metres of path inside inflated soft obstacles.
+    pub soft_exposure_m: f64,
+}
+
+/// Fleet-wide figures.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+pub struct FleetFigures {
+    /// Smallest distance between any two vehicles at the same instant, metres (`null` for a
+    /// single vehicle).
+    pub min_separation_m: Option<f64>,
+    /// The pair at that distance.
+    pub min_separation_pair: Option<[String; 2]>,
+    /// When it happens, seconds.
+    pub min_separation_time_s: Option<f64>,
+    /// Total time pairs spend closer than d_min, seconds.
+    pub separation_breach_s: f64,
+    /// Sum of every vehicle's `hard_collisions`.
+    pub hard_collisions: usize,
+    /// Latest arrival minus earliest, seconds.
+    pub arrival_spread_s: f64,
+}
+
+/// Figures and constraint checks of a set of trajectories.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Assessment {
+    /// Per vehicle, in scenario order.
+    pub vehicles: Vec<VehiclePlan>,
+    /// Fleet figures.
+    pub fleet: FleetFigures,
+    /// Broken constraints, in plain words. Empty means feasible.
+    pub violations: Vec<String>,
+}
+
+/// Checks `trajectories` (scenario vehicle order) against every constraint of `scenario`.
+pub fn assess(scenario: &Scenario, trajectories: &[Trajectory]) -> Assessment {
+    let mut violations = Vec::new();
+    let mut vehicles = Vec::with_capacity(trajectories.len());
+    for (v, t) in scenario.vehicles.iter().zip(trajectories) {
+        let pts = &t.points;
+        let length: f64 = pts.windows(2).map(|w| (w[1] - w[0]).norm()).sum();
+        let max_turn = pts
+            .windows(3)
+            .map(|w| heading_change(&w[0], &w[1], &w[2]).to_degrees())
+            .fold(0.0, f64::max);
+        let max_pitch = pts
+            .windows(2)
+            .map(|w| pitch(&w[0], &w[1]).abs().to_degrees())
+            .fold(0.0, f64::max);
+        // Legs of zero length (a waypoint repeated) have no speed to check.
+        let speeds: Vec<f64> = t
+            .leg_speeds()
+            .into_iter()
+            .zip(pts.windows(2))
+            .filter(|(_, w)| (w[1] - w[0]).norm() > TOL)
+            .map(|(s, _)| s)
+            .collect();
+        let min_speed = speeds.iter().copied().fold(f64::INFINITY, f64::min);
+        let max_speed = speeds.iter().copied().fold(0.0, f64::max);
+        let mut clearance: Option<f64> = None;
+        let mut hard_collisions = 0;
+        for o in scenario.hard_obstacles() {
+            let c = o.centre();
+            let mut worst = f64::INFINITY;
+            for w in pts.windows(2) {
+                let d = segment_point_distance(&w[0], &w[1], &c);
+                worst = worst.min(d);
+                if d < o.inflated_radius() {
+                    hard_collisions += 1;
+                }
+            }
+            if pts.len() == 1 {
+                worst = (pts[0] - c).norm();
+            }
+            let surface = worst - o.radius_m;
+            clearance = Some(clearance.map_or(surface, |m: f64| m.min(surface)));
+            if worst < o.inflated_radius() {
+                violations.push(format!(
+                    "{} passes {:.1} m from the centre of hard obstacle {} (radius {:.0} m + inflation {:.0} m = {:.0} m)",
+                    v.id, worst, o.id, o.radius_m, o.inflation_m, o.inflated_radius()
+                ));
+            }
+        }
+        let soft_exposure: f64 = scenario
+            .soft_obstacles()
+            .map(|o| {
+                pts.windows(2)
+                    .map(|w| {
+                        crate::geometry::chord_inside_sphere(
+                            &w[0],
+                            &w[1],
+                            &o.centre(),
+                            o.inflated_radius(),
+                        )
+                    })
+                    .sum::<f64>()
+            })
+            .sum();
+        if max_turn > v.max_turn_deg + TOL {
+            violations.push(format!(
+                "{} turns {:.1}° at a waypoint; its limit is {:.1}°",
+                v.id, max_turn, v.max_turn_deg
+            ));
+        }
+        if max_pitch > v.max_pitch_deg + TOL {
+            violations.push(format!(
+                "{} pitches {:.1}° on a leg; its limit is {:.1}°",
+                v.id, max_pitch, v.max_pitch_deg
+            ));
+        }
+        if !speeds.is_empty()
+            && (min_speed < v.speed_min_mps - TOL || max_speed > v.speed_max_mps + TOL)
+        {
+            violations.push(format!(
+                "{} flies legs at {:.3}–{:.3} m/s, outside its range {:.3}–{:.3} m/s",
+                v.id, min_speed, max_speed, v.speed_min_mps, v.speed_max_mps
+            ));
+        }
+        let out_of_bounds = pts.iter().any(|p| {
+            (0..3)
+                .any(|a| p[a] < scenario.bounds.min[a] - TOL || p[a] > scenario.bounds.max[a] + TOL)
+        });
+        if out_of_bounds {
+            violations.push(format!("{} leaves the scenario bounds", v.id));
+        }
+        let ends_ok = pts.first().is_some_and(|p| (p - v.start()).norm() <= TOL)
+            && pts.last().is_some_and(|p| (p - v.goal()).norm() <= TOL);
+        if !ends_ok {
+            violations.push(format!("{} does not run from its start to its goal", v.id));
+        }
+        vehicles.push(VehiclePlan {
+            id: v.id.clone(),
+            trajectory: t
+                .times
+                .iter()
+                .zip(pts)
+                .map(|(s, p)| [*s, p.x, p.y, p.z])
+                .collect(),
+            length_m: length,
+            arrival_s: t.arrival(),
+            max_turn_deg: max_turn,
+            max_pitch_deg: max_pitch,
+            min_speed_mps: if speeds.is_empty() { 0.0 } else { min_speed },
+            max_speed_mps: max_speed,
+            min_clearance_m: clearance,
+            hard_collisions,
+            soft_exposure_m: soft_exposure,
+        });
+    }
+
+    let d_min = scenario.fleet.d_min_m;
+    let mut fleet = FleetFigures {
+        min_separation_m: None,
+        min_separation_pair: None,
+        min_separation_time_s: None,
+        separation_breach_s: 0.0,
+        hard_collisions: vehicles.iter().map(|v| v.hard_collisions).sum(),
+        arrival_spread_s: 0.0,
+    };
+    for i in 0..trajectories.len() {
+        for j in i + 1..trajectories.len() {
+            let s = pair_separation(&trajectories[i], &trajectories[j], d_min);
+            fleet.separation_breach_s += s.breach_s;
+            if fleet.min_separation_m.is_none_or(|m| s.min_distance < m) {
+                fleet.min_separation_m = Some(s.min_distance);
+                fleet.min_separation_pair = Some([vehicles[i].id.clone(), vehicles[j].id.clone()]);
+                fleet.min_separation_time_s = Some(s.min_time);
+            }
+            if s.min_distance < d_min {
+                violations.push(format!(
+                    "{} and {} come {:.1} m apart at t = {:.0} s (minimum separation {:.0} m), closer than that for {:.0} s",
+                    vehicles[i].id, vehicles[j].id, s.min_distance, s.min_time, d_min, s.breach_s
+                ));
+            }
+        }
+    }
+    let (first, last) = vehicles
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+            (a.min(v.arrival_s), b.max(v.arrival_s))
+        });
+    fleet.arrival_spread_s = if vehicles.is_empty() {
+        0.0
+    } else {
+        last - first
+    };
+    if fleet.arrival_spread_s > 1.0 {
+        violations.push(format!(
+            "arrivals are not synchronised: first at {first:.0} s, last at {last:.0} s"
+        ));
+    }
+    Assessment {
+        vehicles,
+        fleet,
+        violations,
+    }
+}
+
+/// Plain-words notes on the timing: why the common arrival differs from the mission time.
+pub fn timing_notices(
+    scenario: &Scenario,
+    trajectories: &[Trajectory],
+    common_arrival: f64,
+) -> Vec<String> {
+    let mut out = Vec::new();
+    let mission = scenario.fleet.mission_time_s;
+    for (v, t) in scenario.vehicles.iter().zip(trajectories) {
+        let length: f64 = t.points.windows(2).map(|w| (w[1] - w[0]).norm()).sum();
+        let earliest = length / v.speed_max_mps;
+        let latest = length / v.speed_min_mps;
+        let straight = (v.goal() - v.start()).norm();
+        if earliest > mission + TOL {
+            let dz = (v.goal()[2] - v.start()[2]).abs();
+            let horizontal = {
+                let d: Vec3 = v.goal() - v.start();
+                (d.x * d.x + d.y * d.y).sqrt()
+            };
+            let steep = dz > horizontal * v.max_pitch_deg.to_radians().tan();
+            let why = if steep {
+                format!(
+                    "its depth change of {dz:.0} m over {horizontal:.0} m is steeper than its {:.0}° pitch limit, so its path must be longer than the {straight:.0} m straight line",
+                    v.max_pitch_deg
+                )
+            } else {
+                format!("obstacles and turn limits make its path longer than the {straight:.0} m straight line")
+            };
+            out.push(format!(
+                "{} cannot arrive by the mission time of {mission:.0} s: its {length:.0} m path takes at least {earliest:.0} s at its top speed of {:.3} m/s ({why}); every vehicle is timed to arrive at {common_arrival:.0} s instead",
+                v.id, v.speed_max_mps
+            ));
+        } else if latest < common_arrival - TOL {
+            out.push(format!(
+                "{} cannot slow down enough to arrive at {common_arrival:.0} s: at its slowest, {:.3} m/s, its {length:.0} m path takes only {latest:.0} s",
+                v.id, v.speed_min_mps
+            ));
+        }
+    }
+    out
+}
+
+/// `plan.json`.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+pub struct Plan {
+    /// Scenario name.
+    pub scenario: String,
+    /// Optimizer used.
+    pub algorithm: String,
+    /// `in-process` or `distributed`.
+    pub mode: String,
+    /// RNG seed.
+    pub seed: u64,
+    /// Planning wall time, seconds.
+    pub runtime_s: f64,
+    /// Final fitness (eq. (12) plus weighted penalties); lower is better.
+    pub fitness: f64,
+    /// eq. (12) alone.
+    pub objective: f64,
+    /// Unweighted constraint penalty (0 for a feasible plan).
+    pub penalty: f64,
+    /// True when `violations` is empty.
+    pub feasible: bool,
+    /// Broken constraints, in plain words.
+    pub violations: Vec<String>,
+    /// Things a user should know that are not violations (e.g. late common arrival).
+    pub notices: Vec<String>,
+    /// Mission time from the scenario, seconds.
+    pub mission_time_s: f64,
+    /// Arrival time every vehicle is timed for, seconds.
+    pub common_arrival_s: f64,
+    /// Minimum separation from the scenario, metres.
+    pub d_min_m: f64,
+    /// Iterations run.
+    pub iterations: usize,
+    /// Fitness evaluations.
+    pub evaluations: u64,
+    /// Why the optimizer stopped.
+    pub termination: String,
+    /// Per vehicle.
+    pub vehicles: Vec<VehiclePlan>,
+    /// Fleet figures.
+    pub fleet: FleetFigures,
+    /// Best fitness after each iteration.
+    pub convergence: Vec<f64>,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn scenario() -> Result<Scenario, crate::scenario::ScenarioError> {
+        Scenario::parse(
+            r#"
+name = "p"
+[bounds]
+min = [0.0, 0.0, 0.0]
+max = [1000.0, 1000.0, 1000.0]
+[[obstacles]]
+id = "H"
+kind = "hard"
+centre = [500.0, 25.0, 0.0]
+radius_m = 20.0
+inflation_m = 10.0
+[[vehicles]]
+id = "a"
+kind = "auv"
+start = [0.0, 0.0, 0.0]
+goal = [1000.0, 0.0, 0.0]
+speed_min_mps = 0.5
+speed_max_mps = 2.0
+max_turn_deg = 35.0
+max_pitch_deg = 20.0
+[[vehicles]]
+id = "b"
+kind = "auv"
+start = [1000.0, 100.0, 0.0]
+goal = [0.0, 100.0, 0.0]
+speed_min_mps = 0.5
+speed_max_mps = 2.0
+max_turn_deg = 35.0
+max_pitch_deg = 20.0
+[fleet]
+d_min_m = 150.0
+mission_time_s = 1000.0
+"#,
+            std::path::Path::new("p.toml"),
+        )
+    }
+
+    fn line(a: [f64; 3], b: [f64; 3], t: f64) -> Trajectory {
+        Trajectory {
+            times: vec![0.0, t],
+            points: vec![Vec3::from(a), Vec3::from(b)],
+        }
+    }
+
+    #[test]
+    fn figures_by_hand() -> Result<(), crate::scenario::ScenarioError> {
+        let s = scenario()?;
+        // a along y = 0, b back along y = 100, both at 1 m/s: they pass 100 m apart at t = 500,
+        // below d_min = 150 while the x gap is under √(150² − 100²) = 111.8 m: 111.8 s.
+        // a passes 25 m from H's centre: clearance 25 − 20 = 5 m, inside the 30 m inflated sphere.
+        let t = [
+            line(s.vehicles[0].start, s.vehicles[0].goal, 1000.0),
+            line(s.vehicles[1].start, s.vehicles[1].goal, 1000.0),
+        ];
+        let a = assess(&s, &t);
+        assert!((a.vehicles[0].length_m - 1000.0).abs() < 1e-9);
+        assert_eq!(
+            a.vehicles[0]
+                .min_clearance_m
+                .map(|c| (c * 1e6).round() / 1e6),
+            Some(5.0)
+        );
+        assert_eq!(a.vehicles[0].hard_collisions, 1);
+        assert_eq!(a.vehicles[1].hard_collisions, 0);
+        assert_eq!(a.fleet.hard_collisions, 1);
+        let sep = a.fleet.min_separation_m.unwrap_or(f64::NAN);
+        assert!((sep - 100.0).abs() < 1e-9);
+        assert!((a.fleet.min_separation_time_s.unwrap_or(f64::NAN) - 500.0).abs() < 1e-9);
+        // x gap closes at 2 m/s from +111.8 to −111.8 m: 111.8 s.
+        let expect = (150f64.powi(2) - 100f64.powi(2)).sqrt();
+        assert!((a.fleet.separation_breach_s - expect).abs() < 1e-6);
+        assert_eq!(a.fleet.arrival_spread_s, 0.0);
+        assert_eq!(a.violations.len(), 2, "{:?}", a.violations);
+        assert!(a.violations[0].contains("hard obstacle H"));
+        assert!(a.violations[1].contains("a and b"));
+        Ok(())
+    }
+
+    #[test]
+    fn speed_turn_pitch_and_arrival_violations_are_worded(
+    ) -> Result<(), crate::scenario::ScenarioError> {
+        let s = scenario()?;
+        // a at 2.5 m/s (above 2.0), b arrives 400 s later than a and climbs 45° on a hook.
+        let a = line(s.vehicles[0].start, s.vehicles[0].goal, 400.0);
+        let b = Trajectory {
+            times: vec![0.0, 100.0, 800.0],
+            points: vec![
+                Vec3::new(1000.0, 100.0, 0.0),
+                Vec3::new(950.0, 150.0, 50.0 * 2f64.sqrt()),
+                Vec3::new(0.0, 100.0, 0.0),
+            ],
+        };
+        let out = assess(&s, &[a, b]);
+        let all = out.violations.join("\n");
+        assert!(all.contains("a flies legs at 2.500"), "{all}");
+        assert!(all.contains("b pitches 45.0°"), "{all}");
+        assert!(all.contains("b turns"), "{all}");
+        assert!(all.contains("not synchronised"), "{all}");
+        assert!((out.fleet.arrival_spread_s - 400.0).abs() < 1e-9);
+        Ok(())
+    }
+
+    #[test]
+    fn late_arrival_is_explained() -> Result<(), crate::scenario::ScenarioError> {
+        let mut s = scenario()?;
+        s.fleet.mission_time_s = 300.0;
+        let t = [
+            line(s.vehicles[0].start, s.vehicles[0].goal, 500.0),
+            line(s.vehicles[1].start, s.vehicles[1].goal, 500.0),
+        ];
+        let n = timing_notices(&s, &t, 500.0);
+        assert_eq!(n.len(), 2);
+        assert!(
+            n[0].contains("a cannot arrive by the mission time of 300 s"),
+            "{}",
+            n[0]
+        );
+        assert!(n[0].contains("at least 500 s"), "{}", n[0]);
+        Ok(())
+    }
+}

@@ -1,0 +1,583 @@
+//! Scenario files: the mission a planner is asked to solve, in TOML with SI units (metres, seconds,
+//! metres per second, degrees).
+//!
+//! Loading never panics on user input: a syntax error, an unknown key or a bad value comes back as
+//! a [`ScenarioError`] naming the file, the field and the value.
+
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+
+use crate::geometry::Vec3;
+
+/// One knot in metres per second (1852 m / 3600 s), for scenario comments and tests.
+pub const KNOT_MPS: f64 = 1852.0 / 3600.0;
+
+/// Why a scenario could not be used.
+#[derive(Debug, thiserror::Error)]
+pub enum ScenarioError {
+    /// The file could not be read at all.
+    #[error("{file}: cannot read: {source}")]
+    Io {
+        file: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    /// TOML syntax, an unknown key, a missing key or a value of the wrong type.
+    #[error("{file}: {message}")]
+    Parse { file: PathBuf, message: String },
+    /// A value that parses but makes no sense for a mission.
+    #[error("{file}: field `{field}` = {value}: {reason}")]
+    Invalid {
+        file: PathBuf,
+        field: String,
+        value: String,
+        reason: String,
+    },
+}
+
+/// A whole mission: where, what is in the way, who goes where, and how to optimise.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct Scenario {
+    /// Short name, reported in `plan.json` (e.g. `amp-pso-3`).
+    pub name: String,
+    /// Free text: where the numbers come from.
+    #[serde(default)]
+    pub description: String,
+    /// The box every waypoint must stay in; z is up and `max[2]` is the sea surface.
+    pub bounds: Bounds,
+    /// Spheres to avoid (hard) or to spend little time in (soft).
+    #[serde(default)]
+    pub obstacles: Vec<Obstacle>,
+    /// The vehicles to plan for, one chromosome each.
+    pub vehicles: Vec<Vehicle>,
+    /// Coupling between the vehicles: separation and synchronised arrival.
+    pub fleet: Fleet,
+    /// Which optimizer and with what budget.
+    #[serde(default)]
+    pub optimizer: OptimizerSettings,
+}
+
+/// Axis-aligned box of the navigation space, metres.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct Bounds {
+    /// South-west-bottom corner.
+    pub min: [f64; 3],
+    /// North-east-top corner; `max[2]` is the surface used by the depth term.
+    pub max: [f64; 3],
+}
+
+/// How an obstacle affects a vehicle (seed 004 §2.1).
+#[derive(Debug, Clone, Copy, Serialize, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "lowercase")]
+pub enum ObstacleKind {
+    /// Must never be entered (radius plus inflation): a plan touching one is infeasible.
+    Hard,
+    /// May be crossed at a cost (seston, particulates): the threat term F(O).
+    Soft,
+}
+
+/// A sphere with a safety inflation margin (seed 004 Fig. 1).
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct Obstacle {
+    /// Name used in reports (e.g. `HObs#1`).
+    pub id: String,
+    /// Hard or soft.
+    pub kind: ObstacleKind,
+    /// Centre, metres.
+    pub centre: [f64; 3],
+    /// Physical radius, metres.
+    pub radius_m: f64,
+    /// Safety margin added to the radius, metres (seed 004 Table 4: d_hard = d_soft = 50 m).
+    pub inflation_m: f64,
+}
+
+impl Obstacle {
+    /// Centre as a vector.
+    pub fn centre(&self) -> Vec3 {
+        Vec3::from(self.centre)
+    }
+    /// Radius plus inflation: the sphere the planner keeps out of.
+    pub fn inflated_radius(&self) -> f64 {
+        self.radius_m + self.inflation_m
+    }
+}
+
+/// Vehicle type; decides which planner capabilities apply.
+#[derive(Debug, Clone, Copy, Serialize, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "lowercase")]
+pub enum VehicleKind {
+    /// Free-swimming AUV.
+    Auv,
+    /// Tracked seabed crawler (mining vehicle).
+    Crawler,
+}
+
+/// One vehicle of the fleet and its kinematic limits.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct Vehicle {
+    /// Unique id (e.g. `auv1`).
+    pub id: String,
+    /// AUV or crawler.
+    pub kind: VehicleKind,
+    /// Start point, metres.
+    pub start: [f64; 3],
+    /// Goal point, metres.
+    pub goal: [f64; 3],
+    /// Slowest speed through the water on any leg, m/s.
+    pub speed_min_mps: f64,
+    /// Fastest speed on any leg, m/s.
+    pub speed_max_mps: f64,
+    /// Largest heading change at a waypoint, degrees (seed 004: 35°).
+    pub max_turn_deg: f64,
+    /// Largest |pitch| of a leg, degrees (seed 004: 20°).
+    pub max_pitch_deg: f64,
+}
+
+impl Vehicle {
+    /// Start as a vector.
+    pub fn start(&self) -> Vec3 {
+        Vec3::from(self.start)
+    }
+    /// Goal as a vector.
+    pub fn goal(&self) -> Vec3 {
+        Vec3::from(self.goal)
+    }
+}
+
+/// Fleet coupling (seed 004 §2.2.2).
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct Fleet {
+    /// Minimum distance between any two vehicles at every instant, metres (eq. (1)).
+    pub d_min_m: f64,
+    /// Time at which every vehicle should reach its goal, seconds after the start (t_e).
+    pub mission_time_s: f64,
+}
+
+/// The optimizers `plan` can run.
+#[derive(Debug, Clone, Copy, Serialize, Deserialize, PartialEq, Eq, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum Algorithm {
+    /// Adaptive multi-population PSO (seed 004).
+    #[default]
+    AmpPso,
+    /// Classic single-population PSO with fixed coefficients (Table 5).
+    Pso,
+    /// Multi-population PSO with fixed coefficients, c3 = 1.5 (Table 5).
+    MpPso,
+    /// Single-population PSO with the adaptive coefficients of eq. (7) (Table 5).
+    APso,
+}
+
+impl Algorithm {
+    /// Name as written in files and on the command line.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Algorithm::AmpPso => "amp-pso",
+            Algorithm::Pso => "pso",
+            Algorithm::MpPso => "mp-pso",
+            Algorithm::APso => "a-pso",
+        }
+    }
+    /// Every algorithm, in the order of seed 004 Table 5.
+    pub const ALL: [Algorithm; 4] = [
+        Algorithm::AmpPso,
+        Algorithm::APso,
+        Algorithm::MpPso,
+        Algorithm::Pso,
+    ];
+}
+
+impl std::str::FromStr for Algorithm {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        Algorithm::ALL
+            .into_iter()
+            .find(|a| a.as_str() == s)
+            .ok_or_else(|| {
+                format!("unknown algorithm `{s}` (expected amp-pso, pso, mp-pso or a-pso)")
+            })
+    }
+}
+
+/// Optimizer budget and objective weights. Defaults are seed 004 Table 5 and §4.1.4.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields, default)]
+pub struct OptimizerSettings {
+    /// Which optimizer.
+    pub algorithm: Algorithm,
+    /// Follower populations for the multi-population algorithms (Table 5: 20).
+    pub populations: usize,
+    /// Particles per population (Table 5: 50).
+    pub particles: usize,
+    /// Original particles of the leader population, besides the immigrants (§3.2.2 leaves the
+    /// number open; 20 keeps the leader as large as the set of immigrants).
+    pub leader_particles: usize,
+    /// Iterations (Table 5: 200).
+    pub iterations: usize,
+    /// Inner waypoints per vehicle, M (Table 4: 30).
+    pub waypoints: usize,
+    /// Leader/follower exchange period in iterations (§3.2.2 exchanges every iteration).
+    pub exchange_every: usize,
+    /// RNG seed; the same seed gives the same plan.
+    pub seed: u64,
+    /// λ1..λ5 of eq. (12): length, depth, soft threat, time, space (§4.1.4).
+    pub weights: [f64; 5],
+    /// Weight of the constraint penalties (hard obstacles, turn, pitch, separation) that turn the
+    /// constrained problem into an unconstrained one (§3.3.1, ref. [30]).
+    pub penalty_weight: f64,
+    /// Velocity limit per dimension as a fraction of that dimension's range. Eq. (7) starts ω at 2,
+    /// which diverges without a limit; 0.1 is the common PSO choice.
+    pub max_velocity_fraction: f64,
+    /// Worker threads for population steps (results do not depend on it).
+    pub threads: usize,
+}
+
+impl Default for OptimizerSettings {
+    fn default() -> Self {
+        OptimizerSettings {
+            algorithm: Algorithm::AmpPso,
+            populations: 20,
+            particles: 50,
+            leader_particles: 20,
+            iterations: 200,
+            waypoints: 30,
+            exchange_every: 1,
+            seed: 1,
+            weights: [0.2, 0.1, 0.3, 0.1, 0.3],
+            penalty_weight: 10.0,
+            max_velocity_fraction: 0.1,
+            threads: 2,
+        }
+    }
+}
+
+impl Scenario {
+    /// Reads, parses and validates a scenario file.
+    pub fn load(path: &Path) -> Result<Scenario, ScenarioError> {
+        let text = std::fs::read_to_string(path).map_err(|source| ScenarioError::Io {
+            file: path.to_path_buf(),
+            source,
+        })?;
+        Scenario::parse(&text, path)
+    }
+
+    /// Parses and validates scenario text; `file` is only used in error messages.
+    pub fn parse(text: &str, file: &Path) -> Result<Scenario, ScenarioError> {
+        let scenario: Scenario = toml::from_str(text).map_err(|e| ScenarioError::Parse {
+            file: file.to_path_buf(),
+            message: e.to_string().trim_end().replace('\n', "\n  "),
+        })?;
+        scenario.validate(file)?;
+        Ok(scenario)
+    }
+
+    /// Checks every value a planner relies on; the first bad one is reported.
+    pub fn validate(&self, file: &Path) -> Result<(), ScenarioError> {
+        let bad = |field: String, value: String, reason: &str| ScenarioError::Invalid {
+            file: file.to_path_buf(),
+            field,
+            value,
+            reason: reason.to_string(),
+        };
+        for axis in 0..3 {
+            let (lo, hi) = (self.bounds.min[axis], self.bounds.max[axis]);
+            if !(lo.is_finite() && hi.is_finite() && lo < hi) {
+                return Err(bad(
+                    format!("bounds.max[{axis}]"),
+                    format!("{hi}"),
+                    &format!("must be finite and greater than bounds.min[{axis}] = {lo}"),
+                ));
+            }
+        }
+        let inside =
+            |p: &[f64; 3]| (0..3).all(|a| p[a] >= self.bounds.min[a] && p[a] <= self.bounds.max[a]);
+        for (i, o) in self.obstacles.iter().enumerate() {
+            if !o.centre.iter().all(|c| c.is_finite()) {
+                return Err(bad(
+                    format!("obstacles[{i}].centre"),
+                    format!("{:?}", o.centre),
+                    "must be finite",
+                ));
+            }
+            if !(o.radius_m.is_finite() && o.radius_m > 0.0) {
+                return Err(bad(
+                    format!("obstacles[{i}].radius_m"),
+                    o.radius_m.to_string(),
+                    "must be a positive number of metres",
+                ));
+            }
+            if !(o.inflation_m.is_finite() && o.inflation_m >= 0.0) {
+                return Err(bad(
+                    format!("obstacles[{i}].inflation_m"),
+                    o.inflation_m.to_string(),
+                    "must be zero or a positive number of metres",
+                ));
+            }
+        }
+        if self.vehicles.is_empty() {
+            return Err(bad(
+                "vehicles".into(),
+                "[]".into(),
+                "at least one vehicle is needed",
+            ));
+        }
+        for (i, v) in self.vehicles.iter().enumerate() {
+            if v.id.trim().is_empty() {
+                return Err(bad(
+                    format!("vehicles[{i}].id"),
+                    format!("{:?}", v.id),
+                    "must not be empty",
+                ));
+            }
+            if let Some(j) = self.vehicles[..i].iter().position(|w| w.id == v.id) {
+                return Err(bad(
+                    format!("vehicles[{i}].id"),
+                    format!("{:?}", v.id),
+                    &format!("duplicates vehicles[{j}].id"),
+                ));
+            }
+            for (name, p) in [("start", &v.start), ("goal", &v.goal)] {
+                if !inside(p) {
+                    return Err(bad(
+                        format!("vehicles[{i}].{name}"),
+                        format!("{p:?}"),
+                        "lies outside the bounds",
+                    ));
+                }
+                for o in self
+                    .obstacles
+                    .iter()
+                    .filter(|o| o.kind == ObstacleKind::Hard)
+                {
+                    let d = (Vec3::from(*p) - o.centre()).norm();
+                    if d < o.inflated_radius() {
+                        return Err(bad(
+                            format!("vehicles[{i}].{name}"),
+                            format!("{p:?}"),
+                            &format!("lies inside hard obstacle {} (radius plus inflation {:.1} m, distance {d:.1} m)", o.id, o.inflated_radius()),
+                        ));
+                    }
+                }
+            }
+            if !(v.speed_min_mps.is_finite() && v.speed_min_mps > 0.0) {
+                return Err(bad(
+                    format!("vehicles[{i}].speed_min_mps"),
+                    v.speed_min_mps.to_string(),
+                    "must be a positive speed in m/s",
+                ));
+            }
+            if !(v.speed_max_mps.is_finite() && v.speed_max_mps >= v.speed_min_mps) {
+                return Err(bad(
+                    format!("vehicles[{i}].speed_max_mps"),
+                    v.speed_max_mps.to_string(),
+                    "must be at least speed_min_mps",
+                ));
+            }
+            if !(v.max_turn_deg > 0.0 && v.max_turn_deg <= 180.0) {
+                return Err(bad(
+                    format!("vehicles[{i}].max_turn_deg"),
+                    v.max_turn_deg.to_string(),
+                    "must be in (0, 180] degrees",
+                ));
+            }
+            if !(v.max_pitch_deg > 0.0 && v.max_pitch_deg <= 90.0) {
+                return Err(bad(
+                    format!("vehicles[{i}].max_pitch_deg"),
+                    v.max_pitch_deg.to_string(),
+                    "must be in (0, 90] degrees",
+                ));
+            }
+        }
+        if !(self.fleet.d_min_m.is_finite() && self.fleet.d_min_m >= 0.0) {
+            return Err(bad(
+                "fleet.d_min_m".into(),
+                self.fleet.d_min_m.to_string(),
+                "must be zero or a positive number of metres",
+            ));
+        }
+        if !(self.fleet.mission_time_s.is_finite() && self.fleet.mission_time_s > 0.0) {
+            return Err(bad(
+                "fleet.mission_time_s".into(),
+                self.fleet.mission_time_s.to_string(),
+                "must be a positive number of seconds",
+            ));
+        }
+        let o = &self.optimizer;
+        let positive = [
+            ("optimizer.populations", o.populations),
+            ("optimizer.particles", o.particles),
+            ("optimizer.iterations", o.iterations),
+            ("optimizer.waypoints", o.waypoints),
+            ("optimizer.exchange_every", o.exchange_every),
+            ("optimizer.threads", o.threads),
+        ];
+        for (field, value) in positive {
+            if value == 0 {
+                return Err(bad(field.into(), "0".into(), "must be at least 1"));
+            }
+        }
+        if let Some(k) = o.weights.iter().position(|w| !(w.is_finite() && *w >= 0.0)) {
+            return Err(bad(
+                format!("optimizer.weights[{k}]"),
+                o.weights[k].to_string(),
+                "must be a finite weight >= 0",
+            ));
+        }
+        if !(o.penalty_weight.is_finite() && o.penalty_weight > 0.0) {
+            return Err(bad(
+                "optimizer.penalty_weight".into(),
+                o.penalty_weight.to_string(),
+                "must be positive",
+            ));
+        }
+        if !(o.max_velocity_fraction > 0.0 && o.max_velocity_fraction <= 1.0) {
+            return Err(bad(
+                "optimizer.max_velocity_fraction".into(),
+                o.max_velocity_fraction.to_string(),
+                "must be in (0, 1]",
+            ));
+        }
+        Ok(())
+    }
+
+    /// Hard obstacles only.
+    pub fn hard_obstacles(&self) -> impl Iterator<Item = &Obstacle> {
+        self.obstacles
+            .iter()
+            .filter(|o| o.kind == ObstacleKind::Hard)
+    }
+
+    /// Soft obstacles only.
+    pub fn soft_obstacles(&self) -> impl Iterator<Item = &Obstacle> {
+        self.obstacles
+            .iter()
+            .filter(|o| o.kind == ObstacleKind::Soft)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const GOOD: &str = r#"
+name = "t"
+[bounds]
+min = [0.0, 0.0, 0.0]
+max = [100.0, 100.0, 100.0]
+[[obstacles]]
+id = "H1"
+kind = "hard"
+centre = [50.0, 50.0, 50.0]
+radius_m = 10.0
+inflation_m = 5.0
+[[vehicles]]
+id = "a"
+kind = "auv"
+start = [1.0, 1.0, 1.0]
+goal = [99.0, 99.0, 99.0]
+speed_min_mps = 0.5
+speed_max_mps = 1.5
+max_turn_deg = 35.0
+max_pitch_deg = 20.0
+[fleet]
+d_min_m = 5.0
+mission_time_s = 200.0
+"#;
+
+    fn parse(text: &str) -> Result<Scenario, ScenarioError> {
+        Scenario::parse(text, Path::new("scenarios/x.toml"))
+    }
+
+    #[test]
+    fn good_file_parses_with_table5_defaults() -> Result<(), ScenarioError> {
+        let s = parse(GOOD)?;
+        assert_eq!(s.optimizer.populations, 20);
+        assert_eq!(s.optimizer.particles, 50);
+        assert_eq!(s.optimizer.iterations, 200);
+        assert_eq!(s.optimizer.weights, [0.2, 0.1, 0.3, 0.1, 0.3]);
+        assert_eq!(s.obstacles[0].inflated_radius(), 15.0);
+        Ok(())
+    }
+
+    #[test]
+    fn bad_value_names_file_field_and_value() {
+        let text = GOOD.replace("speed_max_mps = 1.5", "speed_max_mps = 0.1");
+        let msg = parse(&text)
+            .err()
+            .map(|e| e.to_string())
+            .unwrap_or_default();
+        assert!(msg.contains("scenarios/x.toml"), "{msg}");
+        assert!(msg.contains("vehicles[0].speed_max_mps"), "{msg}");
+        assert!(msg.contains("0.1"), "{msg}");
+    }
+
+    #[test]
+    fn start_inside_hard_obstacle_is_rejected() {
+        let text = GOOD.replace("start = [1.0, 1.0, 1.0]", "start = [45.0, 50.0, 50.0]");
+        let msg = parse(&text)
+            .err()
+            .map(|e| e.to_string())
+            .unwrap_or_default();
+        assert!(
+            msg.contains("vehicles[0].start") && msg.contains("H1"),
+            "{msg}"
+        );
+    }
+
+    #[test]
+    fn unknown_key_and_wrong_type_are_named() {
+        let text = GOOD.replace("max_pitch_deg = 20.0", "max_pitch_deg = 20.0\nmax_pich = 3");
+        let msg = parse(&text)
+            .err()
+            .map(|e| e.to_string())
+            .unwrap_or_default();
+        assert!(msg.contains("max_pich"), "{msg}");
+        let text = GOOD.replace("radius_m = 10.0", "radius_m = \"ten\"");
+        let msg = parse(&text)
+            .err()
+            .map(|e| e.to_string())
+            .unwrap_or_default();
+        assert!(msg.contains("radius_m") && msg.contains("x.toml"), "{msg}");
+    }
+
+    #[test]
+    fn duplicate_vehicle_and_zero_budget_are_rejected() {
+        let dup = GOOD.to_string()
+            + r#"
+[[vehicles]]
+id = "a"
+kind = "auv"
+start = [2.0, 1.0, 1.0]
+goal = [98.0, 99.0, 99.0]
+speed_min_mps = 0.5
+speed_max_mps = 1.5
+max_turn_deg = 35.0
+max_pitch_deg = 20.0
+"#;
+        let msg = parse(&dup).err().map(|e| e.to_string()).unwrap_or_default();
+        assert!(
+            msg.contains("vehicles[1].id") && msg.contains("duplicates"),
+            "{msg}"
+        );
+        let zero = GOOD.to_string() + "[optimizer]\niterations = 0\n";
+        let msg = parse(&zero)
+            .err()
+            .map(|e| e.to_string())
+            .unwrap_or_default();
+        assert!(msg.contains("optimizer.iterations"), "{msg}");
+    }
+
+    #[test]
+    fn algorithm_names_round_trip() {
+        for a in Algorithm::ALL {
+            assert_eq!(a.as_str().parse::<Algorithm>(), Ok(a));
+        }
+        assert!("ga".parse::<Algorithm>().is_err());
+    }
+}

@@ -1,0 +1,237 @@
+//! Multi-population PSO with a leader population (seed 004 §3.2–3.3): AMP-PSO with the adaptive
+//! coefficients of eq. (7)–(8), and MP-PSO with Table 5's fixed ones (c3 = 1.5).
+//!
+//! Every iteration each follower population moves by eq. (5) on its own. Every `exchange_every`
+//! iterations the best particle of each follower immigrates into the leader population (Fig. 5a);
+//! immigrants and the leader's own particles move by eq. (6), pulled also towards the followers'
+//! global best o_f_gbest (Fig. 5b); the updated immigrants then return to their own follower
+//! population and replace its worst particle (Fig. 5c).
+
+use super::population::{assemble, update, Limits, Particle, Population, Schedule};
+use super::{Problem, Progress, Solver, SolverState};
+
+/// Multi-population PSO with a leader.
+#[derive(Debug, Clone)]
+pub struct MultiPso {
+    /// Follower populations (Table 5: 20).
+    pub populations: usize,
+    /// Particles per follower population (Table 5: 50).
+    pub particles: usize,
+    /// The leader's own particles, besides the immigrants.
+    pub leader_particles: usize,
+    /// Exchange period, iterations.
+    pub exchange_every: usize,
+    /// Fixed (MP-PSO) or adaptive (AMP-PSO) coefficients.
+    pub schedule: Schedule,
+    /// Velocity cap as a fraction of each dimension's range.
+    pub max_velocity_fraction: f64,
+    /// Threads that step follower populations; the result does not depend on it.
+    pub threads: usize,
+    /// RNG seed.
+    pub seed: u64,
+}
+
+impl MultiPso {
+    /// AMP-PSO with Table 5's sizes.
+    pub fn amp(seed: u64) -> MultiPso {
+        MultiPso {
+            populations: 20,
+            particles: 50,
+            leader_particles: 20,
+            exchange_every: 1,
+            schedule: Schedule::Adaptive,
+            max_velocity_fraction: 0.1,
+            threads: 2,
+            seed,
+        }
+    }
+
+    /// MP-PSO: the same structure with Table 5's fixed coefficients.
+    pub fn mp(seed: u64) -> MultiPso {
+        MultiPso {
+            schedule: Schedule::TABLE5_FIXED,
+            ..MultiPso::amp(seed)
+        }
+    }
+}
+
+/// Seed of population `k`: distinct streams from one user seed.
+fn stream_seed(seed: u64, k: u64) -> u64 {
+    seed ^ (k + 1).wrapping_mul(0x9E37_79B9_7F4A_7C15)
+}
+
+/// State of a multi-population run.
+#[derive(Debug, Clone)]
+pub struct MultiState {
+    /// Follower populations.
+    pub followers: Vec<Population>,
+    /// The leader's own particles (immigrants join it only during an exchange).
+    pub leader: Population,
+    /// Box and velocity limits.
+    pub limits: Limits,
+    /// Best position found by any population.
+    pub best_x: Vec<f64>,
+    /// Its cost.
+    pub best_cost: f64,
+    /// Evaluations so far.
+    pub evaluations: u64,
+}
+
+impl MultiState {
+    /// Keeps the best truly evaluated position of any population as the run's best.
+    fn absorb_elites(&mut self) {
+        for pop in self.followers.iter().chain(std::iter::once(&self.leader)) {
+            if pop.elite_cost < self.best_cost {
+                self.best_cost = pop.elite_cost;
+                self.best_x.clone_from(&pop.elite_x);
+            }
+        }
+    }
+}
+
+impl SolverState for MultiState {
+    fn best_cost(&self) -> f64 {
+        self.best_cost
+    }
+    fn best_position(&self) -> &[f64] {
+        &self.best_x
+    }
+    fn evaluations(&self) -> u64 {
+        self.evaluations
+    }
+}
+
+impl MultiPso {
+    /// Steps every follower by eq. (5), spread over `threads` scoped threads.
+    fn step_followers<P: Problem>(
+        &self,
+        problem: &P,
+        state: &mut MultiState,
+        progress: Progress,
+    ) -> u64 {
+        let c = self.schedule.at(progress);
+        let limits = &state.limits;
+        let chunk = state.followers.len().div_ceil(self.threads.max(1)).max(1);
+        std::thread::scope(|scope| {
+            let handles: Vec<_> = state
+                .followers
+                .chunks_mut(chunk)
+                .map(|pops| {
+                    scope.spawn(move || {
+                        pops.iter_mut()
+                            .map(|pop| pop.step(problem, c, None, limits))
+                            .sum::<u64>()
+                    })
+                })
+                .collect();
+            // A panicking follower thread is a bug in the cost function; re-raise it here.
+            handles
+                .into_iter()
+                .map(|h| h.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
+                .sum()
+        })
+    }
+
+    /// Fig. 5: immigrate, update the leader by eq. (6), return the immigrants.
+    fn exchange<P: Problem>(&self, problem: &P, state: &mut MultiState, progress: Progress) -> u64 {
+        let c = self.schedule.at(progress);
+        // (a) the best of each follower immigrates (a fresh evaluation when its best is assembled).
+        let mut immigrants: Vec<Particle> = state
+            .followers
+            .iter()
+            .filter_map(|f| f.emigrant(problem))
+            .collect();
+        let mut evaluations = if problem.blocks() > 1 {
+            immigrants.len() as u64
+        } else {
+            0
+        };
+        // o_f_gbest: the followers' global best, assembled over all followers' particles.
+        let Some((f_gbest, _)) = assemble(
+            problem,
+            state.followers.iter().flat_map(|f| f.particles.iter()),
+        ) else {
+            return evaluations;
+        };
+        // (b) leader and immigrants move by eq. (6), towards the leader's own best and o_f_gbest.
+        let leader_gbest = assemble(
+            problem,
+            state.leader.particles.iter().chain(immigrants.iter()),
+        )
+        .map_or_else(|| f_gbest.clone(), |(x, _)| x);
+        let rng = &mut state.leader.rng;
+        for p in state
+            .leader
+            .particles
+            .iter_mut()
+            .chain(immigrants.iter_mut())
+        {
+            update(p, &leader_gbest, Some(&f_gbest), c, &state.limits, rng);
+            p.evaluate(problem);
+        }
+        evaluations += (state.leader.particles.len() + immigrants.len()) as u64;
+        for im in &immigrants {
+            if im.cost < state.leader.elite_cost {
+                state.leader.elite_cost = im.cost;
+                state.leader.elite_x.clone_from(&im.x);
+            }
+        }
+        evaluations += state.leader.refresh(problem);
+        // (c) the updated immigrants return home and replace the worst particle there.
+        for (f, immigrant) in immigrants.into_iter().enumerate() {
+            let pop = &mut state.followers[f];
+            let worst = pop.worst();
+            pop.particles[worst] = immigrant;
+            evaluations += pop.refresh(problem);
+        }
+        evaluations
+    }
+}
+
+impl<P: Problem> Solver<P> for MultiPso {
+    type State = MultiState;
+
+    fn name(&self) -> &'static str {
+        match self.schedule {
+            Schedule::Adaptive => "amp-pso",
+            Schedule::Fixed(_) => "mp-pso",
+        }
+    }
+
+    fn init(&mut self, problem: &P) -> MultiState {
+        let followers: Vec<Population> = (0..self.populations)
+            .map(|k| Population::sample(problem, self.particles, stream_seed(self.seed, k as u64)))
+            .collect();
+        let leader = Population::sample(
+            problem,
+            self.leader_particles,
+            stream_seed(self.seed, self.populations as u64),
+        );
+        let mut state = MultiState {
+            evaluations: followers
+                .iter()
+                .chain(std::iter::once(&leader))
+                .map(|p| p.evaluations)
+                .sum(),
+            limits: Limits::of(problem, self.max_velocity_fraction),
+            best_x: Vec::new(),
+            best_cost: f64::INFINITY,
+            followers,
+            leader,
+        };
+        state.absorb_elites();
+        state
+    }
+
+    fn step(&mut self, problem: &P, mut state: MultiState, progress: Progress) -> MultiState {
+        state.evaluations += self.step_followers(problem, &mut state, progress);
+        if progress
+            .iteration
+            .is_multiple_of(self.exchange_every.max(1))
+        {
+            state.evaluations += self.exchange(problem, &mut state, progress);
+        }
+        state.absorb_elites();
+        state
+    }
+}

@@ -1,0 +1,454 @@
+//! Particles, populations and the PSO update rules every variant shares: eq. (5) for a population
+//! on its own and eq. (6) when a third attractor (the followers' best) is added, with either fixed
+//! coefficients (Table 5) or the adaptive ones of eq. (7)–(8).
+//!
+//! Memories are kept block by block (see [`Problem::blocks`]): a particle's personal best is, for
+//! each block, the best that block has been, and a population's global best takes each block from
+//! the particle that remembers it best. For a problem of one block this is textbook PSO. Because
+//! an assembled best was never evaluated as a whole, every population also keeps its *elite*: the
+//! best position it has truly evaluated, which is what a run reports.
+
+use rand::rngs::StdRng;
+use rand::{Rng, SeedableRng};
+
+use super::{Problem, Progress};
+
+/// One particle: where it is, where it goes, and the best place each block of it has been.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Particle {
+    /// Position x_i(k).
+    pub x: Vec<f64>,
+    /// Velocity v_i(k).
+    pub v: Vec<f64>,
+    /// Cost of `x` (a true evaluation).
+    pub cost: f64,
+    /// Cost of `x` per block.
+    pub parts: Vec<f64>,
+    /// Personal best o_pbest, assembled block by block.
+    pub best_x: Vec<f64>,
+    /// Per-block cost of `best_x`'s blocks when they were evaluated.
+    pub best_parts: Vec<f64>,
+    /// Sum of `best_parts`.
+    pub best_cost: f64,
+}
+
+impl Particle {
+    /// A particle at `x` with zero velocity, evaluated.
+    pub fn new<P: Problem>(problem: &P, x: Vec<f64>) -> Particle {
+        let mut parts = vec![0.0; problem.blocks()];
+        let cost = problem.cost_parts(&x, &mut parts);
+        Particle {
+            v: vec![0.0; x.len()],
+            best_x: x.clone(),
+            best_parts: parts.clone(),
+            best_cost: cost,
+            cost,
+            parts,
+            x,
+        }
+    }
+
+    /// Re-evaluates after a move and keeps each block's personal best.
+    pub fn evaluate<P: Problem>(&mut self, problem: &P) {
+        self.cost = problem.cost_parts(&self.x, &mut self.parts);
+        for b in 0..self.parts.len() {
+            if self.parts[b] < self.best_parts[b] {
+                self.best_parts[b] = self.parts[b];
+                let r = problem.block_range(b);
+                self.best_x[r.clone()].copy_from_slice(&self.x[r]);
+            }
+        }
+        self.best_cost = self.best_parts.iter().sum();
+    }
+}
+
+/// Global best assembled block by block from the personal bests of `particles`: each block comes
+/// from the particle that remembers it best. Returns the position and its per-block costs.
+pub fn assemble<'a, P: Problem>(
+    problem: &P,
+    particles: impl Iterator<Item = &'a Particle> + Clone,
+) -> Option<(Vec<f64>, Vec<f64>)> {
+    let first = particles.clone().next()?;
+    let mut x = first.best_x.clone();
+    let mut parts = first.best_parts.clone();
+    for p in particles.skip(1) {
+        for (b, part) in parts.iter_mut().enumerate() {
+            if p.best_parts[b] < *part {
+                *part = p.best_parts[b];
+                let r = problem.block_range(b);
+                x[r.clone()].copy_from_slice(&p.best_x[r]);
+            }
+        }
+    }
+    Some((x, parts))
+}
+
+/// PSO coefficients for one iteration.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Coefficients {
+    /// Inertia weight ω.
+    pub w: f64,
+    /// Cognitive factor c1 (pull to the personal best).
+    pub c1: f64,
+    /// Social factor c2 (pull to the population best).
+    pub c2: f64,
+    /// Exchange factor c3 (pull to the followers' best), leader only.
+    pub c3: f64,
+}
+
+/// How the coefficients evolve over a run.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Schedule {
+    /// Constant (classic PSO, MP-PSO: ω = 0.15, c1 = c2 = c3 = 1.5 in Table 5).
+    Fixed(Coefficients),
+    /// Seed 004 eq. (7)–(8): ω = 2 − 2a/b, c1 = 2 − a/b, c2 = 1 + a/b, c3 = 2 − a/b.
+    Adaptive,
+}
+
+impl Schedule {
+    /// Table 5's fixed coefficients for the comparison algorithms.
+    pub const TABLE5_FIXED: Schedule = Schedule::Fixed(Coefficients {
+        w: 0.15,
+        c1: 1.5,
+        c2: 1.5,
+        c3: 1.5,
+    });
+
+    /// Coefficients at `progress`.
+    pub fn at(&self, progress: Progress) -> Coefficients {
+        match *self {
+            Schedule::Fixed(c) => c,
+            Schedule::Adaptive => {
+                let r = progress.fraction();
+                Coefficients {
+                    w: -2.0 * r + 2.0,
+                    c1: -r + 2.0,
+                    c2: r + 1.0,
+                    c3: -r + 2.0,
+                }
+            }
+        }
+    }
+}
+
+/// Box and velocity limits every move respects.
+#[derive(Debug, Clone)]
+pub struct Limits {
+    /// Lower bounds.
+    pub lower: Vec<f64>,
+    /// Upper bounds.
+    pub upper: Vec<f64>,
+    /// Largest |velocity| per dimension.
+    pub vmax: Vec<f64>,
+    /// Dimensions that share their random factors and velocity scaling: one group per
+    /// dimension for textbook PSO, one per block for coherent blocks.
+    pub groups: Vec<std::ops::Range<usize>>,
+}
+
+impl Limits {
+    /// Limits of `problem`, with velocities capped at `fraction` of each dimension's range.
+    pub fn of<P: Problem>(problem: &P, fraction: f64) -> Limits {
+        let lower = problem.lower().to_vec();
+        let upper = problem.upper().to_vec();
+        let vmax = lower
+            .iter()
+            .zip(&upper)
+            .map(|(l, u)| fraction * (u - l))
+            .collect();
+        let groups = if problem.coherent_blocks() {
+            (0..problem.blocks())
+                .map(|b| problem.block_range(b))
+                .collect()
+        } else {
+            (0..problem.dim()).map(|d| d..d + 1).collect()
+        };
+        Limits {
+            lower,
+            upper,
+            vmax,
+            groups,
+        }
+    }
+}
+
+/// Moves `p` by eq. (5) — or eq. (6) when `exchange` gives the followers' best o_f_gbest — then
+/// scales the velocity into its limits and clamps the position. A particle that hits a wall stops
+/// in that dimension (absorbing boundary), so it does not keep pushing outwards.
+///
+/// `r1`, `r2`, `r3` are drawn per group of [`Limits::groups`]: per dimension in textbook PSO, once
+/// per vehicle path for coherent blocks. A path's new velocity is then a linear combination of
+/// whole paths (the old velocity, the personal and the global best), so smooth paths stay smooth
+/// instead of picking up an independent kink at every waypoint; for the same reason a group's
+/// velocity over its limit is scaled down as a whole (for a one-dimension group, a plain clamp).
+pub fn update(
+    p: &mut Particle,
+    gbest: &[f64],
+    exchange: Option<&[f64]>,
+    c: Coefficients,
+    limits: &Limits,
+    rng: &mut StdRng,
+) {
+    for g in &limits.groups {
+        let (r1, r2): (f64, f64) = (rng.random(), rng.random());
+        let (a1, a2) = (c.c1 * r1, c.c2 * r2);
+        let a3 = if exchange.is_some() {
+            c.c3 * rng.random::<f64>()
+        } else {
+            0.0
+        };
+        let mut over: f64 = 1.0;
+        for d in g.clone() {
+            let mut v = c.w * p.v[d] + a1 * (p.best_x[d] - p.x[d]) + a2 * (gbest[d] - p.x[d]);
+            if let Some(f) = exchange {
+                v += a3 * (f[d] - p.x[d]);
+            }
+            p.v[d] = v;
+            over = over.max(v.abs() / limits.vmax[d]);
+        }
+        let scale = 1.0 / over;
+        for d in g.clone() {
+            let mut v = p.v[d] * scale;
+            let mut x = p.x[d] + v;
+            if x < limits.lower[d] {
+                x = limits.lower[d];
+                v = 0.0;
+            } else if x > limits.upper[d] {
+                x = limits.upper[d];
+                v = 0.0;
+            }
+            p.x[d] = x;
+            p.v[d] = v;
+        }
+    }
+}
+
+/// A population with its own RNG, so populations can step on different threads and still give
+/// the same result for the same seed.
+#[derive(Debug, Clone)]
+pub struct Population {
+    /// Its particles.
+    pub particles: Vec<Particle>,
+    /// o_gbest, assembled block by block from the personal bests.
+    pub gbest: Vec<f64>,
+    /// Per-block costs of `gbest` as remembered.
+    pub gbest_parts: Vec<f64>,
+    /// Best position this population has truly evaluated.
+    pub elite_x: Vec<f64>,
+    /// Its cost.
+    pub elite_cost: f64,
+    /// This population's random stream.
+    pub rng: StdRng,
+    /// Cost evaluations this population has made.
+    pub evaluations: u64,
+}
+
+impl Population {
+    /// `size` particles sampled from `problem`, with the RNG seeded from `seed`.
+    pub fn sample<P: Problem>(problem: &P, size: usize, seed: u64) -> Population {
+        let mut rng = StdRng::seed_from_u64(seed);
+        let particles: Vec<Particle> = (0..size)
+            .map(|_| {
+                let x = problem.sample(&mut rng);
+                Particle::new(problem, x)
+            })
+            .collect();
+        Population::from_particles(problem, particles, rng)
+    }
+
+    /// A population of given particles.
+    pub fn from_particles<P: Problem>(
+        problem: &P,
+        particles: Vec<Particle>,
+        rng: StdRng,
+    ) -> Population {
+        let mut pop = Population {
+            particles,
+            gbest: Vec::new(),
+            gbest_parts: Vec::new(),
+            elite_x: Vec::new(),
+            elite_cost: f64::INFINITY,
+            rng,
+            evaluations: 0,
+        };
+        pop.evaluations = pop.particles.len() as u64;
+        pop.refresh(problem);
+        pop
+    }
+
+    /// Recomputes o_gbest and the elite after particles moved or were replaced.
+    pub fn refresh<P: Problem>(&mut self, problem: &P) -> u64 {
+        for p in &self.particles {
+            if p.cost < self.elite_cost {
+                self.elite_cost = p.cost;
+                self.elite_x.clone_from(&p.x);
+            }
+        }
+        let Some((x, parts)) = assemble(problem, self.particles.iter()) else {
+            return 0;
+        };
+        self.gbest = x;
+        self.gbest_parts = parts;
+        // An assembled best is a new position: evaluate it once so the elite can take it.
+        if problem.blocks() > 1 && self.gbest != self.elite_x {
+            let cost = problem.cost(&self.gbest);
+            self.evaluations += 1;
+            if cost < self.elite_cost {
+                self.elite_cost = cost;
+                self.elite_x.clone_from(&self.gbest);
+            }
+            return 1;
+        }
+        0
+    }
+
+    /// The particle an exchange sends to the leader: the population's best, positioned at its
+    /// global best.
+    pub fn emigrant<P: Problem>(&self, problem: &P) -> Option<Particle> {
+        if problem.blocks() > 1 {
+            return Some(Particle::new(problem, self.gbest.clone()));
+        }
+        self.particles
+            .iter()
+            .min_by(|a, b| a.best_cost.total_cmp(&b.best_cost))
+            .cloned()
+    }
+
+    /// Index of the particle whose current cost is worst.
+    pub fn worst(&self) -> usize {
+        self.particles
+            .iter()
+            .enumerate()
+            .max_by(|a, b| a.1.cost.total_cmp(&b.1.cost))
+            .map_or(0, |(i, _)| i)
+    }
+
+    /// One eq. (5) / (6) iteration of every particle, then evaluation. Returns evaluations made.
+    pub fn step<P: Problem>(
+        &mut self,
+        problem: &P,
+        c: Coefficients,
+        exchange: Option<&[f64]>,
+        limits: &Limits,
+    ) -> u64 {
+        for p in &mut self.particles {
+            update(p, &self.gbest, exchange, c, limits, &mut self.rng);
+            p.evaluate(problem);
+        }
+        self.evaluations += self.particles.len() as u64;
+        self.particles.len() as u64 + self.refresh(problem)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use approx::assert_abs_diff_eq;
+
+    #[test]
+    fn adaptive_schedule_follows_eq_7_and_8() {
+        let at = |a, b| {
+            Schedule::Adaptive.at(Progress {
+                iteration: a,
+                max_iterations: b,
+            })
+        };
+        let c = at(0, 200);
+        assert_eq!((c.w, c.c1, c.c2, c.c3), (2.0, 2.0, 1.0, 2.0));
+        let c = at(50, 200);
+        assert_abs_diff_eq!(c.w, 1.5);
+        assert_abs_diff_eq!(c.c1, 1.75);
+        assert_abs_diff_eq!(c.c2, 1.25);
+        assert_abs_diff_eq!(c.c3, 1.75);
+        let c = at(200, 200);
+        assert_eq!((c.w, c.c1, c.c2, c.c3), (0.0, 1.0, 2.0, 1.0));
+    }
+
+    #[test]
+    fn update_with_no_pull_is_pure_inertia_scaled_into_its_limits() {
+        let limits = Limits {
+            lower: vec![0.0, 0.0],
+            upper: vec![10.0, 10.0],
+            vmax: vec![3.0, 3.0],
+            groups: std::iter::once(0..2).collect(),
+        };
+        let mut p = Particle {
+            x: vec![5.0, 9.0],
+            v: vec![1.0, 5.0],
+            cost: 0.0,
+            parts: vec![0.0],
+            best_x: vec![5.0, 9.0],
+            best_parts: vec![0.0],
+            best_cost: 0.0,
+        };
+        // Personal and global best equal x: only inertia acts. ω = 2 → v = (2, 10); the second
+        // dimension is 10/3 over its cap, so both are scaled by 3/10 → (0.6, 3), keeping the
+        // direction. x = (5.6, 12) → the wall at 10 stops the second dimension.
+        let c = Coefficients {
+            w: 2.0,
+            c1: 1.5,
+            c2: 1.5,
+            c3: 0.0,
+        };
+        let mut rng = StdRng::seed_from_u64(0);
+        update(&mut p, &[5.0, 9.0], None, c, &limits, &mut rng);
+        assert_abs_diff_eq!(p.x[0], 5.6, epsilon = 1e-12);
+        assert_abs_diff_eq!(p.x[1], 10.0);
+        assert_abs_diff_eq!(p.v[0], 0.6, epsilon = 1e-12);
+        assert_abs_diff_eq!(p.v[1], 0.0);
+        // Per-dimension groups clamp each dimension on its own: (2, 10) → (2, 3).
+        let per_dim = Limits {
+            groups: vec![0..1, 1..2],
+            ..limits
+        };
+        p.x = vec![5.0, 5.0];
+        p.best_x = vec![5.0, 5.0];
+        p.v = vec![1.0, 5.0];
+        update(&mut p, &[5.0, 5.0], None, c, &per_dim, &mut rng);
+        assert_eq!(p.x, vec![7.0, 8.0]);
+    }
+
+    /// Two independent blocks: cost = (x0 − 1)² + (x1 − 2)².
+    struct TwoBlocks;
+    impl Problem for TwoBlocks {
+        fn lower(&self) -> &[f64] {
+            &[-10.0, -10.0]
+        }
+        fn upper(&self) -> &[f64] {
+            &[10.0, 10.0]
+        }
+        fn cost(&self, x: &[f64]) -> f64 {
+            let mut p = [0.0; 2];
+            self.cost_parts(x, &mut p)
+        }
+        fn blocks(&self) -> usize {
+            2
+        }
+        fn block_range(&self, b: usize) -> std::ops::Range<usize> {
+            b..b + 1
+        }
+        fn cost_parts(&self, x: &[f64], parts: &mut [f64]) -> f64 {
+            parts[0] = (x[0] - 1.0).powi(2);
+            parts[1] = (x[1] - 2.0).powi(2);
+            parts[0] + parts[1]
+        }
+    }
+
+    #[test]
+    fn memories_are_kept_block_by_block() {
+        let mut p = Particle::new(&TwoBlocks, vec![3.0, 2.0]); // parts (4, 0)
+        p.x = vec![1.0, 5.0]; // parts (0, 9): block 0 improves, block 1 does not
+        p.evaluate(&TwoBlocks);
+        assert_eq!(p.cost, 9.0);
+        assert_eq!(p.best_x, vec![1.0, 2.0]);
+        assert_eq!(p.best_parts, vec![0.0, 0.0]);
+        assert_eq!(p.best_cost, 0.0);
+        // Assembling takes block 0 from one particle and block 1 from another; the elite is the
+        // assembled position once it is evaluated.
+        let a = Particle::new(&TwoBlocks, vec![1.0, 7.0]);
+        let b = Particle::new(&TwoBlocks, vec![6.0, 2.0]);
+        let pop = Population::from_particles(&TwoBlocks, vec![a, b], StdRng::seed_from_u64(1));
+        assert_eq!(pop.gbest, vec![1.0, 2.0]);
+        assert_eq!(pop.elite_x, vec![1.0, 2.0]);
+        assert_eq!(pop.elite_cost, 0.0);
+    }
+}

@@ -1,0 +1,338 @@
+//! Particle encoding (seed 004 eq. (3)–(4)) and timed trajectories.
+//!
+//! A vehicle's chromosome is `M` genes `g_j = (x_j, y_j, z_j, δ_j)`: an inner waypoint and its
+//! status gene. Shoal uses the status gene as the *requested speed* on the leg that ends at
+//! waypoint `j` (the last leg, into the goal, keeps `δ_M`), so the optimizer shapes the timing and
+//! the vehicles can let each other pass. A fleet particle is the chromosomes of all vehicles, one
+//! after the other (Fig. 3).
+//!
+//! Timing: the requested speeds are only a *profile*. [`retime`] scales the profile so the vehicle
+//! arrives at the fleet's common arrival time, keeping every leg's speed inside the vehicle's range.
+
+use crate::geometry::Vec3;
+use crate::scenario::{Scenario, Vehicle};
+
+/// Genes per waypoint: x, y, z and the status gene δ.
+pub const GENES_PER_WAYPOINT: usize = 4;
+
+/// Where each vehicle's chromosome sits in a fleet particle.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Layout {
+    /// Inner waypoints per vehicle (M).
+    pub waypoints: usize,
+    /// Number of vehicles (chromosomes).
+    pub vehicles: usize,
+}
+
+impl Layout {
+    /// Layout for a scenario.
+    pub fn of(scenario: &Scenario) -> Layout {
+        Layout {
+            waypoints: scenario.optimizer.waypoints,
+            vehicles: scenario.vehicles.len(),
+        }
+    }
+    /// Genes in one chromosome.
+    pub fn chromosome_len(&self) -> usize {
+        self.waypoints * GENES_PER_WAYPOINT
+    }
+    /// Genes in one fleet particle.
+    pub fn dim(&self) -> usize {
+        self.chromosome_len() * self.vehicles
+    }
+    /// Gene range of vehicle `i`'s chromosome.
+    pub fn chromosome(&self, i: usize) -> std::ops::Range<usize> {
+        let n = self.chromosome_len();
+        i * n..(i + 1) * n
+    }
+    /// Lower and upper bound of every gene of a fleet particle: the scenario box for coordinates,
+    /// the vehicle's speed range for δ.
+    pub fn gene_bounds(&self, scenario: &Scenario) -> (Vec<f64>, Vec<f64>) {
+        let mut lo = Vec::with_capacity(self.dim());
+        let mut hi = Vec::with_capacity(self.dim());
+        for v in &scenario.vehicles {
+            for _ in 0..self.waypoints {
+                lo.extend_from_slice(&scenario.bounds.min);
+                hi.extend_from_slice(&scenario.bounds.max);
+                lo.push(v.speed_min_mps);
+                hi.push(v.speed_max_mps);
+            }
+        }
+        (lo, hi)
+    }
+}
+
+/// A vehicle's geometric path decoded from its chromosome: start, inner waypoints, goal, and the
+/// requested speed of each leg (`points.len() − 1` legs).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Path {
+    /// Start, the M inner waypoints, goal.
+    pub points: Vec<Vec3>,
+    /// Requested speed per leg, m/s (from the status genes).
+    pub speeds: Vec<f64>,
+}
+
+impl Path {
+    /// Decodes one chromosome (`genes.len() == 4 M`) for `vehicle`.
+    pub fn decode(vehicle: &Vehicle, genes: &[f64]) -> Path {
+        let m = genes.len() / GENES_PER_WAYPOINT;
+        let mut points = Vec::with_capacity(m + 2);
+        let mut speeds = Vec::with_capacity(m + 1);
+        points.push(vehicle.start());
+        for g in genes.chunks_exact(GENES_PER_WAYPOINT) {
+            points.push(Vec3::new(g[0], g[1], g[2]));
+            speeds.push(g[3]);
+        }
+        points.push(vehicle.goal());
+        speeds.push(speeds.last().copied().unwrap_or(vehicle.speed_max_mps));
+        Path { points, speeds }
+    }
+
+    /// Length of every leg, metres.
+    pub fn leg_lengths(&self) -> Vec<f64> {
+        self.points
+            .windows(2)
+            .map(|w| (w[1] - w[0]).norm())
+            .collect()
+    }
+
+    /// Total length, metres.
+    pub fn length(&self) -> f64 {
+        self.points.windows(2).map(|w| (w[1] - w[0]).norm()).sum()
+    }
+}
+
+/// A timed trajectory: the vehicle moves in a straight line at constant speed between consecutive
+/// samples, and holds at its last sample afterwards.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Trajectory {
+    /// Sample times, seconds, non-decreasing, starting at 0.
+    pub times: Vec<f64>,
+    /// Sample positions, metres.
+    pub points: Vec<Vec3>,
+}
+
+impl Trajectory {
+    /// Time of the last sample: the arrival at the goal, seconds.
+    pub fn arrival(&self) -> f64 {
+        self.times.last().copied().unwrap_or(0.0)
+    }
+
+    /// Position at time `t` (held before the first and after the last sample).
+    pub fn position_at(&self, t: f64) -> Vec3 {
+        let n = self.times.len();
+        if n == 0 {
+            return Vec3::zeros();
+        }
+        if t <= self.times[0] {
+            return self.points[0];
+        }
+        if t >= self.times[n - 1] {
+            return self.points[n - 1];
+        }
+        // First sample strictly after t; t lies in [times[k-1], times[k]).
+        let k = self.times.partition_point(|&s| s <= t);
+        let (t0, t1) = (self.times[k - 1], self.times[k]);
+        let s = if t1 > t0 { (t - t0) / (t1 - t0) } else { 1.0 };
+        self.points[k - 1] + (self.points[k] - self.points[k - 1]) * s
+    }
+
+    /// Speed on each leg, m/s (zero for a leg of zero duration and length).
+    pub fn leg_speeds(&self) -> Vec<f64> {
+        self.times
+            .windows(2)
+            .zip(self.points.windows(2))
+            .map(|(t, p)| {
+                let dt = t[1] - t[0];
+                let d = (p[1] - p[0]).norm();
+                if dt > 0.0 {
+                    d / dt
+                } else {
+                    0.0
+                }
+            })
+            .collect()
+    }
+}
+
+/// Earliest and latest arrival a path allows: `t_min = L / v_max`, `t_max = L / v_min`
+/// (seed 004 eq. (2)), seconds.
+pub fn arrival_window(length: f64, vehicle: &Vehicle) -> (f64, f64) {
+    (
+        length / vehicle.speed_max_mps,
+        length / vehicle.speed_min_mps,
+    )
+}
+
+/// The arrival time all vehicles aim for: the mission time when every vehicle can make it, else
+/// the earliest time the slowest-to-arrive vehicle can make (seed 004 §2.2.2: the task "cannot be
+/// completed on time"). Never earlier than the mission time.
+pub fn common_arrival(mission_time: f64, earliest: impl IntoIterator<Item = f64>) -> f64 {
+    earliest.into_iter().fold(mission_time, f64::max)
+}
+
+/// Times `path` so the vehicle arrives at `target` seconds, with every leg's speed inside
+/// `[v_min, v_max]` and the legs' speeds in the proportions the status genes request as far as
+/// the limits allow.
+///
+/// Each leg's pace (s/m) is `clamp(α / δ_j, 1/v_max, 1/v_min)`; the total time is monotone in `α`,
+/// so `α` is found by bisection and then solved exactly on the final active set. If the target is
+/// out of reach the vehicle flies the whole path at `v_max` (too late) or `v_min` (too early).
+pub fn retime(path: &Path, vehicle: &Vehicle, target: f64) -> Trajectory {
+    let lengths = path.leg_lengths();
+    let (p_lo, p_hi) = (1.0 / vehicle.speed_max_mps, 1.0 / vehicle.speed_min_mps);
+    let total: f64 = lengths.iter().sum();
+    let paces: Vec<f64> = path
+        .speeds
+        .iter()
+        .map(|v| 1.0 / v.clamp(vehicle.speed_min_mps, vehicle.speed_max_mps))
+        .collect();
+    let leg_pace: Vec<f64> = if total * p_lo >= target {
+        vec![p_lo; lengths.len()]
+    } else if total * p_hi <= target {
+        vec![p_hi; lengths.len()]
+    } else {
+        let time = |a: f64| -> f64 {
+            lengths
+                .iter()
+                .zip(&paces)
+                .map(|(l, p)| l * (a * p).clamp(p_lo, p_hi))
+                .sum()
+        };
+        let max_p = paces.iter().copied().fold(f64::MIN, f64::max);
+        let min_p = paces.iter().copied().fold(f64::MAX, f64::min);
+        let (mut lo, mut hi) = (p_lo / max_p, p_hi / min_p);
+        // 40 halvings narrow α to ~1e-12 of its range; the exact solve below removes the rest.
+        for _ in 0..40 {
+            let mid = 0.5 * (lo + hi);
+            if time(mid) < target {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        // Exact solve on the active set at the bracket's midpoint: free legs scale with α.
+        let a = 0.5 * (lo + hi);
+        let (mut fixed, mut free) = (0.0, 0.0);
+        for (l, p) in lengths.iter().zip(&paces) {
+            let q = a * p;
+            if q <= p_lo || q >= p_hi {
+                fixed += l * q.clamp(p_lo, p_hi);
+            } else {
+                free += l * p;
+            }
+        }
+        let a = if free > 0.0 {
+            ((target - fixed) / free).clamp(lo, hi)
+        } else {
+            a
+        };
+        paces.iter().map(|p| (a * p).clamp(p_lo, p_hi)).collect()
+    };
+    let mut times = Vec::with_capacity(path.points.len());
+    let mut t = 0.0;
+    times.push(0.0);
+    for (l, p) in lengths.iter().zip(&leg_pace) {
+        t += l * p;
+        times.push(t);
+    }
+    Trajectory {
+        times,
+        points: path.points.clone(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use approx::assert_abs_diff_eq;
+
+    fn vehicle() -> Vehicle {
+        Vehicle {
+            id: "a".into(),
+            kind: crate::scenario::VehicleKind::Auv,
+            start: [0.0, 0.0, 0.0],
+            goal: [300.0, 0.0, 0.0],
+            speed_min_mps: 0.5,
+            speed_max_mps: 1.5,
+            max_turn_deg: 35.0,
+            max_pitch_deg: 20.0,
+        }
+    }
+
+    #[test]
+    fn decode_places_start_genes_goal_and_speeds() {
+        let v = vehicle();
+        let p = Path::decode(&v, &[100.0, 0.0, 0.0, 1.0, 200.0, 0.0, 0.0, 0.5]);
+        assert_eq!(p.points.len(), 4);
+        assert_eq!(p.points[1], Vec3::new(100.0, 0.0, 0.0));
+        assert_eq!(p.speeds, vec![1.0, 0.5, 0.5]);
+        assert_abs_diff_eq!(p.length(), 300.0);
+    }
+
+    #[test]
+    fn layout_bounds_cover_box_and_speed_range() {
+        let l = Layout {
+            waypoints: 2,
+            vehicles: 3,
+        };
+        assert_eq!(l.dim(), 24);
+        assert_eq!(l.chromosome(1), 8..16);
+    }
+
+    #[test]
+    fn retime_hits_target_keeping_speed_ratios() {
+        let v = vehicle();
+        // Legs 100, 100, 100 m with requested speeds 1.0, 0.5, 0.5: paces 1, 2, 2 s/m.
+        let p = Path::decode(&v, &[100.0, 0.0, 0.0, 1.0, 200.0, 0.0, 0.0, 0.5]);
+        // Target 400 s: α (100·1 + 100·2 + 100·2) = 400 → α = 0.8 → paces 0.8, 1.6, 1.6 s/m,
+        // all inside [1/1.5, 1/0.5] = [0.667, 2].
+        let t = retime(&p, &v, 400.0);
+        assert_abs_diff_eq!(t.arrival(), 400.0, epsilon = 1e-9);
+        assert_abs_diff_eq!(t.times[1], 80.0, epsilon = 1e-9);
+        assert_abs_diff_eq!(t.times[2], 240.0, epsilon = 1e-9);
+        // Target 300 s: α·1 would give pace < 0.667 on the fast leg → clamped at 0.667 s/m
+        // (1.5 m/s); the other two share the rest: 66.67 + 200 α·2 = 300 → α = 0.5833.
+        let t = retime(&p, &v, 300.0);
+        assert_abs_diff_eq!(t.arrival(), 300.0, epsilon = 1e-9);
+        let s = t.leg_speeds();
+        assert_abs_diff_eq!(s[0], 1.5, epsilon = 1e-9);
+        assert_abs_diff_eq!(s[1], s[2], epsilon = 1e-9);
+        assert!(s.iter().all(|&x| (0.5 - 1e-12..=1.5 + 1e-12).contains(&x)));
+    }
+
+    #[test]
+    fn retime_out_of_reach_flies_at_the_limit() {
+        let v = vehicle();
+        let p = Path::decode(&v, &[100.0, 0.0, 0.0, 1.0, 200.0, 0.0, 0.0, 0.5]);
+        // 300 m at 1.5 m/s takes 200 s at best.
+        assert_abs_diff_eq!(retime(&p, &v, 100.0).arrival(), 200.0, epsilon = 1e-9);
+        // ... and 600 s at worst.
+        assert_abs_diff_eq!(retime(&p, &v, 1000.0).arrival(), 600.0, epsilon = 1e-9);
+    }
+
+    #[test]
+    fn window_and_common_arrival() {
+        let v = vehicle();
+        assert_eq!(arrival_window(300.0, &v), (200.0, 600.0));
+        assert_eq!(common_arrival(250.0, [200.0, 240.0]), 250.0);
+        assert_eq!(common_arrival(250.0, [200.0, 280.0]), 280.0);
+    }
+
+    #[test]
+    fn position_is_linear_between_samples_and_held_after() {
+        let t = Trajectory {
+            times: vec![0.0, 10.0, 30.0],
+            points: vec![
+                Vec3::new(0.0, 0.0, 0.0),
+                Vec3::new(10.0, 0.0, 0.0),
+                Vec3::new(10.0, 20.0, 0.0),
+            ],
+        };
+        assert_eq!(t.position_at(5.0), Vec3::new(5.0, 0.0, 0.0));
+        assert_eq!(t.position_at(20.0), Vec3::new(10.0, 10.0, 0.0));
+        assert_eq!(t.position_at(99.0), Vec3::new(10.0, 20.0, 0.0));
+        assert_eq!(t.position_at(-1.0), Vec3::new(0.0, 0.0, 0.0));
+        assert_eq!(t.leg_speeds(), vec![1.0, 1.0]);
+    }
+}

@@ -1,0 +1,204 @@
+//! Shoal's coordinator as a library: the binary parses its command line and calls [`run`]; tests
+//! call [`run`] (or the functions it uses) directly.
+
+pub mod cli;
+pub mod compare;
+pub mod planner;
+pub mod summary;
+pub mod svg;
+
+use std::io::IsTerminal;
+use std::path::Path;
+use std::sync::atomic::AtomicBool;
+use std::sync::Arc;
+
+use anyhow::{bail, Context};
+use shoal_common::plan::Plan;
+use shoal_common::scenario::Scenario;
+use shoal_common::swarm::IterationReport;
+
+pub use cli::{Command, PlanArgs};
+
+/// Exit status of a plan with no violations.
+pub const EXIT_FEASIBLE: i32 = 0;
+/// Exit status of an error (bad input, I/O).
+pub const EXIT_ERROR: i32 = 1;
+/// Exit status of a plan produced with constraint violations.
+pub const EXIT_VIOLATIONS: i32 = 3;
+
+/// Runs one command to completion. `shutdown` ends long work early (the best result so far is
+/// still written). Returns the process exit status.
+pub fn run(command: Command, shutdown: Arc<AtomicBool>) -> anyhow::Result<i32> {
+    match command {
+        Command::Plan(args) => plan_command(&args, shutdown),
+        Command::Compare(args) => compare_command(&args),
+    }
+}
+
+fn compare_command(args: &compare::CompareArgs) -> anyhow::Result<i32> {
+    let scenarios = args
+        .scenarios
+        .iter()
+        .map(|p| {
+            let mut s = Scenario::load(p)?;
+            if let Some(i) = args.iterations {
+                s.optimizer.iterations = i;
+            }
+            s.validate(p)?;
+            Ok(s)
+        })
+        .collect::<anyhow::Result<Vec<_>>>()?;
+    let total = scenarios.len() * args.algorithms.len() * args.seeds as usize;
+    let mut done = 0;
+    let cells = compare::compare(&scenarios, &args.algorithms, 1..args.seeds + 1, &mut |p| {
+        done += 1;
+        eprintln!(
+            "[{done}/{total}] {} {} seed {}: fitness {:.4}, {} in {:.2} s",
+            p.scenario,
+            p.algorithm,
+            p.seed,
+            p.fitness,
+            if p.feasible { "feasible" } else { "infeasible" },
+            p.runtime_s
+        );
+    });
+    let table = compare::markdown(&cells);
+    say(&table);
+    if let Some(out) = &args.out {
+        std::fs::write(out, &table).with_context(|| format!("cannot write {}", out.display()))?;
+    }
+    Ok(EXIT_FEASIBLE)
+}
+
+/// Loads a scenario and applies the command-line overrides.
+pub fn load_scenario(args: &PlanArgs) -> anyhow::Result<Scenario> {
+    let mut s = Scenario::load(&args.scenario)?;
+    let o = &mut s.optimizer;
+    if let Some(v) = args.seed {
+        o.seed = v;
+    }
+    if let Some(v) = args.algorithm {
+        o.algorithm = v;
+    }
+    if let Some(v) = args.iterations {
+        o.iterations = v;
+    }
+    if let Some(v) = args.populations {
+        o.populations = v;
+    }
+    if let Some(v) = args.particles {
+        o.particles = v;
+    }
+    if let Some(v) = args.threads {
+        o.threads = v;
+    }
+    // Overrides are user input too: check them with the same rules, naming the flag's field.
+    s.validate(&args.scenario)?;
+    Ok(s)
+}
+
+fn plan_command(args: &PlanArgs, shutdown: Arc<AtomicBool>) -> anyhow::Result<i32> {
+    if !args.in_process {
+        bail!(
+            "distributed planning (coordinator + one shoal-agent per vehicle over Zenoh) is not built yet; \
+             run `shoal-coordinator plan {} --in-process --out {}`",
+            args.scenario.display(),
+            args.out.display()
+        );
+    }
+    let scenario = load_scenario(args)?;
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("cannot create output directory {}", args.out.display()))?;
+    tracing::info!(
+        scenario = %scenario.name,
+        algorithm = scenario.optimizer.algorithm.as_str(),
+        seed = scenario.optimizer.seed,
+        "planning in-process"
+    );
+    let mut progress = Progress::new(scenario.optimizer.iterations, args.quiet);
+    let plan = planner::plan_in_process(&scenario, Some(shutdown), &mut |r| progress.update(r));
+    progress.finish();
+    write_outputs(&args.out, &plan)?;
+    write_svg(&args.out, &scenario, &plan)?;
+    say(&summary::summary(&plan));
+    say(&format!(
+        "Wrote {} and {}\n",
+        args.out.join("plan.json").display(),
+        args.out.join("plan.svg").display()
+    ));
+    Ok(if plan.feasible {
+        EXIT_FEASIBLE
+    } else {
+        EXIT_VIOLATIONS
+    })
+}
+
+/// Writes `plan.json` (and `plan.svg`) into `dir`.
+pub fn write_outputs(dir: &Path, plan: &Plan) -> anyhow::Result<()> {
+    let json = serde_json::to_string_pretty(plan).context("cannot serialise the plan")?;
+    let path = dir.join("plan.json");
+    std::fs::write(&path, json).with_context(|| format!("cannot write {}", path.display()))?;
+    Ok(())
+}
+
+/// Writes `plan.svg` into `dir`.
+pub fn write_svg(dir: &Path, scenario: &Scenario, plan: &Plan) -> anyhow::Result<()> {
+    let svg = svg::render_plan(scenario, plan)?;
+    let path = dir.join("plan.svg");
+    std::fs::write(&path, svg).with_context(|| format!("cannot write {}", path.display()))?;
+    Ok(())
+}
+
+/// Prints to stdout; a closed pipe (`| head`) is not an error worth a panic.
+fn say(text: &str) {
+    use std::io::Write;
+    let mut out = std::io::stdout().lock();
+    let _ = out.write_all(text.as_bytes()).and_then(|()| out.flush());
+}
+
+/// Progress on stderr: a bar on a terminal, a line every tenth of the run otherwise.
+struct Progress {
+    bar: Option<indicatif::ProgressBar>,
+    every: usize,
+    quiet: bool,
+}
+
+impl Progress {
+    fn new(iterations: usize, quiet: bool) -> Progress {
+        let bar = (!quiet && std::io::stderr().is_terminal()).then(|| {
+            let b = indicatif::ProgressBar::new(iterations as u64);
+            let style = indicatif::ProgressStyle::with_template(
+                "{spinner} [{elapsed_precise}] {bar:30} {pos}/{len} iterations  {msg}",
+            )
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar());
+            b.set_style(style);
+            b
+        });
+        Progress {
+            bar,
+            every: (iterations / 10).max(1),
+            quiet,
+        }
+    }
+
+    fn update(&mut self, r: &IterationReport) {
+        let msg = format!(
+            "best fitness {:.4}, {} evaluations",
+            r.best_cost, r.evaluations
+        );
+        if let Some(b) = &self.bar {
+            b.set_position(r.iteration as u64);
+            b.set_message(msg);
+        } else if !self.quiet
+            && (r.iteration.is_multiple_of(self.every) || r.iteration == r.max_iterations)
+        {
+            eprintln!("iteration {}/{}: {msg}", r.iteration, r.max_iterations);
+        }
+    }
+
+    fn finish(&self) {
+        if let Some(b) = &self.bar {
+            b.finish_and_clear();
+        }
+    }
+}

@@ -1,0 +1,100 @@
+//! In-process planning: scenario → fleet model → optimizer → validated [`Plan`].
+
+use std::sync::atomic::AtomicBool;
+use std::sync::Arc;
+
+use shoal_common::cost::FleetModel;
+use shoal_common::plan::{assess, timing_notices, Plan};
+use shoal_common::scenario::{Algorithm, Scenario};
+use shoal_common::swarm::multi::MultiPso;
+use shoal_common::swarm::population::Schedule;
+use shoal_common::swarm::pso::Pso;
+use shoal_common::swarm::{Executor, IterationReport, Solver, SolverState, Termination};
+
+/// What an optimizer run leaves behind, whatever the algorithm.
+struct RunResult {
+    best_x: Vec<f64>,
+    convergence: Vec<f64>,
+    evaluations: u64,
+    termination: Termination,
+    runtime_s: f64,
+}
+
+fn run_solver<S: Solver<FleetModel>>(
+    model: &FleetModel,
+    mut solver: S,
+    executor: &Executor,
+    observe: &mut dyn FnMut(&IterationReport),
+) -> RunResult {
+    let out = executor.run(model, &mut solver, observe);
+    RunResult {
+        best_x: out.state.best_position().to_vec(),
+        evaluations: out.state.evaluations(),
+        convergence: out.convergence,
+        termination: out.termination,
+        runtime_s: out.elapsed.as_secs_f64(),
+    }
+}
+
+/// Plans `scenario` in this process with the optimizer its settings name. `stop` ends the run
+/// early (the best plan so far is still returned); `observe` sees every iteration.
+pub fn plan_in_process(
+    scenario: &Scenario,
+    stop: Option<Arc<AtomicBool>>,
+    observe: &mut dyn FnMut(&IterationReport),
+) -> Plan {
+    let o = &scenario.optimizer;
+    let model = FleetModel::new(scenario);
+    let executor = Executor {
+        max_iterations: o.iterations,
+        stop,
+        ..Executor::default()
+    };
+    let multi = |schedule| MultiPso {
+        populations: o.populations,
+        particles: o.particles,
+        leader_particles: o.leader_particles,
+        exchange_every: o.exchange_every,
+        schedule,
+        max_velocity_fraction: o.max_velocity_fraction,
+        threads: o.threads,
+        seed: o.seed,
+    };
+    let single = |schedule| Pso {
+        particles: o.particles,
+        schedule,
+        max_velocity_fraction: o.max_velocity_fraction,
+        seed: o.seed,
+    };
+    let run = match o.algorithm {
+        Algorithm::AmpPso => run_solver(&model, multi(Schedule::Adaptive), &executor, observe),
+        Algorithm::MpPso => run_solver(&model, multi(Schedule::TABLE5_FIXED), &executor, observe),
+        Algorithm::APso => run_solver(&model, single(Schedule::Adaptive), &executor, observe),
+        Algorithm::Pso => run_solver(&model, single(Schedule::TABLE5_FIXED), &executor, observe),
+    };
+    let eval = model.evaluate(&run.best_x);
+    let assessment = assess(scenario, &eval.trajectories);
+    let notices = timing_notices(scenario, &eval.trajectories, eval.common_arrival);
+    Plan {
+        scenario: scenario.name.clone(),
+        algorithm: o.algorithm.as_str().to_string(),
+        mode: "in-process".to_string(),
+        seed: o.seed,
+        runtime_s: run.runtime_s,
+        fitness: eval.total,
+        objective: eval.objective,
+        penalty: eval.penalty,
+        feasible: assessment.violations.is_empty(),
+        violations: assessment.violations,
+        notices,
+        mission_time_s: scenario.fleet.mission_time_s,
+        common_arrival_s: eval.common_arrival,
+        d_min_m: scenario.fleet.d_min_m,
+        iterations: run.convergence.len(),
+        evaluations: run.evaluations,
+        termination: format!("{:?}", run.termination),
+        vehicles: assessment.vehicles,
+        fleet: assessment.fleet,
+        convergence: run.convergence,
+    }
+}
