@@ -17,10 +17,10 @@
 //! each as `count + depth of the breach relative to its limit`, so the swarm feels both how many
 //! and how bad.
 
-use crate::geometry::{chord_inside_sphere, heading_change, pitch, segment_point_distance, Vec3};
+use crate::geometry::{chord_inside_sphere, heading_change, pitch, Vec3};
 use crate::scenario::{Scenario, Vehicle};
-use crate::separation::pair_separation;
-use crate::trajectory::{common_arrival, retime, Layout, Path, Trajectory};
+use crate::separation::{motion_separation, Motion};
+use crate::trajectory::{common_arrival, retime_legs, Layout, Path, Trajectory};
 
 /// A sphere the cost functions test against: centre and radius already inflated.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -56,13 +56,63 @@ pub fn depth_term(points: &[Vec3], surface_z: f64, column: f64) -> f64 {
 /// distance. A path crossing a soft sphere through its centre pays its diameter; a graze pays
 /// almost nothing.
 pub fn soft_threat_term(points: &[Vec3], soft: &[Sphere], straight: f64) -> f64 {
-    let mut inside = 0.0;
-    for w in points.windows(2) {
-        for s in soft {
-            inside += chord_inside_sphere(&w[0], &w[1], &s.centre, s.radius);
+    sphere_terms(points, &[], soft).soft_inside / straight.max(1e-9)
+}
+
+/// What the legs of a path do to the obstacles, computed in one pass.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+struct SphereTerms {
+    /// [`hard_penalty`]'s penalty.
+    hard_penalty: f64,
+    /// Leg × hard-sphere intrusions.
+    hard_hits: usize,
+    /// Metres inside soft spheres.
+    soft_inside: f64,
+}
+
+/// Every leg against every sphere. Per sphere the legs are walked in order with a lower bound on
+/// the centre's distance to the current leg's start (triangle inequality: it shrinks by at most one
+/// leg length per leg), so legs that cannot reach the sphere cost one subtraction; the others get
+/// the exact squared distance, and roots and chords are taken only on a hit.
+fn sphere_terms(points: &[Vec3], hard: &[Sphere], soft: &[Sphere]) -> SphereTerms {
+    let mut out = SphereTerms::default();
+    let legs: Vec<(Vec3, f64, f64)> = points
+        .windows(2)
+        .map(|w| {
+            let k = w[1] - w[0];
+            let len2 = k.norm_squared();
+            (k, len2.sqrt(), if len2 > 0.0 { 1.0 / len2 } else { 0.0 })
+        })
+        .collect();
+    for (s, is_hard) in hard
+        .iter()
+        .map(|s| (s, true))
+        .chain(soft.iter().map(|s| (s, false)))
+    {
+        let r2 = s.radius * s.radius;
+        // Lower bound on |centre − points[j]|.
+        let mut bound = f64::NEG_INFINITY;
+        for (j, (k, len, inv)) in legs.iter().enumerate() {
+            if bound - len >= s.radius {
+                bound -= len;
+                continue;
+            }
+            let q = s.centre - points[j];
+            let u = (q.dot(k) * inv).clamp(0.0, 1.0);
+            let d2 = (q - k * u).norm_squared();
+            if d2 < r2 {
+                if is_hard {
+                    out.hard_penalty += 1.0 + (s.radius - d2.sqrt()) / s.radius;
+                    out.hard_hits += 1;
+                } else {
+                    out.soft_inside +=
+                        chord_inside_sphere(&points[j], &points[j + 1], &s.centre, s.radius);
+                }
+            }
+            bound = (s.centre - points[j + 1]).norm();
         }
     }
-    inside / straight.max(1e-9)
+    out
 }
 
 /// F_i(T) of eq. (10), over the mission time: how far the mission time `t_e` lies outside the
@@ -89,17 +139,8 @@ pub fn space_term(breach_seconds: f64) -> f64 {
 /// Hard-obstacle penalty: for every (leg, obstacle) whose leg enters the inflated sphere, `1 + how
 /// deep it gets / inflated radius`. Returns the penalty and the number of such intrusions.
 pub fn hard_penalty(points: &[Vec3], hard: &[Sphere]) -> (f64, usize) {
-    let (mut p, mut hits) = (0.0, 0);
-    for w in points.windows(2) {
-        for s in hard {
-            let d = segment_point_distance(&w[0], &w[1], &s.centre);
-            if d < s.radius {
-                p += 1.0 + (s.radius - d) / s.radius;
-                hits += 1;
-            }
-        }
-    }
-    (p, hits)
+    let t = sphere_terms(points, hard, &[]);
+    (t.hard_penalty, t.hard_hits)
 }
 
 /// Turn penalty: at every inner waypoint whose heading change exceeds `max_turn` (radians),
@@ -177,8 +218,6 @@ pub struct VehicleTerms {
 /// Everything the fitness computed for one fleet particle.
 #[derive(Debug, Clone)]
 pub struct FleetEvaluation {
-    /// Decoded paths, in vehicle order.
-    pub paths: Vec<Path>,
     /// Timed trajectories (what the vehicles fly), in vehicle order.
     pub trajectories: Vec<Trajectory>,
     /// The arrival time every vehicle was timed for, seconds.
@@ -239,24 +278,23 @@ impl FleetModel {
     }
 
     /// Vehicle-local terms of vehicle `i` (everything but F(S) and the separation penalty).
-    pub fn vehicle_terms(&self, i: usize, path: &Path) -> VehicleTerms {
+    pub fn vehicle_terms(&self, i: usize, path: &Path, length: f64) -> VehicleTerms {
         let s = &self.scenario;
         let v = &s.vehicles[i];
-        let length = path.length();
         let surface = s.bounds.max[2];
         let column = s.bounds.max[2] - s.bounds.min[2];
-        let (hard, hard_hits) = hard_penalty(&path.points, &self.hard);
+        let spheres = sphere_terms(&path.points, &self.hard, &self.soft);
         VehicleTerms {
             length: length_term(length, self.straight[i]),
             depth: depth_term(&path.points, surface, column),
-            soft: soft_threat_term(&path.points, &self.soft, self.straight[i]),
+            soft: spheres.soft_inside / self.straight[i].max(1e-9),
             time: time_term(length, v, s.fleet.mission_time_s),
             space: 0.0,
             separation: 0.0,
-            hard,
+            hard: spheres.hard_penalty,
             motion: turn_penalty(&path.points, v.max_turn_deg.to_radians())
                 + pitch_penalty(&path.points, v.max_pitch_deg.to_radians()),
-            hard_hits,
+            hard_hits: spheres.hard_hits,
         }
     }
 
@@ -282,7 +320,8 @@ impl FleetModel {
             .enumerate()
             .map(|(i, v)| Path::decode(v, &x[self.layout.chromosome(i)]))
             .collect();
-        let lengths: Vec<f64> = paths.iter().map(Path::length).collect();
+        let legs: Vec<Vec<f64>> = paths.iter().map(Path::leg_lengths).collect();
+        let lengths: Vec<f64> = legs.iter().map(|l| l.iter().sum()).collect();
         let arrival = common_arrival(
             s.fleet.mission_time_s,
             lengths
@@ -290,20 +329,22 @@ impl FleetModel {
                 .zip(&s.vehicles)
                 .map(|(l, v)| l / v.speed_max_mps),
         );
-        let trajectories: Vec<Trajectory> = paths
-            .iter()
-            .zip(&s.vehicles)
-            .map(|(p, v)| retime(p, v, arrival))
-            .collect();
         let mut vehicles: Vec<VehicleTerms> = paths
             .iter()
             .enumerate()
-            .map(|(i, p)| self.vehicle_terms(i, p))
+            .map(|(i, p)| self.vehicle_terms(i, p, lengths[i]))
             .collect();
+        let trajectories: Vec<Trajectory> = paths
+            .into_iter()
+            .zip(&legs)
+            .zip(&s.vehicles)
+            .map(|((p, l), v)| retime_legs(p, l, v, arrival))
+            .collect();
+        let motions: Vec<Motion> = trajectories.iter().map(Motion::new).collect();
         let mut sep_penalty = 0.0;
-        for i in 0..trajectories.len() {
-            for j in i + 1..trajectories.len() {
-                let ps = pair_separation(&trajectories[i], &trajectories[j], s.fleet.d_min_m);
+        for i in 0..motions.len() {
+            for j in i + 1..motions.len() {
+                let ps = motion_separation(&motions[i], &motions[j], s.fleet.d_min_m, false);
                 // eq. (12) sums F_i(S) over vehicles: a breach counts for both of the pair.
                 vehicles[i].space += space_term(ps.breach_s);
                 vehicles[j].space += space_term(ps.breach_s);
@@ -316,7 +357,6 @@ impl FleetModel {
         let objective: f64 = vehicles.iter().map(|t| self.objective_of(t)).sum();
         let penalty: f64 = vehicles.iter().map(|t| t.hard + t.motion).sum::<f64>() + sep_penalty;
         FleetEvaluation {
-            paths,
             trajectories,
             common_arrival: arrival,
             vehicles,
@@ -436,6 +476,38 @@ mod tests {
             v(2., 0., 1.0 + 10f64.to_radians().tan()),
         ];
         assert_abs_diff_eq!(pitch_penalty(&pts, pmax), 1.0 + 25.0 / 20.0, epsilon = 1e-9);
+    }
+
+    proptest::proptest! {
+        #[test]
+        fn sphere_terms_match_the_brute_force(
+            pts in proptest::collection::vec((0.0f64..1000.0, 0.0f64..1000.0, 0.0f64..1000.0), 2..30),
+            spheres in proptest::collection::vec((0.0f64..1000.0, 0.0f64..1000.0, 0.0f64..1000.0, 1.0f64..300.0, proptest::bool::ANY), 1..12),
+        ) {
+            let pts: Vec<Vec3> = pts.iter().map(|p| v(p.0, p.1, p.2)).collect();
+            let (mut hard, mut soft) = (Vec::new(), Vec::new());
+            for s in &spheres {
+                let sp = Sphere { centre: v(s.0, s.1, s.2), radius: s.3 };
+                if s.4 { hard.push(sp) } else { soft.push(sp) }
+            }
+            let fast = sphere_terms(&pts, &hard, &soft);
+            let (mut p, mut hits, mut inside) = (0.0, 0, 0.0);
+            for w in pts.windows(2) {
+                for s in &hard {
+                    let d = crate::geometry::segment_point_distance(&w[0], &w[1], &s.centre);
+                    if d < s.radius {
+                        p += 1.0 + (s.radius - d) / s.radius;
+                        hits += 1;
+                    }
+                }
+                for s in &soft {
+                    inside += chord_inside_sphere(&w[0], &w[1], &s.centre, s.radius);
+                }
+            }
+            proptest::prop_assert_eq!(fast.hard_hits, hits);
+            proptest::prop_assert!((fast.hard_penalty - p).abs() < 1e-9);
+            proptest::prop_assert!((fast.soft_inside - inside).abs() < 1e-6);
+        }
     }
 
     #[test]

@@ -7,7 +7,7 @@
 //! [`crate::geometry::fraction_within`]). Nothing is sampled, so no graze between samples is missed.
 //! A vehicle holds at its last sample after it arrives.
 
-use crate::geometry::{closest_approach, fraction_within, Vec3};
+use crate::geometry::{fraction_within, Vec3};
 use crate::trajectory::Trajectory;
 
 /// How close two vehicles come, and for how long they breach the minimum separation.
@@ -21,85 +21,158 @@ pub struct PairSeparation {
     pub breach_s: f64,
 }
 
-/// Walks a trajectory forward in time without searching: the planner's hottest loop asks for
-/// positions at increasing times only.
-struct Cursor<'a> {
-    t: &'a Trajectory,
-    /// Index of the first sample strictly after the last time asked for.
-    next: usize,
+/// A trajectory prepared for fast queries: each leg's start time, start point and velocity, so a
+/// position is one multiply-add, with no search and no division.
+#[derive(Debug, Clone)]
+pub struct Motion<'a> {
+    /// Leg start times, then the arrival time (one more than legs).
+    times: &'a [f64],
+    /// Leg start points, then the final point.
+    points: &'a [Vec3],
+    /// Velocity on each leg, m/s (zero for a leg of zero duration).
+    velocities: Vec<Vec3>,
+    /// Fastest leg speed, m/s: bounds how fast a distance can shrink.
+    max_speed: f64,
 }
 
-impl<'a> Cursor<'a> {
-    fn new(t: &'a Trajectory) -> Cursor<'a> {
-        Cursor { t, next: 0 }
+impl<'a> Motion<'a> {
+    /// Prepares `t` (at least one sample).
+    pub fn new(t: &'a Trajectory) -> Motion<'a> {
+        let velocities: Vec<Vec3> = t
+            .times
+            .windows(2)
+            .zip(t.points.windows(2))
+            .map(|(tt, pp)| {
+                let dt = tt[1] - tt[0];
+                if dt > 0.0 {
+                    (pp[1] - pp[0]) / dt
+                } else {
+                    Vec3::zeros()
+                }
+            })
+            .collect();
+        let max_speed = velocities
+            .iter()
+            .map(|v: &Vec3| v.norm())
+            .fold(0.0, f64::max);
+        Motion {
+            times: &t.times,
+            points: &t.points,
+            velocities,
+            max_speed,
+        }
     }
 
-    /// Time of the next sample after `now`, if any.
-    fn next_time(&mut self, now: f64) -> Option<f64> {
-        while self.next < self.t.times.len() && self.t.times[self.next] <= now {
-            self.next += 1;
+    /// Position at `time` on leg `k` (or held at the end when `k` is past the last leg).
+    #[inline]
+    fn at(&self, k: usize, time: f64) -> Vec3 {
+        match self.velocities.get(k) {
+            Some(v) => self.points[k] + v * (time - self.times[k]),
+            None => self.points[self.points.len() - 1],
         }
-        self.t.times.get(self.next).copied()
-    }
-
-    /// Position at `time`, which must not be earlier than the last time given to `next_time`.
-    fn position(&self, time: f64) -> Vec3 {
-        let (times, points) = (&self.t.times, &self.t.points);
-        let k = self.next;
-        if k == 0 {
-            return points.first().copied().unwrap_or_else(Vec3::zeros);
-        }
-        if k >= times.len() {
-            return points[times.len() - 1];
-        }
-        let (t0, t1) = (times[k - 1], times[k]);
-        if time >= t1 {
-            return points[k];
-        }
-        let s = if t1 > t0 {
-            (time - t0) / (t1 - t0)
-        } else {
-            1.0
-        };
-        points[k - 1] + (points[k] - points[k - 1]) * s
     }
 }
 
 /// Separation of `a` and `b` over `[0, max(arrival_a, arrival_b)]` against `d_min`.
 pub fn pair_separation(a: &Trajectory, b: &Trajectory, d_min: f64) -> PairSeparation {
+    if a.times.is_empty() || b.times.is_empty() {
+        return PairSeparation {
+            min_distance: f64::INFINITY,
+            min_time: 0.0,
+            breach_s: 0.0,
+        };
+    }
+    motion_separation(&Motion::new(a), &Motion::new(b), d_min, true)
+}
+
+/// [`pair_separation`] on prepared trajectories.
+///
+/// With `exact_min == false` (the fitness), stretches of time in which the pair provably stays at
+/// least `d_min` apart are skipped: two vehicles `D` apart cannot close in below `d_min` sooner
+/// than `(D − d_min) / (v_a,max + v_b,max)`. The breach time is still exact, and so is
+/// `min_distance` when it is below `d_min`; otherwise it is only known to be at least `d_min`.
+pub fn motion_separation(
+    a: &Motion<'_>,
+    b: &Motion<'_>,
+    d_min: f64,
+    exact_min: bool,
+) -> PairSeparation {
     let mut best = PairSeparation {
         min_distance: f64::INFINITY,
         min_time: 0.0,
         breach_s: 0.0,
     };
-    let (mut ca, mut cb) = (Cursor::new(a), Cursor::new(b));
+    // Legs in progress: the last leg whose start time is <= t0 (legs of zero duration are
+    // skipped because the next one starts at the same time).
+    let (na, nb) = (a.velocities.len(), b.velocities.len());
+    let (mut i, mut j) = (0usize, 0usize);
     let mut t0 = 0.0;
-    let mut d0 = b.position_at(0.0) - a.position_at(0.0);
+    let mut d0 = b.points[0] - a.points[0];
     consider_point(&mut best, &d0, t0);
-    // Walk the merged sample times of both trajectories.
+    let d_min2 = d_min * d_min;
+    let closing = a.max_speed + b.max_speed;
+    let end = a.times[na].max(b.times[nb]);
     loop {
-        let t1 = match (ca.next_time(t0), cb.next_time(t0)) {
-            (Some(ta), Some(tb)) => ta.min(tb),
-            (Some(ta), None) => ta,
-            (None, Some(tb)) => tb,
-            (None, None) => break,
+        while i < na && a.times[i + 1] <= t0 {
+            i += 1;
+        }
+        while j < nb && b.times[j + 1] <= t0 {
+            j += 1;
+        }
+        if !exact_min && closing > 0.0 {
+            // Jump ahead only if the pair is far enough apart to stay clear past the next
+            // breakpoint; the test is done in squares so most intervals pay no square root.
+            let next = a
+                .times
+                .get(i + 1)
+                .copied()
+                .unwrap_or(f64::INFINITY)
+                .min(b.times.get(j + 1).copied().unwrap_or(f64::INFINITY));
+            let reach = d_min + closing * (next.min(end) - t0);
+            let gap2 = d0.norm_squared();
+            if gap2 > reach * reach {
+                let safe_until = t0 + (gap2.sqrt() - d_min) / closing;
+                if safe_until >= end {
+                    break;
+                }
+                t0 = safe_until;
+                while i < na && a.times[i + 1] <= t0 {
+                    i += 1;
+                }
+                while j < nb && b.times[j + 1] <= t0 {
+                    j += 1;
+                }
+                d0 = b.at(j, t0) - a.at(i, t0);
+                continue;
+            }
+        }
+        let t1 = match (i < na, j < nb) {
+            (true, true) => a.times[i + 1].min(b.times[j + 1]),
+            (true, false) => a.times[i + 1],
+            (false, true) => b.times[j + 1],
+            (false, false) => break,
         };
-        // Both cursors now point past t0 and at or before t1.
-        let d1 = cb.position(t1) - ca.position(t1);
+        let d1 = b.at(j, t1) - a.at(i, t1);
         let dt = t1 - t0;
-        let m = closest_approach(&d0, &d1);
-        if m < best.min_distance {
-            best.min_distance = m;
-            // Time of closest approach on this interval.
-            let k = d1 - d0;
-            let s = if k.norm_squared() > 0.0 {
-                (-d0.dot(&k) / k.norm_squared()).clamp(0.0, 1.0)
-            } else {
-                0.0
-            };
+        // Closest approach of d0 + s·k, s ∈ [0, 1], kept in squares and as a fraction
+        // num / den so that the division happens only when a new minimum is found.
+        let k = d1 - d0;
+        let dk = d0.dot(&k);
+        let kk = k.norm_squared();
+        let (num, den, s) = if dk >= 0.0 || kk <= 0.0 {
+            (d0.norm_squared(), 1.0, 0.0)
+        } else if d1.dot(&k) <= 0.0 {
+            (d1.norm_squared(), 1.0, 1.0)
+        } else {
+            (d0.norm_squared() * kk - dk * dk, kk, f64::NAN)
+        };
+        let num = num.max(0.0);
+        if num < best.min_distance * best.min_distance * den {
+            best.min_distance = (num / den).sqrt();
+            let s = if s.is_nan() { -dk / kk } else { s };
             best.min_time = t0 + s * dt;
         }
-        if m < d_min {
+        if num < d_min2 * den {
             best.breach_s += fraction_within(&d0, &d1, d_min) * dt;
         }
         t0 = t1;
@@ -213,6 +286,31 @@ mod tests {
                 let t = horizon * k as f64 / 200.0;
                 let d = (a.position_at(t) - b.position_at(t)).norm();
                 prop_assert!(ab.min_distance <= d + 1e-9);
+            }
+        }
+
+        #[test]
+        fn skipping_safe_stretches_keeps_breaches_exact(
+            pa in proptest::collection::vec((-100.0f64..100.0, -100.0f64..100.0, -10.0f64..10.0), 2..8),
+            pb in proptest::collection::vec((-100.0f64..100.0, -100.0f64..100.0, -10.0f64..10.0), 2..8),
+            dt in proptest::collection::vec(0.1f64..30.0, 8),
+            d_min in 1.0f64..60.0,
+        ) {
+            let mk = |p: &Vec<(f64, f64, f64)>, off: usize| {
+                let mut t = 0.0;
+                let mut times = vec![0.0];
+                for k in 1..p.len() { t += dt[(k + off) % dt.len()]; times.push(t); }
+                Trajectory { times, points: p.iter().map(|q| Vec3::new(q.0, q.1, q.2)).collect() }
+            };
+            let (a, b) = (mk(&pa, 0), mk(&pb, 5));
+            let (ma, mb) = (Motion::new(&a), Motion::new(&b));
+            let exact = motion_separation(&ma, &mb, d_min, true);
+            let fast = motion_separation(&ma, &mb, d_min, false);
+            prop_assert!((exact.breach_s - fast.breach_s).abs() < 1e-6);
+            if exact.min_distance < d_min {
+                prop_assert!((exact.min_distance - fast.min_distance).abs() < 1e-9);
+            } else {
+                prop_assert!(fast.min_distance >= d_min - 1e-9);
             }
         }
 

@@ -89,6 +89,7 @@ impl Path {
     }
 
     /// Length of every leg, metres.
+    #[inline]
     pub fn leg_lengths(&self) -> Vec<f64> {
         self.points
             .windows(2)
@@ -175,70 +176,97 @@ pub fn common_arrival(mission_time: f64, earliest: impl IntoIterator<Item = f64>
 /// `[v_min, v_max]` and the legs' speeds in the proportions the status genes request as far as
 /// the limits allow.
 ///
-/// Each leg's pace (s/m) is `clamp(α / δ_j, 1/v_max, 1/v_min)`; the total time is monotone in `α`,
-/// so `α` is found by bisection and then solved exactly on the final active set. If the target is
-/// out of reach the vehicle flies the whole path at `v_max` (too late) or `v_min` (too early).
+/// Each leg's pace (s/m) is `clamp(α / δ_j, 1/v_max, 1/v_min)`; the total time `T(α)` is
+/// continuous, piecewise linear and non-decreasing in `α`, so a Newton step on the current linear
+/// piece, safeguarded by a bisection bracket, lands on the exact `α` in a few steps. If the target
+/// is out of reach the vehicle flies the whole path at `v_max` (too late) or `v_min` (too early).
 pub fn retime(path: &Path, vehicle: &Vehicle, target: f64) -> Trajectory {
     let lengths = path.leg_lengths();
+    retime_legs(path.clone(), &lengths, vehicle, target)
+}
+
+/// [`retime`] with the leg lengths already known, taking the path's points over.
+pub fn retime_legs(path: Path, lengths: &[f64], vehicle: &Vehicle, target: f64) -> Trajectory {
     let (p_lo, p_hi) = (1.0 / vehicle.speed_max_mps, 1.0 / vehicle.speed_min_mps);
     let total: f64 = lengths.iter().sum();
-    let paces: Vec<f64> = path
-        .speeds
-        .iter()
-        .map(|v| 1.0 / v.clamp(vehicle.speed_min_mps, vehicle.speed_max_mps))
-        .collect();
-    let leg_pace: Vec<f64> = if total * p_lo >= target {
-        vec![p_lo; lengths.len()]
+    let pace_of = |v: &f64| 1.0 / v.clamp(vehicle.speed_min_mps, vehicle.speed_max_mps);
+    let alpha = if total * p_lo >= target {
+        None
     } else if total * p_hi <= target {
-        vec![p_hi; lengths.len()]
+        Some(f64::INFINITY)
     } else {
-        let time = |a: f64| -> f64 {
-            lengths
-                .iter()
-                .zip(&paces)
-                .map(|(l, p)| l * (a * p).clamp(p_lo, p_hi))
-                .sum()
+        // T(α) and its slope on the current piece (the free legs' Σ l p).
+        let eval = |a: f64| -> (f64, f64) {
+            let (mut t, mut slope) = (0.0, 0.0);
+            for (l, v) in lengths.iter().zip(&path.speeds) {
+                let p = pace_of(v);
+                let q = a * p;
+                if q <= p_lo {
+                    t += l * p_lo;
+                } else if q >= p_hi {
+                    t += l * p_hi;
+                } else {
+                    t += l * q;
+                    slope += l * p;
+                }
+            }
+            (t, slope)
         };
-        let max_p = paces.iter().copied().fold(f64::MIN, f64::max);
-        let min_p = paces.iter().copied().fold(f64::MAX, f64::min);
+        let (max_p, min_p) = path
+            .speeds
+            .iter()
+            .map(pace_of)
+            .fold((f64::MIN, f64::MAX), |(hi, lo), p| (hi.max(p), lo.min(p)));
         let (mut lo, mut hi) = (p_lo / max_p, p_hi / min_p);
-        // 40 halvings narrow α to ~1e-12 of its range; the exact solve below removes the rest.
-        for _ in 0..40 {
-            let mid = 0.5 * (lo + hi);
-            if time(mid) < target {
-                lo = mid;
+        // Start from the unclamped solution.
+        let free: f64 = lengths
+            .iter()
+            .zip(&path.speeds)
+            .map(|(l, v)| l * pace_of(v))
+            .sum();
+        let mut a = (target / free).clamp(lo, hi);
+        for _ in 0..100 {
+            let (t, slope) = eval(a);
+            let err = t - target;
+            if err.abs() <= 1e-12 * target {
+                break;
+            }
+            if err < 0.0 {
+                lo = a;
             } else {
-                hi = mid;
+                hi = a;
+            }
+            let newton = if slope > 0.0 {
+                a - err / slope
+            } else {
+                f64::NAN
+            };
+            a = if newton > lo && newton < hi {
+                newton
+            } else {
+                0.5 * (lo + hi)
+            };
+            if hi - lo <= 1e-15 * hi {
+                break;
             }
         }
-        // Exact solve on the active set at the bracket's midpoint: free legs scale with α.
-        let a = 0.5 * (lo + hi);
-        let (mut fixed, mut free) = (0.0, 0.0);
-        for (l, p) in lengths.iter().zip(&paces) {
-            let q = a * p;
-            if q <= p_lo || q >= p_hi {
-                fixed += l * q.clamp(p_lo, p_hi);
-            } else {
-                free += l * p;
-            }
-        }
-        let a = if free > 0.0 {
-            ((target - fixed) / free).clamp(lo, hi)
-        } else {
-            a
-        };
-        paces.iter().map(|p| (a * p).clamp(p_lo, p_hi)).collect()
+        Some(a)
     };
     let mut times = Vec::with_capacity(path.points.len());
     let mut t = 0.0;
     times.push(0.0);
-    for (l, p) in lengths.iter().zip(&leg_pace) {
-        t += l * p;
+    for (l, v) in lengths.iter().zip(&path.speeds) {
+        let pace = match alpha {
+            None => p_lo,
+            Some(a) if a.is_infinite() => p_hi,
+            Some(a) => (a * pace_of(v)).clamp(p_lo, p_hi),
+        };
+        t += l * pace;
         times.push(t);
     }
     Trajectory {
         times,
-        points: path.points.clone(),
+        points: path.points,
     }
 }
 

@@ -5,6 +5,7 @@
 //! A new variant (IPSO, EPA-PSO, DE-PSO…) is one file implementing [`Solver`].
 
 pub mod multi;
+pub mod parallel;
 pub mod population;
 pub mod pso;
 #[cfg(test)]

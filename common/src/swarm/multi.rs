@@ -8,7 +8,7 @@
 //! population and replace its worst particle (Fig. 5c).
 
 use super::population::{assemble, update, Limits, Particle, Population, Schedule};
-use super::{Problem, Progress, Solver, SolverState};
+use super::{parallel, Problem, Progress, Solver, SolverState};
 
 /// Multi-population PSO with a leader.
 #[derive(Debug, Clone)]
@@ -111,36 +111,23 @@ impl MultiPso {
     ) -> u64 {
         let c = self.schedule.at(progress);
         let limits = &state.limits;
-        let chunk = state.followers.len().div_ceil(self.threads.max(1)).max(1);
-        std::thread::scope(|scope| {
-            let handles: Vec<_> = state
-                .followers
-                .chunks_mut(chunk)
-                .map(|pops| {
-                    scope.spawn(move || {
-                        pops.iter_mut()
-                            .map(|pop| pop.step(problem, c, None, limits))
-                            .sum::<u64>()
-                    })
-                })
-                .collect();
-            // A panicking follower thread is a bug in the cost function; re-raise it here.
-            handles
-                .into_iter()
-                .map(|h| h.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
-                .sum()
-        })
+        let before: u64 = state.followers.iter().map(|p| p.evaluations).sum();
+        parallel::for_each_mut(&mut state.followers, self.threads, |pop| {
+            pop.step(problem, c, None, limits);
+        });
+        state.followers.iter().map(|p| p.evaluations).sum::<u64>() - before
     }
 
     /// Fig. 5: immigrate, update the leader by eq. (6), return the immigrants.
     fn exchange<P: Problem>(&self, problem: &P, state: &mut MultiState, progress: Progress) -> u64 {
         let c = self.schedule.at(progress);
+        let threads = self.threads;
         // (a) the best of each follower immigrates (a fresh evaluation when its best is assembled).
-        let mut immigrants: Vec<Particle> = state
-            .followers
-            .iter()
-            .filter_map(|f| f.emigrant(problem))
-            .collect();
+        let mut immigrants: Vec<Particle> =
+            parallel::map(&state.followers, threads, |f| f.emigrant(problem))
+                .into_iter()
+                .flatten()
+                .collect();
         let mut evaluations = if problem.blocks() > 1 {
             immigrants.len() as u64
         } else {
@@ -153,23 +140,25 @@ impl MultiPso {
         ) else {
             return evaluations;
         };
-        // (b) leader and immigrants move by eq. (6), towards the leader's own best and o_f_gbest.
+        // (b) leader and immigrants move by eq. (6), towards the leader's own best and o_f_gbest;
+        // the moves draw from the leader's RNG in order, the evaluations run in parallel.
         let leader_gbest = assemble(
             problem,
             state.leader.particles.iter().chain(immigrants.iter()),
         )
         .map_or_else(|| f_gbest.clone(), |(x, _)| x);
         let rng = &mut state.leader.rng;
-        for p in state
+        let mut movers: Vec<&mut Particle> = state
             .leader
             .particles
             .iter_mut()
             .chain(immigrants.iter_mut())
-        {
+            .collect();
+        for p in movers.iter_mut() {
             update(p, &leader_gbest, Some(&f_gbest), c, &state.limits, rng);
-            p.evaluate(problem);
         }
-        evaluations += (state.leader.particles.len() + immigrants.len()) as u64;
+        parallel::for_each_mut(&mut movers, threads, |p| p.evaluate(problem));
+        evaluations += movers.len() as u64;
         for im in &immigrants {
             if im.cost < state.leader.elite_cost {
                 state.leader.elite_cost = im.cost;
@@ -178,13 +167,15 @@ impl MultiPso {
         }
         evaluations += state.leader.refresh(problem);
         // (c) the updated immigrants return home and replace the worst particle there.
-        for (f, immigrant) in immigrants.into_iter().enumerate() {
-            let pop = &mut state.followers[f];
+        for (pop, immigrant) in state.followers.iter_mut().zip(immigrants) {
             let worst = pop.worst();
             pop.particles[worst] = immigrant;
-            evaluations += pop.refresh(problem);
         }
-        evaluations
+        let before: u64 = state.followers.iter().map(|p| p.evaluations).sum();
+        parallel::for_each_mut(&mut state.followers, threads, |pop| {
+            pop.refresh(problem);
+        });
+        evaluations + state.followers.iter().map(|p| p.evaluations).sum::<u64>() - before
     }
 }
 

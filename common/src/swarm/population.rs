@@ -140,6 +140,8 @@ pub struct Limits {
     pub upper: Vec<f64>,
     /// Largest |velocity| per dimension.
     pub vmax: Vec<f64>,
+    /// 1 / vmax, so the update loop multiplies instead of dividing.
+    pub inv_vmax: Vec<f64>,
     /// Dimensions that share their random factors and velocity scaling: one group per
     /// dimension for textbook PSO, one per block for coherent blocks.
     pub groups: Vec<std::ops::Range<usize>>,
@@ -150,7 +152,7 @@ impl Limits {
     pub fn of<P: Problem>(problem: &P, fraction: f64) -> Limits {
         let lower = problem.lower().to_vec();
         let upper = problem.upper().to_vec();
-        let vmax = lower
+        let vmax: Vec<f64> = lower
             .iter()
             .zip(&upper)
             .map(|(l, u)| fraction * (u - l))
@@ -163,12 +165,19 @@ impl Limits {
             (0..problem.dim()).map(|d| d..d + 1).collect()
         };
         Limits {
+            inv_vmax: inverses(&vmax),
             lower,
             upper,
             vmax,
             groups,
         }
     }
+}
+
+fn inverses(v: &[f64]) -> Vec<f64> {
+    v.iter()
+        .map(|x| if *x > 0.0 { 1.0 / x } else { f64::INFINITY })
+        .collect()
 }
 
 /// Moves `p` by eq. (5) — or eq. (6) when `exchange` gives the followers' best o_f_gbest — then
@@ -191,22 +200,23 @@ pub fn update(
     for g in &limits.groups {
         let (r1, r2): (f64, f64) = (rng.random(), rng.random());
         let (a1, a2) = (c.c1 * r1, c.c2 * r2);
-        let a3 = if exchange.is_some() {
-            c.c3 * rng.random::<f64>()
-        } else {
-            0.0
-        };
-        let mut over: f64 = 1.0;
-        for d in g.clone() {
-            let mut v = c.w * p.v[d] + a1 * (p.best_x[d] - p.x[d]) + a2 * (gbest[d] - p.x[d]);
-            if let Some(f) = exchange {
-                v += a3 * (f[d] - p.x[d]);
-            }
-            p.v[d] = v;
-            over = over.max(v.abs() / limits.vmax[d]);
+        let r = g.clone();
+        let (x, v, best) = (&p.x[r.clone()], &mut p.v[r.clone()], &p.best_x[r.clone()]);
+        for (((v, x), b), gb) in v.iter_mut().zip(x).zip(best).zip(&gbest[r.clone()]) {
+            *v = c.w * *v + a1 * (b - x) + a2 * (gb - x);
         }
+        if let Some(f) = exchange {
+            let a3 = c.c3 * rng.random::<f64>();
+            for ((v, x), fb) in v.iter_mut().zip(x).zip(&f[r.clone()]) {
+                *v += a3 * (fb - x);
+            }
+        }
+        let over = v
+            .iter()
+            .zip(&limits.inv_vmax[r.clone()])
+            .fold(1.0f64, |m, (v, inv)| m.max(v.abs() * inv));
         let scale = 1.0 / over;
-        for d in g.clone() {
+        for d in r {
             let mut v = p.v[d] * scale;
             let mut x = p.x[d] + v;
             if x < limits.lower[d] {
@@ -369,6 +379,7 @@ mod tests {
             lower: vec![0.0, 0.0],
             upper: vec![10.0, 10.0],
             vmax: vec![3.0, 3.0],
+            inv_vmax: vec![1.0 / 3.0, 1.0 / 3.0],
             groups: std::iter::once(0..2).collect(),
         };
         let mut p = Particle {
