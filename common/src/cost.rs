@@ -17,7 +17,7 @@
 //! each as `count + depth of the breach relative to its limit`, so the swarm feels both how many
 //! and how bad.
 
-use crate::geometry::{chord_inside_sphere, heading_change, pitch, Vec3};
+use crate::geometry::{chord_inside_sphere, pitch, Vec3, MIN_HEADING_EXTENT};
 use crate::scenario::{Scenario, Vehicle};
 use crate::separation::{motion_separation, Motion};
 use crate::trajectory::{common_arrival, retime_legs, Layout, Path, Trajectory};
@@ -143,22 +143,28 @@ pub fn hard_penalty(points: &[Vec3], hard: &[Sphere]) -> (f64, usize) {
     (t.hard_penalty, t.hard_hits)
 }
 
-/// Turn penalty: at every inner waypoint whose heading change exceeds `max_turn` (radians),
+/// Turn penalty: for every heading change (see [`crate::geometry::turns`]) that exceeds `max_turn` (radians),
 /// `1 + excess / max_turn`. The cosine is compared first so only violations pay for `atan2`.
 pub fn turn_penalty(points: &[Vec3], max_turn: f64) -> f64 {
     let cos_max = max_turn.cos();
     let mut p = 0.0;
-    for w in points.windows(3) {
-        let (ux, uy) = (w[1].x - w[0].x, w[1].y - w[0].y);
-        let (vx, vy) = (w[2].x - w[1].x, w[2].y - w[1].y);
-        let norms = ((ux * ux + uy * uy) * (vx * vx + vy * vy)).sqrt();
-        if norms <= 1e-18 || (ux * vx + uy * vy) >= cos_max * norms {
+    let mut prev: Option<(f64, f64, f64)> = None;
+    for w in points.windows(2) {
+        let (x, y) = (w[1].x - w[0].x, w[1].y - w[0].y);
+        let n = (x * x + y * y).sqrt();
+        if n <= MIN_HEADING_EXTENT {
             continue;
         }
-        let t = heading_change(&w[0], &w[1], &w[2]);
-        if t > max_turn {
-            p += 1.0 + (t - max_turn) / max_turn;
+        if let Some((px, py, pn)) = prev {
+            let dot = px * x + py * y;
+            if dot < cos_max * pn * n {
+                let t = (px * y - py * x).atan2(dot).abs();
+                if t > max_turn {
+                    p += 1.0 + (t - max_turn) / max_turn;
+                }
+            }
         }
+        prev = Some((x, y, n));
     }
     p
 }
@@ -468,6 +474,10 @@ mod tests {
         let c = 30f64.to_radians();
         let pts = [v(0., 0., 0.), v(1., 0., 0.), v(1. + c.cos(), c.sin(), 0.)];
         assert_abs_diff_eq!(turn_penalty(&pts, max), 0.0);
+        // A vertical leg between an eastward and a westward leg hides nothing: 180° turn,
+        // 1 + 145/35.
+        let pts = [v(0., 0., 0.), v(1., 0., 0.), v(1., 0., 1.), v(0., 0., 1.)];
+        assert_abs_diff_eq!(turn_penalty(&pts, max), 1.0 + 145.0 / 35.0, epsilon = 1e-9);
         // A 45° climb exceeds 20° by 25°: 1 + 25/20; a 10° climb is free.
         let pmax = 20f64.to_radians();
         let pts = [

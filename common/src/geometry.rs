@@ -97,6 +97,25 @@ pub fn heading_change(a: &Vec3, b: &Vec3, c: &Vec3) -> f64 {
     cross.atan2(dot).abs()
 }
 
+/// Horizontal extent below which a leg has no heading, metres.
+pub const MIN_HEADING_EXTENT: f64 = 1e-9;
+
+/// The heading changes along a path, radians in `[0, π]`, one per pair of consecutive legs
+/// *that have a heading*: legs with no horizontal extent (vertical, or a repeated waypoint) are
+/// skipped over, so they cannot hide the turn between the legs around them.
+pub fn turns(points: &[Vec3]) -> impl Iterator<Item = f64> + '_ {
+    let mut prev: Option<(f64, f64)> = None;
+    points.windows(2).filter_map(move |w| {
+        let (x, y) = (w[1].x - w[0].x, w[1].y - w[0].y);
+        if (x * x + y * y).sqrt() <= MIN_HEADING_EXTENT {
+            return None;
+        }
+        let turn = prev.map(|(px, py)| (px * y - py * x).atan2(px * x + py * y).abs());
+        prev = Some((x, y));
+        turn
+    })
+}
+
 /// Pitch of segment `a→b` in radians, `atan2(Δz, horizontal length)`, in `[−π/2, π/2]`.
 pub fn pitch(a: &Vec3, b: &Vec3) -> f64 {
     let d = b - a;
@@ -223,6 +242,35 @@ mod tests {
         // Stationary relative position: all or nothing.
         assert_abs_diff_eq!(fraction_within(&v(3., 0., 0.), &v(3., 0., 0.), 5.0), 1.0);
         assert_abs_diff_eq!(fraction_within(&v(6., 0., 0.), &v(6., 0., 0.), 5.0), 0.0);
+    }
+
+    #[test]
+    fn turns_skip_legs_without_a_heading() {
+        let deg = |pts: &[Vec3]| turns(pts).map(f64::to_degrees).collect::<Vec<_>>();
+        // East, up (vertical), west: the vertical leg does not hide the U-turn.
+        let t = deg(&[
+            v(0., 0., 0.),
+            v(10., 0., 0.),
+            v(10., 0., 10.),
+            v(0., 0., 10.),
+        ]);
+        assert_eq!(t.len(), 1);
+        assert_abs_diff_eq!(t[0], 180.0, epsilon = 1e-9);
+        // East, a repeated waypoint, north: 90°.
+        let t = deg(&[
+            v(0., 0., 0.),
+            v(10., 0., 0.),
+            v(10., 0., 0.),
+            v(10., 10., 0.),
+        ]);
+        assert_eq!(t.len(), 1);
+        assert_abs_diff_eq!(t[0], 90.0, epsilon = 1e-9);
+        // Straight line: one corner, 0°.
+        let t = deg(&[v(0., 0., 0.), v(1., 0., 0.), v(2., 0., 1.)]);
+        assert_eq!(t.len(), 1);
+        assert_abs_diff_eq!(t[0], 0.0, epsilon = 1e-9);
+        // Fewer than two legs with a heading: no turn at all.
+        assert!(deg(&[v(0., 0., 0.), v(0., 0., 5.), v(3., 0., 5.)]).is_empty());
     }
 
     #[test]

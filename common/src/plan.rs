@@ -6,7 +6,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::geometry::{heading_change, pitch, segment_point_distance, Vec3};
+use crate::geometry::{pitch, segment_point_distance, turns, Vec3};
 use crate::scenario::Scenario;
 use crate::separation::pair_separation;
 use crate::trajectory::Trajectory;
@@ -25,7 +25,8 @@ pub struct VehiclePlan {
     pub length_m: f64,
     /// Time of the last sample, seconds.
     pub arrival_s: f64,
-    /// Largest heading change at a sample, degrees.
+    /// Largest heading change between consecutive legs with a heading, degrees (legs with no
+    /// horizontal extent are skipped over, see [`crate::geometry::turns`]).
     pub max_turn_deg: f64,
     /// Largest |pitch| of a leg, degrees.
     pub max_pitch_deg: f64,
@@ -78,10 +79,7 @@ pub fn assess(scenario: &Scenario, trajectories: &[Trajectory]) -> Assessment {
     for (v, t) in scenario.vehicles.iter().zip(trajectories) {
         let pts = &t.points;
         let length: f64 = pts.windows(2).map(|w| (w[1] - w[0]).norm()).sum();
-        let max_turn = pts
-            .windows(3)
-            .map(|w| heading_change(&w[0], &w[1], &w[2]).to_degrees())
-            .fold(0.0, f64::max);
+        let max_turn = turns(pts).map(f64::to_degrees).fold(0.0, f64::max);
         let max_pitch = pts
             .windows(2)
             .map(|w| pitch(&w[0], &w[1]).abs().to_degrees())

@@ -1,0 +1,83 @@
+//! End-to-end error handling of `shoal-coordinator plan --in-process`: bad scenario values,
+//! missing files and unknown options exit non-zero with a message naming the culprit, and write
+//! no plan.
+
+mod common;
+
+use common::{plan, scenario, TestResult};
+
+#[test]
+fn bad_value_is_reported_with_file_field_and_value() -> TestResult {
+    let dir = tempfile::tempdir()?;
+    let text = std::fs::read_to_string(scenario("amp-pso-1"))?;
+    let mut doc: toml::Table = toml::from_str(&text)?;
+    let Some(v0) = doc
+        .get_mut("vehicles")
+        .and_then(|v| v.as_array_mut())
+        .and_then(|a| a.first_mut())
+        .and_then(|v| v.as_table_mut())
+    else {
+        panic!("amp-pso-1.toml has no [[vehicles]]");
+    };
+    v0.insert("speed_max_mps".into(), toml::Value::Float(-1.0));
+    let bad = dir.path().join("bad-speed.toml");
+    std::fs::write(&bad, toml::to_string(&doc)?)?;
+    let out = dir.path().join("out");
+    let r = plan(
+        &bad,
+        &out,
+        &[
+            "--iterations",
+            "2",
+            "--populations",
+            "1",
+            "--particles",
+            "4",
+        ],
+    );
+    assert_eq!(r.code(), Some(1), "{r}");
+    for needle in ["bad-speed.toml", "vehicles[0].speed_max_mps", "-1"] {
+        assert!(
+            r.stderr.contains(needle),
+            "stderr does not mention `{needle}`:\n{r}"
+        );
+    }
+    assert!(
+        !out.join("plan.json").exists(),
+        "a plan was written for a bad scenario:\n{r}"
+    );
+    Ok(())
+}
+
+#[test]
+fn missing_scenario_file_is_reported() -> TestResult {
+    let dir = tempfile::tempdir()?;
+    let missing = dir.path().join("does-not-exist.toml");
+    let r = plan(&missing, &dir.path().join("out"), &[]);
+    assert_eq!(r.code(), Some(1), "{r}");
+    assert!(
+        r.stderr.contains(&missing.display().to_string()),
+        "stderr does not name {}:\n{r}",
+        missing.display()
+    );
+    Ok(())
+}
+
+#[test]
+fn unknown_algorithm_is_refused() -> TestResult {
+    let dir = tempfile::tempdir()?;
+    let r = plan(&scenario("amp-pso-1"), dir.path(), &["--algorithm", "nope"]);
+    assert!(
+        r.code().is_some_and(|c| c != 0),
+        "expected a non-zero exit:\n{r}"
+    );
+    assert!(
+        r.stderr.contains("nope"),
+        "stderr does not name the bad value:\n{r}"
+    );
+    assert!(
+        !dir.path().join("plan.json").exists(),
+        "a plan was written:\n{r}"
+    );
+    Ok(())
+}
