@@ -31,9 +31,9 @@ impl Problem for FleetModel {
         self.layout.chromosome(b)
     }
 
-    /// A chromosome is one vehicle's path: it moves as a whole.
-    fn coherent_blocks(&self) -> bool {
-        true
+    /// A vehicle's waypoints move as one path and its speeds as one profile.
+    fn move_groups(&self) -> Vec<std::ops::Range<usize>> {
+        self.layout.move_groups()
     }
 
     fn cost_parts(&self, x: &[f64], parts: &mut [f64]) -> f64 {
@@ -98,8 +98,8 @@ impl Problem for FleetModel {
                     p[d] = p[d].clamp(s.bounds.min[d], s.bounds.max[d]);
                 }
                 x.extend_from_slice(&[p.x, p.y, p.z]);
-                x.push(rng.random_range(v.speed_min_mps..=v.speed_max_mps));
             }
+            x.extend((0..m).map(|_| rng.random_range(v.speed_min_mps..=v.speed_max_mps)));
         }
         debug_assert_eq!(x.len(), m * GENES_PER_WAYPOINT * s.vehicles.len());
         x
@@ -179,8 +179,9 @@ waypoints = 6
         for v in &model.scenario.vehicles {
             for j in 1..=6 {
                 let p = v.start() + (v.goal() - v.start()) * (j as f64 / 7.0);
-                x.extend_from_slice(&[p.x, p.y, p.z, 1.0]);
+                x.extend_from_slice(&[p.x, p.y, p.z]);
             }
+            x.extend_from_slice(&[1.0; 6]);
         }
         let e = model.evaluate(&x);
         assert!(e.vehicles.iter().all(|t| t.hard_hits > 0));

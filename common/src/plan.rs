@@ -233,13 +233,22 @@ pub fn assess(scenario: &Scenario, trajectories: &[Trajectory]) -> Assessment {
     }
 }
 
-/// Plain-words notes on the timing: why the common arrival differs from the mission time.
+/// Plain-words notes that are not violations: why the common arrival differs from the mission
+/// time, and capabilities a vehicle would need that are not built yet.
 pub fn timing_notices(
     scenario: &Scenario,
     trajectories: &[Trajectory],
     common_arrival: f64,
 ) -> Vec<String> {
     let mut out = Vec::new();
+    for v in &scenario.vehicles {
+        if v.kind == crate::scenario::VehicleKind::Crawler {
+            out.push(format!(
+                "{} is a crawler, but seabed terrain and crawler costs are not built yet: it was planned as a free-swimming vehicle",
+                v.id
+            ));
+        }
+    }
     let mission = scenario.fleet.mission_time_s;
     for (v, t) in scenario.vehicles.iter().zip(trajectories) {
         let length: f64 = t.points.windows(2).map(|w| (w[1] - w[0]).norm()).sum();

@@ -261,6 +261,20 @@ mod tests {
         assert_abs_diff_eq!(s.min_time, 50.0, epsilon = 1e-9);
     }
 
+    /// A trajectory through `points` whose leg durations cycle through `dt` from `offset`.
+    fn timed(points: &[(f64, f64, f64)], dt: &[f64], offset: usize) -> Trajectory {
+        let mut t = 0.0;
+        let mut times = vec![0.0];
+        for k in 1..points.len() {
+            t += dt[(k + offset) % dt.len()];
+            times.push(t);
+        }
+        Trajectory {
+            times,
+            points: points.iter().map(|q| Vec3::new(q.0, q.1, q.2)).collect(),
+        }
+    }
+
     proptest! {
         #[test]
         fn separation_is_symmetric_and_non_negative(
@@ -268,13 +282,7 @@ mod tests {
             pb in proptest::collection::vec((-100.0f64..100.0, -100.0f64..100.0, -100.0f64..100.0), 2..6),
             dt in proptest::collection::vec(0.1f64..30.0, 6),
         ) {
-            let mk = |p: &Vec<(f64, f64, f64)>, off: usize| {
-                let mut t = 0.0;
-                let mut times = vec![0.0];
-                for k in 1..p.len() { t += dt[(k + off) % dt.len()]; times.push(t); }
-                Trajectory { times, points: p.iter().map(|q| Vec3::new(q.0, q.1, q.2)).collect() }
-            };
-            let (a, b) = (mk(&pa, 0), mk(&pb, 3));
+            let (a, b) = (timed(&pa, &dt, 0), timed(&pb, &dt, 3));
             let ab = pair_separation(&a, &b, 20.0);
             let ba = pair_separation(&b, &a, 20.0);
             prop_assert!(ab.min_distance >= 0.0);
@@ -296,13 +304,7 @@ mod tests {
             dt in proptest::collection::vec(0.1f64..30.0, 8),
             d_min in 1.0f64..60.0,
         ) {
-            let mk = |p: &Vec<(f64, f64, f64)>, off: usize| {
-                let mut t = 0.0;
-                let mut times = vec![0.0];
-                for k in 1..p.len() { t += dt[(k + off) % dt.len()]; times.push(t); }
-                Trajectory { times, points: p.iter().map(|q| Vec3::new(q.0, q.1, q.2)).collect() }
-            };
-            let (a, b) = (mk(&pa, 0), mk(&pb, 5));
+            let (a, b) = (timed(&pa, &dt, 0), timed(&pb, &dt, 5));
             let (ma, mb) = (Motion::new(&a), Motion::new(&b));
             let exact = motion_separation(&ma, &mb, d_min, true);
             let fast = motion_separation(&ma, &mb, d_min, false);

@@ -6,6 +6,10 @@
 //! the vehicles can let each other pass. A fleet particle is the chromosomes of all vehicles, one
 //! after the other (Fig. 3).
 //!
+//! In memory a chromosome stores its `3M` coordinates first (`x_1, y_1, z_1, …, z_M`) and its `M`
+//! status genes after them, so the path and the speed profile are each one contiguous range that
+//! a solver can move as a whole (see [`Layout::move_groups`]).
+//!
 //! Timing: the requested speeds are only a *profile*. [`retime`] scales the profile so the vehicle
 //! arrives at the fleet's common arrival time, keeping every leg's speed inside the vehicle's range.
 
@@ -45,6 +49,18 @@ impl Layout {
         let n = self.chromosome_len();
         i * n..(i + 1) * n
     }
+    /// The ranges a solver moves as a whole: each vehicle's waypoint coordinates, and each
+    /// vehicle's speed genes. Kept apart so that speeds (metres per second, a range of about
+    /// 1 m/s) and positions (a range of kilometres) do not throttle each other's steps.
+    pub fn move_groups(&self) -> Vec<std::ops::Range<usize>> {
+        let m = self.waypoints;
+        (0..self.vehicles)
+            .flat_map(|i| {
+                let c = self.chromosome(i);
+                [c.start..c.start + 3 * m, c.start + 3 * m..c.end]
+            })
+            .collect()
+    }
     /// Lower and upper bound of every gene of a fleet particle: the scenario box for coordinates,
     /// the vehicle's speed range for δ.
     pub fn gene_bounds(&self, scenario: &Scenario) -> (Vec<f64>, Vec<f64>) {
@@ -54,9 +70,9 @@ impl Layout {
             for _ in 0..self.waypoints {
                 lo.extend_from_slice(&scenario.bounds.min);
                 hi.extend_from_slice(&scenario.bounds.max);
-                lo.push(v.speed_min_mps);
-                hi.push(v.speed_max_mps);
             }
+            lo.extend(std::iter::repeat_n(v.speed_min_mps, self.waypoints));
+            hi.extend(std::iter::repeat_n(v.speed_max_mps, self.waypoints));
         }
         (lo, hi)
     }
@@ -73,16 +89,15 @@ pub struct Path {
 }
 
 impl Path {
-    /// Decodes one chromosome (`genes.len() == 4 M`) for `vehicle`.
+    /// Decodes one chromosome (`genes.len() == 4 M`: coordinates, then speeds) for `vehicle`.
     pub fn decode(vehicle: &Vehicle, genes: &[f64]) -> Path {
         let m = genes.len() / GENES_PER_WAYPOINT;
+        let (coords, status) = genes.split_at(3 * m);
         let mut points = Vec::with_capacity(m + 2);
         let mut speeds = Vec::with_capacity(m + 1);
         points.push(vehicle.start());
-        for g in genes.chunks_exact(GENES_PER_WAYPOINT) {
-            points.push(Vec3::new(g[0], g[1], g[2]));
-            speeds.push(g[3]);
-        }
+        points.extend(coords.chunks_exact(3).map(|g| Vec3::new(g[0], g[1], g[2])));
+        speeds.extend_from_slice(status);
         points.push(vehicle.goal());
         speeds.push(speeds.last().copied().unwrap_or(vehicle.speed_max_mps));
         Path { points, speeds }
@@ -291,7 +306,7 @@ mod tests {
     #[test]
     fn decode_places_start_genes_goal_and_speeds() {
         let v = vehicle();
-        let p = Path::decode(&v, &[100.0, 0.0, 0.0, 1.0, 200.0, 0.0, 0.0, 0.5]);
+        let p = Path::decode(&v, &[100.0, 0.0, 0.0, 200.0, 0.0, 0.0, 1.0, 0.5]);
         assert_eq!(p.points.len(), 4);
         assert_eq!(p.points[1], Vec3::new(100.0, 0.0, 0.0));
         assert_eq!(p.speeds, vec![1.0, 0.5, 0.5]);
@@ -312,7 +327,7 @@ mod tests {
     fn retime_hits_target_keeping_speed_ratios() {
         let v = vehicle();
         // Legs 100, 100, 100 m with requested speeds 1.0, 0.5, 0.5: paces 1, 2, 2 s/m.
-        let p = Path::decode(&v, &[100.0, 0.0, 0.0, 1.0, 200.0, 0.0, 0.0, 0.5]);
+        let p = Path::decode(&v, &[100.0, 0.0, 0.0, 200.0, 0.0, 0.0, 1.0, 0.5]);
         // Target 400 s: α (100·1 + 100·2 + 100·2) = 400 → α = 0.8 → paces 0.8, 1.6, 1.6 s/m,
         // all inside [1/1.5, 1/0.5] = [0.667, 2].
         let t = retime(&p, &v, 400.0);
@@ -332,7 +347,7 @@ mod tests {
     #[test]
     fn retime_out_of_reach_flies_at_the_limit() {
         let v = vehicle();
-        let p = Path::decode(&v, &[100.0, 0.0, 0.0, 1.0, 200.0, 0.0, 0.0, 0.5]);
+        let p = Path::decode(&v, &[100.0, 0.0, 0.0, 200.0, 0.0, 0.0, 1.0, 0.5]);
         // 300 m at 1.5 m/s takes 200 s at best.
         assert_abs_diff_eq!(retime(&p, &v, 100.0).arrival(), 200.0, epsilon = 1e-9);
         // ... and 600 s at worst.

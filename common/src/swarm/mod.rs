@@ -42,11 +42,11 @@ pub trait Problem: Sync {
         let _ = b;
         0..self.dim()
     }
-    /// True when each block is one geometric object (a vehicle's path) that should move as a
-    /// whole: solvers then draw their random factors once per block and scale a block's velocity
-    /// as a whole. False (the default) gives textbook per-dimension randomness.
-    fn coherent_blocks(&self) -> bool {
-        false
+    /// Ranges of dimensions a solver moves as a whole: one random factor per range and one
+    /// velocity scaling per range. The default, one range per dimension, is textbook PSO; a
+    /// problem whose ranges are geometric objects (a vehicle's path) keeps them smooth this way.
+    fn move_groups(&self) -> Vec<std::ops::Range<usize>> {
+        (0..self.dim()).map(|d| d..d + 1).collect()
     }
     /// Cost split by block: writes block `b`'s share into `parts[b]` and returns the total, which
     /// equals the sum of the parts and [`Problem::cost`].

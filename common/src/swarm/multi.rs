@@ -7,7 +7,7 @@
 //! global best o_f_gbest (Fig. 5b); the updated immigrants then return to their own follower
 //! population and replace its worst particle (Fig. 5c).
 
-use super::population::{assemble, update, Limits, Particle, Population, Schedule};
+use super::population::{trusted_best, update, Limits, Particle, Population, Schedule};
 use super::{parallel, Problem, Progress, Solver, SolverState};
 
 /// Multi-population PSO with a leader.
@@ -133,20 +133,40 @@ impl MultiPso {
         } else {
             0
         };
-        // o_f_gbest: the followers' global best, assembled over all followers' particles.
-        let Some((f_gbest, _)) = assemble(
+        // o_f_gbest: the followers' global best, assembled over all followers' particles and
+        // trusted only if it beats the best follower elite.
+        let (f_elite_x, f_elite_cost) = state
+            .followers
+            .iter()
+            .min_by(|a, b| a.elite_cost.total_cmp(&b.elite_cost))
+            .map_or((Vec::new(), f64::INFINITY), |f| {
+                (f.elite_x.clone(), f.elite_cost)
+            });
+        let Some(f_best) = trusted_best(
             problem,
             state.followers.iter().flat_map(|f| f.particles.iter()),
+            &f_elite_x,
+            f_elite_cost,
         ) else {
             return evaluations;
         };
+        evaluations += f_best.evaluations;
+        let f_gbest = f_best.x;
         // (b) leader and immigrants move by eq. (6), towards the leader's own best and o_f_gbest;
         // the moves draw from the leader's RNG in order, the evaluations run in parallel.
-        let leader_gbest = assemble(
+        let (l_elite_x, l_elite_cost) =
+            std::iter::once((&state.leader.elite_x, state.leader.elite_cost))
+                .chain(immigrants.iter().map(|p| (&p.x, p.cost)))
+                .min_by(|a, b| a.1.total_cmp(&b.1))
+                .map_or((Vec::new(), f64::INFINITY), |(x, c)| (x.clone(), c));
+        let leader_best = trusted_best(
             problem,
             state.leader.particles.iter().chain(immigrants.iter()),
-        )
-        .map_or_else(|| f_gbest.clone(), |(x, _)| x);
+            &l_elite_x,
+            l_elite_cost,
+        );
+        evaluations += leader_best.as_ref().map_or(0, |b| b.evaluations);
+        let leader_gbest = leader_best.map_or_else(|| f_gbest.clone(), |b| b.x);
         let rng = &mut state.leader.rng;
         let mut movers: Vec<&mut Particle> = state
             .leader

@@ -83,6 +83,53 @@ pub fn assemble<'a, P: Problem>(
     Some((x, parts))
 }
 
+/// A global best the swarm may follow, with what it cost to find out.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TrustedBest {
+    /// The attractor o_gbest.
+    pub x: Vec<f64>,
+    /// Its true cost.
+    pub cost: f64,
+    /// Evaluations spent (0 or 1).
+    pub evaluations: u64,
+}
+
+/// The global best a swarm should follow. Blocks remembered in different particles were scored
+/// next to different partners, so for a coupled cost (two vehicles' separation) the assembled
+/// best can hide a conflict no single memory saw. It is evaluated once, and followed only if it
+/// is truly at least as good as `elite` (the best position truly evaluated so far); otherwise the
+/// elite is followed. With a single block the assembled best *is* the best personal best.
+pub fn trusted_best<'a, P: Problem>(
+    problem: &P,
+    particles: impl Iterator<Item = &'a Particle> + Clone,
+    elite: &[f64],
+    elite_cost: f64,
+) -> Option<TrustedBest> {
+    let (x, parts) = assemble(problem, particles)?;
+    if problem.blocks() == 1 || x == elite {
+        let cost = parts.iter().sum();
+        return Some(TrustedBest {
+            x,
+            cost,
+            evaluations: 0,
+        });
+    }
+    let cost = problem.cost(&x);
+    if cost <= elite_cost || elite.is_empty() {
+        Some(TrustedBest {
+            x,
+            cost,
+            evaluations: 1,
+        })
+    } else {
+        Some(TrustedBest {
+            x: elite.to_vec(),
+            cost: elite_cost,
+            evaluations: 1,
+        })
+    }
+}
+
 /// PSO coefficients for one iteration.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Coefficients {
@@ -142,8 +189,8 @@ pub struct Limits {
     pub vmax: Vec<f64>,
     /// 1 / vmax, so the update loop multiplies instead of dividing.
     pub inv_vmax: Vec<f64>,
-    /// Dimensions that share their random factors and velocity scaling: one group per
-    /// dimension for textbook PSO, one per block for coherent blocks.
+    /// Dimensions that share their random factors and velocity scaling
+    /// ([`Problem::move_groups`]).
     pub groups: Vec<std::ops::Range<usize>>,
 }
 
@@ -157,13 +204,7 @@ impl Limits {
             .zip(&upper)
             .map(|(l, u)| fraction * (u - l))
             .collect();
-        let groups = if problem.coherent_blocks() {
-            (0..problem.blocks())
-                .map(|b| problem.block_range(b))
-                .collect()
-        } else {
-            (0..problem.dim()).map(|d| d..d + 1).collect()
-        };
+        let groups = problem.move_groups();
         Limits {
             inv_vmax: inverses(&vmax),
             lower,
@@ -185,7 +226,7 @@ fn inverses(v: &[f64]) -> Vec<f64> {
 /// in that dimension (absorbing boundary), so it does not keep pushing outwards.
 ///
 /// `r1`, `r2`, `r3` are drawn per group of [`Limits::groups`]: per dimension in textbook PSO, once
-/// per vehicle path for coherent blocks. A path's new velocity is then a linear combination of
+/// per vehicle path for the fleet problem. A path's new velocity is then a linear combination of
 /// whole paths (the old velocity, the personal and the global best), so smooth paths stay smooth
 /// instead of picking up an independent kink at every waypoint; for the same reason a group's
 /// velocity over its limit is scaled down as a whole (for a one-dimension group, a plain clamp).
@@ -238,10 +279,8 @@ pub fn update(
 pub struct Population {
     /// Its particles.
     pub particles: Vec<Particle>,
-    /// o_gbest, assembled block by block from the personal bests.
+    /// o_gbest (see [`trusted_best`]).
     pub gbest: Vec<f64>,
-    /// Per-block costs of `gbest` as remembered.
-    pub gbest_parts: Vec<f64>,
     /// Best position this population has truly evaluated.
     pub elite_x: Vec<f64>,
     /// Its cost.
@@ -274,7 +313,6 @@ impl Population {
         let mut pop = Population {
             particles,
             gbest: Vec::new(),
-            gbest_parts: Vec::new(),
             elite_x: Vec::new(),
             elite_cost: f64::INFINITY,
             rng,
@@ -293,22 +331,21 @@ impl Population {
                 self.elite_x.clone_from(&p.x);
             }
         }
-        let Some((x, parts)) = assemble(problem, self.particles.iter()) else {
+        let Some(best) = trusted_best(
+            problem,
+            self.particles.iter(),
+            &self.elite_x,
+            self.elite_cost,
+        ) else {
             return 0;
         };
-        self.gbest = x;
-        self.gbest_parts = parts;
-        // An assembled best is a new position: evaluate it once so the elite can take it.
-        if problem.blocks() > 1 && self.gbest != self.elite_x {
-            let cost = problem.cost(&self.gbest);
-            self.evaluations += 1;
-            if cost < self.elite_cost {
-                self.elite_cost = cost;
-                self.elite_x.clone_from(&self.gbest);
-            }
-            return 1;
+        if best.cost < self.elite_cost {
+            self.elite_cost = best.cost;
+            self.elite_x.clone_from(&best.x);
         }
-        0
+        self.gbest = best.x;
+        self.evaluations += best.evaluations;
+        best.evaluations
     }
 
     /// The particle an exchange sends to the leader: the population's best, positioned at its
@@ -442,6 +479,52 @@ mod tests {
             parts[1] = (x[1] - 2.0).powi(2);
             parts[0] + parts[1]
         }
+    }
+
+    /// Two blocks coupled like two vehicles: each pays 5 when they are closer than 1.
+    struct Coupled;
+    impl Problem for Coupled {
+        fn lower(&self) -> &[f64] {
+            &[-10.0, -10.0]
+        }
+        fn upper(&self) -> &[f64] {
+            &[10.0, 10.0]
+        }
+        fn cost(&self, x: &[f64]) -> f64 {
+            let mut p = [0.0; 2];
+            self.cost_parts(x, &mut p)
+        }
+        fn blocks(&self) -> usize {
+            2
+        }
+        fn block_range(&self, b: usize) -> std::ops::Range<usize> {
+            b..b + 1
+        }
+        fn cost_parts(&self, x: &[f64], parts: &mut [f64]) -> f64 {
+            let clash = if (x[0] - x[1]).abs() < 1.0 { 5.0 } else { 0.0 };
+            parts[0] = x[0] * x[0] + clash;
+            parts[1] = x[1] * x[1] + clash;
+            parts[0] + parts[1]
+        }
+    }
+
+    #[test]
+    fn an_assembled_best_that_clashes_is_not_followed() {
+        // a = (0, 3): parts (0, 9), cost 9. b = (3, 0.5): parts (9, 0.25), cost 9.25.
+        // Block by block the best is (0, 0.5), but those two clash: true cost 0 + 0.25 + 10.
+        let a = Particle::new(&Coupled, vec![0.0, 3.0]);
+        let b = Particle::new(&Coupled, vec![3.0, 0.5]);
+        let best = trusted_best(&Coupled, [&a, &b].into_iter(), &a.x, a.cost);
+        assert_eq!(
+            best,
+            Some(TrustedBest {
+                x: vec![0.0, 3.0],
+                cost: 9.0,
+                evaluations: 1
+            })
+        );
+        let pop = Population::from_particles(&Coupled, vec![a, b], StdRng::seed_from_u64(1));
+        assert_eq!((pop.gbest.clone(), pop.elite_cost), (vec![0.0, 3.0], 9.0));
     }
 
     #[test]
