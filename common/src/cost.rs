@@ -70,46 +70,48 @@ struct SphereTerms {
     soft_inside: f64,
 }
 
-/// Every leg against every sphere. Per sphere the legs are walked in order with a lower bound on
-/// the centre's distance to the current leg's start (triangle inequality: it shrinks by at most one
-/// leg length per leg), so legs that cannot reach the sphere cost one subtraction; the others get
+/// Legs per bounding box in [`sphere_terms`]'s cull.
+const CHUNK_LEGS: usize = 6;
+
+/// Every leg against every sphere. Legs are grouped in chunks of [`CHUNK_LEGS`] with a bounding
+/// box each; a sphere that cannot reach a chunk's box skips all its legs at once. The others get
 /// the exact squared distance, and roots and chords are taken only on a hit.
 fn sphere_terms(points: &[Vec3], hard: &[Sphere], soft: &[Sphere]) -> SphereTerms {
     let mut out = SphereTerms::default();
-    let legs: Vec<(Vec3, f64, f64)> = points
-        .windows(2)
-        .map(|w| {
-            let k = w[1] - w[0];
-            let len2 = k.norm_squared();
-            (k, len2.sqrt(), if len2 > 0.0 { 1.0 / len2 } else { 0.0 })
+    let n_legs = points.len().saturating_sub(1);
+    let boxes: Vec<(Vec3, Vec3)> = (0..n_legs)
+        .step_by(CHUNK_LEGS)
+        .map(|start| {
+            let pts = &points[start..(start + CHUNK_LEGS + 1).min(points.len())];
+            let lo = pts.iter().fold(pts[0], |m, p| m.inf(p));
+            let hi = pts.iter().fold(pts[0], |m, p| m.sup(p));
+            (lo, hi)
         })
         .collect();
-    for (s, is_hard) in hard
-        .iter()
-        .map(|s| (s, true))
-        .chain(soft.iter().map(|s| (s, false)))
-    {
+    for (s, is_hard) in hard.iter().map(|s| (s, true)).chain(soft.iter().map(|s| (s, false))) {
         let r2 = s.radius * s.radius;
-        // Lower bound on |centre − points[j]|.
-        let mut bound = f64::NEG_INFINITY;
-        for (j, (k, len, inv)) in legs.iter().enumerate() {
-            if bound - len >= s.radius {
-                bound -= len;
+        for (chunk, (lo, hi)) in boxes.iter().enumerate() {
+            let gap = (lo - s.centre).sup(&(s.centre - hi)).sup(&Vec3::zeros());
+            if gap.norm_squared() >= r2 {
                 continue;
             }
-            let q = s.centre - points[j];
-            let u = (q.dot(k) * inv).clamp(0.0, 1.0);
-            let d2 = (q - k * u).norm_squared();
-            if d2 < r2 {
-                if is_hard {
-                    out.hard_penalty += 1.0 + (s.radius - d2.sqrt()) / s.radius;
-                    out.hard_hits += 1;
-                } else {
-                    out.soft_inside +=
-                        chord_inside_sphere(&points[j], &points[j + 1], &s.centre, s.radius);
+            let start = chunk * CHUNK_LEGS;
+            for j in start..(start + CHUNK_LEGS).min(n_legs) {
+                let (a, b) = (points[j], points[j + 1]);
+                let k = b - a;
+                let len2 = k.norm_squared();
+                let q = s.centre - a;
+                let u = if len2 > 0.0 { (q.dot(&k) / len2).clamp(0.0, 1.0) } else { 0.0 };
+                let d2 = (q - k * u).norm_squared();
+                if d2 < r2 {
+                    if is_hard {
+                        out.hard_penalty += 1.0 + (s.radius - d2.sqrt()) / s.radius;
+                        out.hard_hits += 1;
+                    } else {
+                        out.soft_inside += chord_inside_sphere(&a, &b, &s.centre, s.radius);
+                    }
                 }
             }
-            bound = (s.centre - points[j + 1]).norm();
         }
     }
     out
