@@ -88,7 +88,11 @@ fn sphere_terms(points: &[Vec3], hard: &[Sphere], soft: &[Sphere]) -> SphereTerm
             (lo, hi)
         })
         .collect();
-    for (s, is_hard) in hard.iter().map(|s| (s, true)).chain(soft.iter().map(|s| (s, false))) {
+    for (s, is_hard) in hard
+        .iter()
+        .map(|s| (s, true))
+        .chain(soft.iter().map(|s| (s, false)))
+    {
         let r2 = s.radius * s.radius;
         for (chunk, (lo, hi)) in boxes.iter().enumerate() {
             let gap = (lo - s.centre).sup(&(s.centre - hi)).sup(&Vec3::zeros());
@@ -101,7 +105,11 @@ fn sphere_terms(points: &[Vec3], hard: &[Sphere], soft: &[Sphere]) -> SphereTerm
                 let k = b - a;
                 let len2 = k.norm_squared();
                 let q = s.centre - a;
-                let u = if len2 > 0.0 { (q.dot(&k) / len2).clamp(0.0, 1.0) } else { 0.0 };
+                let u = if len2 > 0.0 {
+                    (q.dot(&k) / len2).clamp(0.0, 1.0)
+                } else {
+                    0.0
+                };
                 let d2 = (q - k * u).norm_squared();
                 if d2 < r2 {
                     if is_hard {

@@ -7,7 +7,7 @@ use rand::Rng;
 use crate::cost::FleetModel;
 use crate::geometry::Vec3;
 use crate::swarm::Problem;
-use crate::trajectory::GENES_PER_WAYPOINT;
+use crate::trajectory::{required_horizontal_length, GENES_PER_WAYPOINT};
 
 impl Problem for FleetModel {
     fn lower(&self) -> &[f64] {
@@ -44,14 +44,17 @@ impl Problem for FleetModel {
         e.total
     }
 
-    /// Initial particles (seed 004 §3.1: uniform draws "adjusting the range"): each vehicle's
-    /// waypoints are the straight line start→goal bent by three sine harmonics (k = 1, 2, 3)
-    /// whose horizontal amplitudes are uniform in ±A/k (a tenth of that vertically), with A itself
-    /// uniform in [2 %, 50 %] of the straight distance, and depth changing in proportion to the
-    /// horizontal distance travelled; speeds are uniform in the vehicle's range. Uniform draws over the whole 2 km box
-    /// would start every path tens of kilometres long and kinked at every waypoint; smooth bends
-    /// of random size keep the population diverse and mostly flyable, and bends are what a
-    /// pitch-limited climb needs to gain horizontal distance.
+    /// Initial particles (seed 004 §3.1: uniform draws "adjusting the range"). Each vehicle's
+    /// waypoints are the straight line start→goal bent by three sine harmonics (k = 1, 2, 3) with
+    /// uniform random coefficients in ±1/k, and depth changing in proportion to the horizontal
+    /// distance travelled; speeds are uniform in the vehicle's range. The bend's size is:
+    /// - for a vehicle whose climb is steeper than its pitch limit, solved so the horizontal
+    ///   length is 1.02–1.25 × what the limit requires (`|Δz| / tan φ_max`): every initial path
+    ///   then climbs within the limit;
+    /// - otherwise uniform in [2 %, 50 %] of the straight distance.
+    ///
+    /// Uniform draws over the whole 2 km box would start every path tens of kilometres long and
+    /// kinked at every waypoint.
     fn sample(&self, rng: &mut StdRng) -> Vec<f64> {
         let s = &self.scenario;
         let m = self.layout.waypoints;
@@ -59,51 +62,86 @@ impl Problem for FleetModel {
         for (i, v) in s.vehicles.iter().enumerate() {
             let (a, b) = (v.start(), v.goal());
             let span = self.straight[i].max(1.0);
-            let amp = rng.random_range(0.02..=0.5) * span;
-            let harmonics: Vec<Vec3> = (1..=3)
+            let shape: Vec<Vec3> = (1..=3)
                 .map(|k| {
                     Vec3::new(
-                        rng.random_range(-amp..=amp),
-                        rng.random_range(-amp..=amp),
-                        0.1 * rng.random_range(-amp..=amp),
+                        rng.random_range(-1.0..=1.0),
+                        rng.random_range(-1.0..=1.0),
+                        0.1 * rng.random_range(-1.0..=1.0),
                     ) / k as f64
                 })
                 .collect();
-            // The bent curve at M + 2 stations, start and goal included.
-            let mut pts: Vec<Vec3> = (0..=m + 1)
-                .map(|j| {
-                    let f = j as f64 / (m + 1) as f64;
-                    let mut p = a + (b - a) * f;
-                    for (k, h) in harmonics.iter().enumerate() {
-                        p += h * ((k + 1) as f64 * std::f64::consts::PI * f).sin();
-                    }
-                    p
-                })
-                .collect();
-            // Depth follows horizontal distance travelled, so the climb is spread evenly and the
-            // pitch is as gentle as this curve allows.
-            let mut along = vec![0.0; pts.len()];
-            for j in 1..pts.len() {
-                let d = pts[j] - pts[j - 1];
-                along[j] = along[j - 1] + (d.x * d.x + d.y * d.y).sqrt();
-            }
-            let total = along[m + 1].max(1e-9);
-            for j in 1..=m {
-                let base = a.z + (b.z - a.z) * along[j] / total;
-                let f = j as f64 / (m + 1) as f64;
-                pts[j].z = base + (pts[j].z - (a.z + (b.z - a.z) * f));
-            }
-            for p in &mut pts[1..=m] {
+            let d = b - a;
+            let needed = required_horizontal_length(v);
+            let amp = if needed > (d.x * d.x + d.y * d.y).sqrt() * (1.0 + 1e-9) {
+                let target = needed * rng.random_range(1.02..=1.25);
+                bend_for_length(a, b, m, &shape, target, 2.0 * span)
+            } else {
+                rng.random_range(0.02..=0.5) * span
+            };
+            for p in bent_curve(a, b, m, &shape, amp)[1..=m].iter() {
                 for d in 0..3 {
-                    p[d] = p[d].clamp(s.bounds.min[d], s.bounds.max[d]);
+                    x.push(p[d].clamp(s.bounds.min[d], s.bounds.max[d]));
                 }
-                x.extend_from_slice(&[p.x, p.y, p.z]);
             }
             x.extend((0..m).map(|_| rng.random_range(v.speed_min_mps..=v.speed_max_mps)));
         }
         debug_assert_eq!(x.len(), m * GENES_PER_WAYPOINT * s.vehicles.len());
         x
     }
+}
+
+/// The straight line `a→b` at `m + 2` stations (ends included) bent by `amp · Σ shape_k sin(kπf)`,
+/// with depth following the horizontal distance travelled, so the climb is spread evenly.
+fn bent_curve(a: Vec3, b: Vec3, m: usize, shape: &[Vec3], amp: f64) -> Vec<Vec3> {
+    let mut pts: Vec<Vec3> = (0..=m + 1)
+        .map(|j| {
+            let f = j as f64 / (m + 1) as f64;
+            let mut p = a + (b - a) * f;
+            for (k, h) in shape.iter().enumerate() {
+                p += h * (amp * ((k + 1) as f64 * std::f64::consts::PI * f).sin());
+            }
+            p
+        })
+        .collect();
+    let along = horizontal_progress(&pts);
+    let total = along[m + 1].max(1e-9);
+    for j in 1..=m {
+        let f = j as f64 / (m + 1) as f64;
+        let bend_z = pts[j].z - (a.z + (b.z - a.z) * f);
+        pts[j].z = a.z + (b.z - a.z) * along[j] / total + bend_z;
+    }
+    pts
+}
+
+/// Cumulative horizontal distance along `pts`.
+fn horizontal_progress(pts: &[Vec3]) -> Vec<f64> {
+    let mut along = vec![0.0; pts.len()];
+    for j in 1..pts.len() {
+        let d = pts[j] - pts[j - 1];
+        along[j] = along[j - 1] + (d.x * d.x + d.y * d.y).sqrt();
+    }
+    along
+}
+
+/// The bend amplitude (in `[0, max_amp]`) whose curve covers `target` metres horizontally, by
+/// bisection (the length grows with the amplitude); `max_amp` if even that falls short.
+fn bend_for_length(a: Vec3, b: Vec3, m: usize, shape: &[Vec3], target: f64, max_amp: f64) -> f64 {
+    let length = |amp: f64| horizontal_progress(&bent_curve(a, b, m, shape, amp))[m + 1];
+    if length(max_amp) <= target {
+        return max_amp;
+    }
+    let (mut lo, mut hi) = (0.0, max_amp);
+    // 30 halvings: a billionth of the range, far finer than a starting bend needs.
+    for _ in 0..30 {
+        let mid = 0.5 * (lo + hi);
+        if length(mid) < target {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    0.5 * (lo + hi)
 }
 
 #[cfg(test)]
@@ -167,6 +205,30 @@ waypoints = 6
             assert!(model.cost(&x).is_finite());
         }
         Ok(())
+    }
+
+    #[test]
+    fn a_steep_climb_starts_with_a_long_enough_bend() {
+        // Climb 600 m over 400 m horizontally with a 20° limit: 600 / tan 20° = 1648 m needed.
+        let (a, b) = (Vec3::new(0.0, 0.0, 0.0), Vec3::new(400.0, 0.0, 600.0));
+        let shape = [
+            Vec3::new(0.3, 1.0, 0.0),
+            Vec3::new(-0.2, 0.4, 0.0),
+            Vec3::zeros(),
+        ];
+        let amp = bend_for_length(a, b, 30, &shape, 1700.0, 5000.0);
+        let pts = bent_curve(a, b, 30, &shape, amp);
+        let along = horizontal_progress(&pts);
+        assert!((along[31] - 1700.0).abs() < 1e-3, "{}", along[31]);
+        // Depth follows horizontal progress: every leg climbs at atan(600 / 1700) = 19.4°.
+        for w in pts.windows(2) {
+            let p = crate::geometry::pitch(&w[0], &w[1]).to_degrees();
+            assert!(
+                (p - (600f64 / 1700.0).atan().to_degrees()).abs() < 1e-6,
+                "{p}"
+            );
+        }
+        assert!((pts[0] - a).norm() < 1e-9 && (pts[31] - b).norm() < 1e-9);
     }
 
     #[test]

@@ -6,10 +6,10 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::geometry::{pitch, segment_point_distance, turns, Vec3};
+use crate::geometry::{pitch, segment_point_distance, turns};
 use crate::scenario::Scenario;
 use crate::separation::pair_separation;
-use crate::trajectory::Trajectory;
+use crate::trajectory::{shortest_pitch_feasible_length, Trajectory};
 
 /// Slack for float noise in limit checks (degrees, m/s, metres, seconds).
 const TOL: f64 = 1e-6;
@@ -254,25 +254,32 @@ pub fn timing_notices(
         let length: f64 = t.points.windows(2).map(|w| (w[1] - w[0]).norm()).sum();
         let earliest = length / v.speed_max_mps;
         let latest = length / v.speed_min_mps;
+        let shortest = shortest_pitch_feasible_length(v);
         let straight = (v.goal() - v.start()).norm();
-        if earliest > mission + TOL {
+        if shortest / v.speed_max_mps > mission + TOL {
+            // No path at all gets this vehicle there in time.
             let dz = (v.goal()[2] - v.start()[2]).abs();
-            let horizontal = {
-                let d: Vec3 = v.goal() - v.start();
-                (d.x * d.x + d.y * d.y).sqrt()
-            };
-            let steep = dz > horizontal * v.max_pitch_deg.to_radians().tan();
-            let why = if steep {
+            let why = if shortest > straight + TOL {
                 format!(
-                    "its depth change of {dz:.0} m over {horizontal:.0} m is steeper than its {:.0}° pitch limit, so its path must be longer than the {straight:.0} m straight line",
+                    "climbing {dz:.0} m within its {:.0}° pitch limit takes at least {shortest:.0} m of path (the straight line is {straight:.0} m)",
                     v.max_pitch_deg
                 )
             } else {
-                format!("obstacles and turn limits make its path longer than the {straight:.0} m straight line")
+                format!("even the {straight:.0} m straight line is too long")
             };
             out.push(format!(
-                "{} cannot arrive by the mission time of {mission:.0} s: its {length:.0} m path takes at least {earliest:.0} s at its top speed of {:.3} m/s ({why}); every vehicle is timed to arrive at {common_arrival:.0} s instead",
-                v.id, v.speed_max_mps
+                "{} cannot arrive by the mission time of {mission:.0} s whatever its path: {why}, {:.0} s at its top speed of {:.3} m/s; every vehicle is timed to arrive at {common_arrival:.0} s instead",
+                v.id,
+                shortest / v.speed_max_mps,
+                v.speed_max_mps
+            ));
+        } else if earliest > mission + TOL && earliest >= common_arrival - TOL {
+            // This vehicle's planned path sets the late arrival, though a shorter one exists.
+            out.push(format!(
+                "{}'s planned path of {length:.0} m takes at least {earliest:.0} s at its top speed of {:.3} m/s, so the fleet arrives at {common_arrival:.0} s instead of the mission time of {mission:.0} s (the shortest path its pitch limit allows, {shortest:.0} m, would take {:.0} s; obstacles, turn limits and the other vehicles made it longer)",
+                v.id,
+                v.speed_max_mps,
+                shortest / v.speed_max_mps
             ));
         } else if latest < common_arrival - TOL {
             out.push(format!(
@@ -332,6 +339,7 @@ pub struct Plan {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::geometry::Vec3;
 
     fn scenario() -> Result<Scenario, crate::scenario::ScenarioError> {
         Scenario::parse(
@@ -445,14 +453,38 @@ mission_time_s = 1000.0
             line(s.vehicles[0].start, s.vehicles[0].goal, 500.0),
             line(s.vehicles[1].start, s.vehicles[1].goal, 500.0),
         ];
+        // Both fly 1000 m flat at 2 m/s at best: no path makes 300 s.
         let n = timing_notices(&s, &t, 500.0);
         assert_eq!(n.len(), 2);
         assert!(
-            n[0].contains("a cannot arrive by the mission time of 300 s"),
+            n[0].contains("a cannot arrive by the mission time of 300 s whatever its path"),
             "{}",
             n[0]
         );
-        assert!(n[0].contains("at least 500 s"), "{}", n[0]);
+        assert!(
+            n[0].contains("even the 1000 m straight line is too long, 500 s"),
+            "{}",
+            n[0]
+        );
+        // With 600 s the mission is possible; a detour of two 750 m legs (750 s) is the plan's
+        // doing.
+        s.fleet.mission_time_s = 600.0;
+        let detour = Trajectory {
+            times: vec![0.0, 375.0, 750.0],
+            points: vec![
+                Vec3::new(0.0, 0.0, 0.0),
+                Vec3::new(500.0, (750f64.powi(2) - 500f64.powi(2)).sqrt(), 0.0),
+                Vec3::new(1000.0, 0.0, 0.0),
+            ],
+        };
+        let n = timing_notices(&s, &[detour, t[1].clone()], 750.0);
+        assert_eq!(n.len(), 1, "{n:?}");
+        assert!(n[0].starts_with("a's planned path of 1500 m"), "{}", n[0]);
+        assert!(n[0].contains("would take 500 s"), "{}", n[0]);
+        // A crawler is planned as a swimmer, and the plan says so.
+        s.vehicles[1].kind = crate::scenario::VehicleKind::Crawler;
+        let n = timing_notices(&s, &t, 500.0);
+        assert!(n[0].contains("b is a crawler"), "{}", n[0]);
         Ok(())
     }
 }

@@ -171,6 +171,28 @@ impl Trajectory {
     }
 }
 
+/// The shortest path the vehicle's pitch limit allows from start to goal, metres: the straight
+/// line when its slope is within the limit, else `|Δz| / sin(φ_max)` (a path winding enough to
+/// climb at exactly the limit). Obstacles and turns can only make it longer.
+pub fn shortest_pitch_feasible_length(vehicle: &Vehicle) -> f64 {
+    let d = vehicle.goal() - vehicle.start();
+    let horizontal = (d.x * d.x + d.y * d.y).sqrt();
+    let phi = vehicle.max_pitch_deg.to_radians();
+    if d.z.abs() <= horizontal * phi.tan() {
+        d.norm()
+    } else {
+        d.z.abs() / phi.sin()
+    }
+}
+
+/// Horizontal distance a path must cover for its climb to stay within the pitch limit, metres:
+/// `|Δz| / tan(φ_max)`, or the straight horizontal distance if that is more.
+pub fn required_horizontal_length(vehicle: &Vehicle) -> f64 {
+    let d = vehicle.goal() - vehicle.start();
+    let horizontal = (d.x * d.x + d.y * d.y).sqrt();
+    horizontal.max(d.z.abs() / vehicle.max_pitch_deg.to_radians().tan())
+}
+
 /// Earliest and latest arrival a path allows: `t_min = L / v_max`, `t_max = L / v_min`
 /// (seed 004 eq. (2)), seconds.
 pub fn arrival_window(length: f64, vehicle: &Vehicle) -> (f64, f64) {
@@ -352,6 +374,31 @@ mod tests {
         assert_abs_diff_eq!(retime(&p, &v, 100.0).arrival(), 200.0, epsilon = 1e-9);
         // ... and 600 s at worst.
         assert_abs_diff_eq!(retime(&p, &v, 1000.0).arrival(), 600.0, epsilon = 1e-9);
+    }
+
+    #[test]
+    fn pitch_limited_lengths_by_hand() {
+        let mut v = vehicle();
+        // (0,0,0) → (300,0,0): flat, the straight line.
+        assert_abs_diff_eq!(shortest_pitch_feasible_length(&v), 300.0, epsilon = 1e-9);
+        assert_abs_diff_eq!(required_horizontal_length(&v), 300.0, epsilon = 1e-9);
+        // Climb 300 m over 300 m (45°) with a 30° limit: 300 / sin 30° = 600 m of path, of which
+        // 300 / tan 30° = 519.6 m horizontal.
+        v.goal = [300.0, 0.0, 300.0];
+        v.max_pitch_deg = 30.0;
+        assert_abs_diff_eq!(shortest_pitch_feasible_length(&v), 600.0, epsilon = 1e-9);
+        assert_abs_diff_eq!(
+            required_horizontal_length(&v),
+            300.0 * 3f64.sqrt(),
+            epsilon = 1e-9
+        );
+        // A 60° limit allows the 45° straight line.
+        v.max_pitch_deg = 60.0;
+        assert_abs_diff_eq!(
+            shortest_pitch_feasible_length(&v),
+            300.0 * 2f64.sqrt(),
+            epsilon = 1e-9
+        );
     }
 
     #[test]

@@ -210,9 +210,11 @@ impl<P: Problem> Solver<P> for MultiPso {
     }
 
     fn init(&mut self, problem: &P) -> MultiState {
-        let followers: Vec<Population> = (0..self.populations)
-            .map(|k| Population::sample(problem, self.particles, stream_seed(self.seed, k as u64)))
-            .collect();
+        // Populations are independent (own seed, own stream): sample them in parallel.
+        let ks: Vec<usize> = (0..self.populations).collect();
+        let followers: Vec<Population> = parallel::map(&ks, self.threads, |&k| {
+            Population::sample(problem, self.particles, stream_seed(self.seed, k as u64))
+        });
         let leader = Population::sample(
             problem,
             self.leader_particles,
