@@ -455,9 +455,9 @@ mod tests {
         assert_eq!(p.x, vec![7.0, 8.0]);
     }
 
-    /// Two independent blocks: cost = (x0 − 1)² + (x1 − 2)².
-    struct TwoBlocks;
-    impl Problem for TwoBlocks {
+    /// A problem of two one-dimensional blocks on [−10, 10]², its per-block costs given by `f`.
+    struct TwoBlocks<F: Fn(&[f64]) -> [f64; 2] + Sync>(F);
+    impl<F: Fn(&[f64]) -> [f64; 2] + Sync> Problem for TwoBlocks<F> {
         fn lower(&self) -> &[f64] {
             &[-10.0, -10.0]
         }
@@ -465,8 +465,7 @@ mod tests {
             &[10.0, 10.0]
         }
         fn cost(&self, x: &[f64]) -> f64 {
-            let mut p = [0.0; 2];
-            self.cost_parts(x, &mut p)
+            (self.0)(x).iter().sum()
         }
         fn blocks(&self) -> usize {
             2
@@ -475,46 +474,30 @@ mod tests {
             b..b + 1
         }
         fn cost_parts(&self, x: &[f64], parts: &mut [f64]) -> f64 {
-            parts[0] = (x[0] - 1.0).powi(2);
-            parts[1] = (x[1] - 2.0).powi(2);
-            parts[0] + parts[1]
+            let p = (self.0)(x);
+            parts.copy_from_slice(&p);
+            p[0] + p[1]
         }
     }
 
-    /// Two blocks coupled like two vehicles: each pays 5 when they are closer than 1.
-    struct Coupled;
-    impl Problem for Coupled {
-        fn lower(&self) -> &[f64] {
-            &[-10.0, -10.0]
-        }
-        fn upper(&self) -> &[f64] {
-            &[10.0, 10.0]
-        }
-        fn cost(&self, x: &[f64]) -> f64 {
-            let mut p = [0.0; 2];
-            self.cost_parts(x, &mut p)
-        }
-        fn blocks(&self) -> usize {
-            2
-        }
-        fn block_range(&self, b: usize) -> std::ops::Range<usize> {
-            b..b + 1
-        }
-        fn cost_parts(&self, x: &[f64], parts: &mut [f64]) -> f64 {
-            let clash = if (x[0] - x[1]).abs() < 1.0 { 5.0 } else { 0.0 };
-            parts[0] = x[0] * x[0] + clash;
-            parts[1] = x[1] * x[1] + clash;
-            parts[0] + parts[1]
-        }
+    /// Independent blocks: cost = (x0 − 1)² + (x1 − 2)².
+    fn independent(x: &[f64]) -> [f64; 2] {
+        [(x[0] - 1.0).powi(2), (x[1] - 2.0).powi(2)]
+    }
+
+    /// Blocks coupled like two vehicles: each pays 5 when they are closer than 1.
+    fn coupled(x: &[f64]) -> [f64; 2] {
+        let clash = if (x[0] - x[1]).abs() < 1.0 { 5.0 } else { 0.0 };
+        [x[0] * x[0] + clash, x[1] * x[1] + clash]
     }
 
     #[test]
     fn an_assembled_best_that_clashes_is_not_followed() {
         // a = (0, 3): parts (0, 9), cost 9. b = (3, 0.5): parts (9, 0.25), cost 9.25.
         // Block by block the best is (0, 0.5), but those two clash: true cost 0 + 0.25 + 10.
-        let a = Particle::new(&Coupled, vec![0.0, 3.0]);
-        let b = Particle::new(&Coupled, vec![3.0, 0.5]);
-        let best = trusted_best(&Coupled, [&a, &b].into_iter(), &a.x, a.cost);
+        let a = Particle::new(&TwoBlocks(coupled), vec![0.0, 3.0]);
+        let b = Particle::new(&TwoBlocks(coupled), vec![3.0, 0.5]);
+        let best = trusted_best(&TwoBlocks(coupled), [&a, &b].into_iter(), &a.x, a.cost);
         assert_eq!(
             best,
             Some(TrustedBest {
@@ -523,24 +506,29 @@ mod tests {
                 evaluations: 1
             })
         );
-        let pop = Population::from_particles(&Coupled, vec![a, b], StdRng::seed_from_u64(1));
+        let pop =
+            Population::from_particles(&TwoBlocks(coupled), vec![a, b], StdRng::seed_from_u64(1));
         assert_eq!((pop.gbest.clone(), pop.elite_cost), (vec![0.0, 3.0], 9.0));
     }
 
     #[test]
     fn memories_are_kept_block_by_block() {
-        let mut p = Particle::new(&TwoBlocks, vec![3.0, 2.0]); // parts (4, 0)
+        let mut p = Particle::new(&TwoBlocks(independent), vec![3.0, 2.0]); // parts (4, 0)
         p.x = vec![1.0, 5.0]; // parts (0, 9): block 0 improves, block 1 does not
-        p.evaluate(&TwoBlocks);
+        p.evaluate(&TwoBlocks(independent));
         assert_eq!(p.cost, 9.0);
         assert_eq!(p.best_x, vec![1.0, 2.0]);
         assert_eq!(p.best_parts, vec![0.0, 0.0]);
         assert_eq!(p.best_cost, 0.0);
         // Assembling takes block 0 from one particle and block 1 from another; the elite is the
         // assembled position once it is evaluated.
-        let a = Particle::new(&TwoBlocks, vec![1.0, 7.0]);
-        let b = Particle::new(&TwoBlocks, vec![6.0, 2.0]);
-        let pop = Population::from_particles(&TwoBlocks, vec![a, b], StdRng::seed_from_u64(1));
+        let a = Particle::new(&TwoBlocks(independent), vec![1.0, 7.0]);
+        let b = Particle::new(&TwoBlocks(independent), vec![6.0, 2.0]);
+        let pop = Population::from_particles(
+            &TwoBlocks(independent),
+            vec![a, b],
+            StdRng::seed_from_u64(1),
+        );
         assert_eq!(pop.gbest, vec![1.0, 2.0]);
         assert_eq!(pop.elite_x, vec![1.0, 2.0]);
         assert_eq!(pop.elite_cost, 0.0);
