@@ -145,7 +145,7 @@ pub struct CompareArgs {
     #[arg(required = true, env = "SHOAL_SCENARIOS", value_delimiter = ',')]
     pub scenarios: Vec<PathBuf>,
     /// Seeds 1..=N.
-    #[arg(long, default_value_t = 10, env = "SHOAL_SEEDS")]
+    #[arg(long, default_value_t = 10, env = "SHOAL_SEEDS", value_parser = clap::value_parser!(u64).range(1..))]
     pub seeds: u64,
     /// Algorithms to compare.
     #[arg(
