@@ -156,12 +156,17 @@ fn say(text: &str) {
     let _ = out.write_all(text.as_bytes()).and_then(|()| out.flush());
 }
 
-/// Progress on stderr: a bar on a terminal, a line every tenth of the run otherwise.
+/// Progress on stderr: a bar on a terminal; otherwise a line after the first iteration, every
+/// tenth of the run, and at least every [`PROGRESS_EVERY`].
 struct Progress {
     bar: Option<indicatif::ProgressBar>,
     every: usize,
     quiet: bool,
+    last: Option<std::time::Instant>,
 }
+
+/// Longest silence on a non-terminal stderr during a run.
+const PROGRESS_EVERY: std::time::Duration = std::time::Duration::from_secs(2);
 
 impl Progress {
     fn new(iterations: usize, quiet: bool) -> Progress {
@@ -178,6 +183,7 @@ impl Progress {
             bar,
             every: (iterations / 10).max(1),
             quiet,
+            last: None,
         }
     }
 
@@ -189,10 +195,14 @@ impl Progress {
         if let Some(b) = &self.bar {
             b.set_position(r.iteration as u64);
             b.set_message(msg);
-        } else if !self.quiet
-            && (r.iteration.is_multiple_of(self.every) || r.iteration == r.max_iterations)
-        {
-            eprintln!("iteration {}/{}: {msg}", r.iteration, r.max_iterations);
+        } else if !self.quiet {
+            let due = self.last.is_none_or(|t| t.elapsed() >= PROGRESS_EVERY)
+                || r.iteration.is_multiple_of(self.every)
+                || r.iteration == r.max_iterations;
+            if due {
+                eprintln!("iteration {}/{}: {msg}", r.iteration, r.max_iterations);
+                self.last = Some(std::time::Instant::now());
+            }
         }
     }
 

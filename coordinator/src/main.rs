@@ -1,7 +1,7 @@
 //! `shoal-coordinator`: parses the command line, sets up logging, and calls the library's `run`.
 
 use std::process::ExitCode;
-use std::sync::atomic::AtomicBool;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 
 use clap::Parser;
@@ -17,6 +17,17 @@ fn main() -> ExitCode {
         .with_writer(std::io::stderr)
         .init();
     let shutdown = Arc::new(AtomicBool::new(false));
+    // First Ctrl-C: stop after the current iteration and write the best plan so far.
+    // Second Ctrl-C: leave at once.
+    let flag = Arc::clone(&shutdown);
+    if let Err(e) = ctrlc::set_handler(move || {
+        if flag.swap(true, Ordering::SeqCst) {
+            std::process::exit(130);
+        }
+        eprintln!("interrupted: finishing the current iteration and writing the best plan so far (Ctrl-C again to quit now)");
+    }) {
+        tracing::warn!("cannot install the Ctrl-C handler: {e}");
+    }
     match shoal_coordinator::run(cli.command, shutdown) {
         Ok(code) => ExitCode::from(code as u8),
         Err(e) => {

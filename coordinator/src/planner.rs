@@ -74,7 +74,14 @@ pub fn plan_in_process(
     };
     let eval = model.evaluate(&run.best_x);
     let assessment = assess(scenario, &eval.trajectories);
-    let notices = timing_notices(scenario, &eval.trajectories, eval.common_arrival);
+    let mut notices = timing_notices(scenario, &eval.trajectories, eval.common_arrival);
+    if run.termination == Termination::Interrupted {
+        notices.push(format!(
+            "planning was interrupted after {} of {} iterations: this is the best plan found so far",
+            run.convergence.len(),
+            o.iterations
+        ));
+    }
     Plan {
         scenario: scenario.name.clone(),
         algorithm: o.algorithm.as_str().to_string(),

@@ -19,8 +19,8 @@ use std::process::Command;
 use serde_json::Value;
 use shoal_tests::{check, geometry, parse_plan};
 
-use process::{coordinator, run, RUN_TIMEOUT};
-pub use process::{root, Run};
+pub use process::{coordinator, root, Run};
+use process::{run, RUN_TIMEOUT};
 
 pub type TestResult = Result<(), Box<dyn Error>>;
 
