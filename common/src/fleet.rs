@@ -56,38 +56,47 @@ impl Problem for FleetModel {
     /// Uniform draws over the whole 2 km box would start every path tens of kilometres long and
     /// kinked at every waypoint.
     fn sample(&self, rng: &mut StdRng) -> Vec<f64> {
+        let mut x = Vec::with_capacity(self.layout.dim());
+        for i in 0..self.scenario.vehicles.len() {
+            self.sample_chromosome(i, rng, &mut x);
+        }
+        x
+    }
+}
+
+impl FleetModel {
+    /// Appends an initial chromosome for vehicle `i` to `x` (see [`Problem::sample`] above for
+    /// how it is drawn); a vehicle agent samples its own chromosome alone with it.
+    pub fn sample_chromosome(&self, i: usize, rng: &mut StdRng, x: &mut Vec<f64>) {
         let s = &self.scenario;
         let m = self.layout.waypoints;
-        let mut x = Vec::with_capacity(self.layout.dim());
-        for (i, v) in s.vehicles.iter().enumerate() {
-            let (a, b) = (v.start(), v.goal());
-            let span = self.straight[i].max(1.0);
-            let shape: Vec<Vec3> = (1..=3)
-                .map(|k| {
-                    Vec3::new(
-                        rng.random_range(-1.0..=1.0),
-                        rng.random_range(-1.0..=1.0),
-                        0.1 * rng.random_range(-1.0..=1.0),
-                    ) / k as f64
-                })
-                .collect();
-            let d = b - a;
-            let needed = required_horizontal_length(v);
-            let amp = if needed > (d.x * d.x + d.y * d.y).sqrt() * (1.0 + 1e-9) {
-                let target = needed * rng.random_range(1.02..=1.25);
-                bend_for_length(a, b, m, &shape, target, 2.0 * span)
-            } else {
-                rng.random_range(0.02..=0.5) * span
-            };
-            for p in bent_curve(a, b, m, &shape, amp)[1..=m].iter() {
-                for d in 0..3 {
-                    x.push(p[d].clamp(s.bounds.min[d], s.bounds.max[d]));
-                }
+        let v = &s.vehicles[i];
+        let (a, b) = (v.start(), v.goal());
+        let span = self.straight[i].max(1.0);
+        let shape: Vec<Vec3> = (1..=3)
+            .map(|k| {
+                Vec3::new(
+                    rng.random_range(-1.0..=1.0),
+                    rng.random_range(-1.0..=1.0),
+                    0.1 * rng.random_range(-1.0..=1.0),
+                ) / k as f64
+            })
+            .collect();
+        let d = b - a;
+        let needed = required_horizontal_length(v);
+        let amp = if needed > (d.x * d.x + d.y * d.y).sqrt() * (1.0 + 1e-9) {
+            let target = needed * rng.random_range(1.02..=1.25);
+            bend_for_length(a, b, m, &shape, target, 2.0 * span)
+        } else {
+            rng.random_range(0.02..=0.5) * span
+        };
+        for p in bent_curve(a, b, m, &shape, amp)[1..=m].iter() {
+            for d in 0..3 {
+                x.push(p[d].clamp(s.bounds.min[d], s.bounds.max[d]));
             }
-            x.extend((0..m).map(|_| rng.random_range(v.speed_min_mps..=v.speed_max_mps)));
         }
-        debug_assert_eq!(x.len(), m * GENES_PER_WAYPOINT * s.vehicles.len());
-        x
+        x.extend((0..m).map(|_| rng.random_range(v.speed_min_mps..=v.speed_max_mps)));
+        debug_assert_eq!(x.len() % (m * GENES_PER_WAYPOINT), 0);
     }
 }
 

@@ -9,6 +9,7 @@ pub mod scenario;
 pub mod separation;
 pub mod swarm;
 pub mod trajectory;
+pub mod vehicle_problem;
 
 /// Version of the shared crate, reported by the binaries.
 pub const VERSION: &str = env!("CARGO_PKG_VERSION");

@@ -1,0 +1,262 @@
+//! One vehicle's chromosome scored against the fixed, timed trajectories of the other vehicles:
+//! the problem a vehicle agent's follower populations solve in distributed AMP-PSO (issue 3),
+//! where each agent optimises its own chromosome and the coordinator sends it the fleet's
+//! current best plan as context.
+//!
+//! The terms are the fleet fitness's (seed 004 eq. (9)–(12), see [`crate::cost`]), restricted to
+//! this vehicle: its own F(L), F(D), F(O), F(T), its hard-obstacle, turn and pitch penalties, and
+//! the coupling with every other vehicle *as the context has it* — F(S) and the whole separation
+//! penalty of each pair it belongs to (the others cannot move out of its way here).
+//!
+//! Timing: the others keep the context's timing. This vehicle is timed for the context's common
+//! arrival, or later if its path is too long for that (it then arrives late, which F(T) and the
+//! coordinator's next fleet evaluation see).
+
+use rand::rngs::StdRng;
+
+use crate::cost::{separation_penalty, space_term, FleetModel, VehicleTerms};
+use crate::separation::{motion_separation, Motion};
+use crate::swarm::Problem;
+use crate::trajectory::{retime_legs, Path, Trajectory};
+
+/// Vehicle `vehicle`'s chromosome against the other vehicles' fixed trajectories.
+#[derive(Debug, Clone)]
+pub struct VehicleProblem<'a> {
+    /// The fleet model (scenario, obstacles, weights).
+    model: &'a FleetModel,
+    /// Which vehicle, in scenario order.
+    vehicle: usize,
+    /// The other vehicles' trajectories, in scenario order without `vehicle`.
+    others: Vec<Trajectory>,
+    /// The arrival time the context was timed for, seconds.
+    arrival: f64,
+    /// Gene bounds of this vehicle's chromosome.
+    lower: Vec<f64>,
+    /// Upper gene bounds.
+    upper: Vec<f64>,
+}
+
+/// Everything one evaluation found.
+#[derive(Debug, Clone)]
+pub struct VehicleEvaluation {
+    /// The timed trajectory this chromosome gives.
+    pub trajectory: Trajectory,
+    /// Its terms (`separation` holds the whole penalty of its pairs).
+    pub terms: VehicleTerms,
+    /// Smallest distance to any other vehicle, metres (`INFINITY` when alone).
+    pub min_separation: f64,
+    /// The cost the swarm minimises.
+    pub total: f64,
+}
+
+impl<'a> VehicleProblem<'a> {
+    /// `context` holds every vehicle's trajectory in scenario order (this vehicle's is ignored),
+    /// timed for the common arrival `arrival`.
+    pub fn new(
+        model: &'a FleetModel,
+        vehicle: usize,
+        context: &[Trajectory],
+        arrival: f64,
+    ) -> Self {
+        let range = model.layout.chromosome(vehicle);
+        VehicleProblem {
+            model,
+            vehicle,
+            others: context
+                .iter()
+                .enumerate()
+                .filter(|(j, _)| *j != vehicle)
+                .map(|(_, t)| t.clone())
+                .collect(),
+            arrival,
+            lower: model.lower[range.clone()].to_vec(),
+            upper: model.upper[range].to_vec(),
+        }
+    }
+
+    /// Decodes and scores one chromosome.
+    pub fn evaluate(&self, genes: &[f64]) -> VehicleEvaluation {
+        let s = &self.model.scenario;
+        let v = &s.vehicles[self.vehicle];
+        let path = Path::decode(v, genes);
+        let legs = path.leg_lengths();
+        let length: f64 = legs.iter().sum();
+        let mut terms = self.model.vehicle_terms(self.vehicle, &path, length);
+        let target = self.arrival.max(length / v.speed_max_mps);
+        let trajectory = retime_legs(path, &legs, v, target);
+        let mine = Motion::new(&trajectory);
+        let mut min_separation = f64::INFINITY;
+        for other in &self.others {
+            let p = motion_separation(&mine, &Motion::new(other), s.fleet.d_min_m, false);
+            terms.space += space_term(p.breach_s);
+            terms.separation += separation_penalty(p.min_distance, s.fleet.d_min_m);
+            min_separation = min_separation.min(p.min_distance);
+        }
+        let total = self.model.objective_of(&terms)
+            + s.optimizer.penalty_weight * (terms.hard + terms.motion + terms.separation);
+        VehicleEvaluation {
+            trajectory,
+            terms,
+            min_separation,
+            total,
+        }
+    }
+}
+
+impl Problem for VehicleProblem<'_> {
+    fn lower(&self) -> &[f64] {
+        &self.lower
+    }
+
+    fn upper(&self) -> &[f64] {
+        &self.upper
+    }
+
+    fn cost(&self, x: &[f64]) -> f64 {
+        self.evaluate(x).total
+    }
+
+    /// The waypoints move as one path and the speeds as one profile, as in the fleet problem.
+    fn move_groups(&self) -> Vec<std::ops::Range<usize>> {
+        let m = self.model.layout.waypoints;
+        vec![0..3 * m, 3 * m..4 * m]
+    }
+
+    fn sample(&self, rng: &mut StdRng) -> Vec<f64> {
+        let mut x = Vec::with_capacity(self.lower.len());
+        self.model.sample_chromosome(self.vehicle, rng, &mut x);
+        x
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scenario::Scenario;
+    use crate::swarm::pso::Pso;
+    use crate::swarm::{Executor, SolverState};
+    use crate::trajectory::Layout;
+    use rand::SeedableRng;
+
+    fn scenario() -> Result<Scenario, crate::scenario::ScenarioError> {
+        Scenario::parse(
+            r#"
+name = "pair"
+[bounds]
+min = [0.0, 0.0, 0.0]
+max = [1000.0, 1000.0, 500.0]
+[[vehicles]]
+id = "a"
+kind = "auv"
+start = [100.0, 500.0, 250.0]
+goal = [900.0, 500.0, 250.0]
+speed_min_mps = 0.5
+speed_max_mps = 1.5
+max_turn_deg = 35.0
+max_pitch_deg = 20.0
+[[vehicles]]
+id = "b"
+kind = "auv"
+start = [500.0, 100.0, 250.0]
+goal = [500.0, 900.0, 250.0]
+speed_min_mps = 0.5
+speed_max_mps = 1.5
+max_turn_deg = 35.0
+max_pitch_deg = 20.0
+[fleet]
+d_min_m = 50.0
+mission_time_s = 800.0
+[optimizer]
+waypoints = 6
+"#,
+            std::path::Path::new("pair.toml"),
+        )
+    }
+
+    /// Both vehicles on their straight lines at one speed: they cross (500, 500) at t = 400 s.
+    fn straight_particle(model: &FleetModel) -> Vec<f64> {
+        let mut x = Vec::new();
+        for v in &model.scenario.vehicles {
+            for j in 1..=6 {
+                let p = v.start() + (v.goal() - v.start()) * (j as f64 / 7.0);
+                x.extend_from_slice(&[p.x, p.y, p.z]);
+            }
+            x.extend_from_slice(&[1.0; 6]);
+        }
+        x
+    }
+
+    #[test]
+    fn agrees_with_the_fleet_model_on_the_fleet_own_plan() -> Result<(), Box<dyn std::error::Error>>
+    {
+        let model = FleetModel::new(&scenario()?);
+        let x = straight_particle(&model);
+        let fleet = model.evaluate(&x);
+        let layout = Layout::of(&model.scenario);
+        for i in 0..2 {
+            let p = VehicleProblem::new(&model, i, &fleet.trajectories, fleet.common_arrival);
+            let e = p.evaluate(&x[layout.chromosome(i)]);
+            let f = fleet.vehicles[i];
+            assert_eq!(e.trajectory, fleet.trajectories[i]);
+            assert!((e.terms.length - f.length).abs() < 1e-12);
+            assert!((e.terms.space - f.space).abs() < 1e-9);
+            // The whole pair penalty here, half of it in the fleet's share.
+            assert!((e.terms.separation - 2.0 * f.separation).abs() < 1e-9);
+            assert!(e.terms.separation > 1.0, "they meet head-on");
+            assert!(e.min_separation < 1e-3, "{}", e.min_separation);
+        }
+        Ok(())
+    }
+
+    #[test]
+    fn a_vehicle_alone_finds_its_straight_line() -> Result<(), Box<dyn std::error::Error>> {
+        let mut s = scenario()?;
+        s.vehicles.truncate(1);
+        let model = FleetModel::new(&s);
+        let p = VehicleProblem::new(&model, 0, &[], s.fleet.mission_time_s);
+        assert_eq!(p.dim(), 24);
+        let mut solver = Pso::adaptive(40, 3);
+        let out = Executor::new(300).run(&p, &mut solver, |_| {});
+        let e = p.evaluate(out.state.best_position());
+        // The straight line is a candidate (F(L) = 1, F(D) = 0.5); F(D) rewards rising towards
+        // the surface, so the optimum trades a little length for depth, and no penalty.
+        let straight = p.evaluate(&straight_particle(&model)[..24]);
+        assert!(
+            e.total <= straight.total + 1e-9,
+            "{} vs {}",
+            e.total,
+            straight.total
+        );
+        assert!(
+            e.terms.length < 1.05 && e.terms.depth < 0.5,
+            "{:?}",
+            e.terms
+        );
+        assert_eq!(e.terms.hard + e.terms.motion + e.terms.separation, 0.0);
+        assert_eq!(e.min_separation, f64::INFINITY);
+        Ok(())
+    }
+
+    #[test]
+    fn the_swarm_steps_out_of_a_crossing_vehicles_way() -> Result<(), Box<dyn std::error::Error>> {
+        let model = FleetModel::new(&scenario()?);
+        let x = straight_particle(&model);
+        let fleet = model.evaluate(&x);
+        // b keeps its straight line and timing; a must avoid meeting it at the centre.
+        let p = VehicleProblem::new(&model, 0, &fleet.trajectories, fleet.common_arrival);
+        let mut rng = StdRng::seed_from_u64(9);
+        assert!(p.sample(&mut rng).len() == p.dim());
+        let mut solver = Pso::adaptive(40, 5);
+        let out = Executor::new(200).run(&p, &mut solver, |_| {});
+        let e = p.evaluate(out.state.best_position());
+        assert!(e.min_separation >= 50.0, "{}", e.min_separation);
+        assert_eq!(e.terms.separation, 0.0);
+        assert!(
+            e.total < fleet.total / 2.0,
+            "{} vs {}",
+            e.total,
+            fleet.total
+        );
+        Ok(())
+    }
+}
