@@ -10,6 +10,7 @@ pub mod separation;
 pub mod swarm;
 pub mod trajectory;
 pub mod vehicle_problem;
+pub mod wire;
 
 /// Version of the shared crate, reported by the binaries.
 pub const VERSION: &str = env!("CARGO_PKG_VERSION");

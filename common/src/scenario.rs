@@ -328,11 +328,11 @@ impl Scenario {
             ));
         }
         for (i, v) in self.vehicles.iter().enumerate() {
-            if v.id.trim().is_empty() {
+            if crate::wire::topics::check_id("vehicle", &v.id).is_err() {
                 return Err(bad(
                     format!("vehicles[{i}].id"),
                     format!("{:?}", v.id),
-                    "must not be empty",
+                    "must be 1-64 letters, digits, '-', '_' or '.' (it names the vehicle on the network)",
                 ));
             }
             if let Some(j) = self.vehicles[..i].iter().position(|w| w.id == v.id) {
@@ -571,6 +571,21 @@ max_pitch_deg = 20.0
             .map(|e| e.to_string())
             .unwrap_or_default();
         assert!(msg.contains("optimizer.iterations"), "{msg}");
+    }
+
+    #[test]
+    fn vehicle_ids_must_be_usable_on_the_network() {
+        for bad in ["", "auv 1", "auv/1", "auv*"] {
+            let text = GOOD.replace("id = \"a\"", &format!("id = {bad:?}"));
+            let msg = parse(&text)
+                .err()
+                .map(|e| e.to_string())
+                .unwrap_or_default();
+            assert!(
+                msg.contains("vehicles[0].id") && msg.contains("network"),
+                "{bad:?}: {msg}"
+            );
+        }
     }
 
     #[test]

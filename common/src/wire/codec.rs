@@ -1,0 +1,197 @@
+//! The one `encode`/`decode` pair: bincode 1.3.3, fixed-width little-endian integers, a size
+//! limit, and trailing bytes rejected. No other code names the codec.
+//!
+//! `decode` never panics and never allocates more than the limit, whatever the bytes: a bad
+//! length prefix or a truncated message is an error, as is a message from another protocol
+//! version (told apart from garbage, so it can be counted separately).
+
+use bincode::Options;
+use serde::de::DeserializeOwned;
+use serde::Serialize;
+
+use super::{Envelope, PROTOCOL_VERSION};
+
+/// Largest message either side sends or accepts, bytes. A scenario-3 context (5 trajectories of
+/// 32 samples) is about 6 KB and a batch of elites a few tens of KB.
+pub const MAX_MESSAGE_BYTES: u64 = 4 * 1024 * 1024;
+
+/// Why bytes could not be read as a message.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum DecodeError {
+    /// Shorter than a version stamp.
+    #[error("message of {0} bytes is too short to carry a protocol version")]
+    TooShort(usize),
+    /// A peer speaking another protocol version.
+    #[error("protocol version {found}, expected {expected}")]
+    Version {
+        /// Version in the message.
+        found: u16,
+        /// This build's version.
+        expected: u16,
+    },
+    /// Not a valid message of this version (garbage, truncated, too large, trailing bytes).
+    #[error("malformed message: {0}")]
+    Malformed(String),
+}
+
+/// Why a message could not be written.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("cannot encode message: {0}")]
+pub struct EncodeError(String);
+
+fn options() -> impl Options {
+    bincode::DefaultOptions::new()
+        .with_fixint_encoding()
+        .with_little_endian()
+        .with_limit(MAX_MESSAGE_BYTES)
+        .reject_trailing_bytes()
+}
+
+/// Writes `message` (over [`MAX_MESSAGE_BYTES`] is an error).
+pub fn encode<T: Serialize>(message: &Envelope<T>) -> Result<Vec<u8>, EncodeError> {
+    options()
+        .serialize(message)
+        .map_err(|e| EncodeError(e.to_string()))
+}
+
+/// Reads a message of this protocol version.
+pub fn decode<T: DeserializeOwned>(bytes: &[u8]) -> Result<Envelope<T>, DecodeError> {
+    let Some(head) = bytes.get(..2) else {
+        return Err(DecodeError::TooShort(bytes.len()));
+    };
+    let found = u16::from_le_bytes([head[0], head[1]]);
+    if found != PROTOCOL_VERSION {
+        return Err(DecodeError::Version {
+            found,
+            expected: PROTOCOL_VERSION,
+        });
+    }
+    options()
+        .deserialize(bytes)
+        .map_err(|e| DecodeError::Malformed(e.to_string()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::wire::agent_to_coordinator::AgentToCoordinator;
+    use crate::wire::coordinator_to_agent::CoordinatorToAgent;
+    use crate::wire::{WireParticle, WireTrajectory};
+    use proptest::prelude::*;
+
+    #[test]
+    fn golden_bytes_of_a_stop_message() -> Result<(), Box<dyn std::error::Error>> {
+        let m = Envelope::new(CoordinatorToAgent::Stop {
+            mission: "m1".into(),
+            reason: "ok".into(),
+        });
+        let bytes = encode(&m)?;
+        // version 1 (u16 LE) | variant 3 (u32 LE) | len 2 (u64 LE) "m1" | len 2 "ok"
+        let expected: Vec<u8> = [
+            &[1u8, 0][..],
+            &[3, 0, 0, 0],
+            &[2, 0, 0, 0, 0, 0, 0, 0],
+            b"m1",
+            &[2, 0, 0, 0, 0, 0, 0, 0],
+            b"ok",
+        ]
+        .concat();
+        assert_eq!(bytes, expected);
+        assert_eq!(decode::<CoordinatorToAgent>(&bytes)?, m);
+        Ok(())
+    }
+
+    #[test]
+    fn other_versions_short_trailing_and_oversized_are_errors() -> Result<(), EncodeError> {
+        let m = Envelope::new(AgentToCoordinator::Done {
+            mission: "m".into(),
+            vehicle: "auv1".into(),
+            iterations: 200,
+            elites_sent: 200,
+            dropped: 0,
+        });
+        let mut bytes = encode(&m)?;
+        let mut v2 = bytes.clone();
+        v2[0] = 2;
+        assert_eq!(
+            decode::<AgentToCoordinator>(&v2),
+            Err(DecodeError::Version {
+                found: 2,
+                expected: 1
+            })
+        );
+        assert_eq!(
+            decode::<AgentToCoordinator>(&bytes[..1]),
+            Err(DecodeError::TooShort(1))
+        );
+        assert!(matches!(
+            decode::<AgentToCoordinator>(&bytes[..bytes.len() - 1]),
+            Err(DecodeError::Malformed(_))
+        ));
+        bytes.push(0);
+        assert!(matches!(
+            decode::<AgentToCoordinator>(&bytes),
+            Err(DecodeError::Malformed(_))
+        ));
+        // A length prefix claiming 2^60 bytes must not allocate: the limit stops it.
+        let mut huge = vec![1u8, 0, 0, 0, 0, 0];
+        huge.extend_from_slice(&(1u64 << 60).to_le_bytes());
+        assert!(matches!(
+            decode::<AgentToCoordinator>(&huge),
+            Err(DecodeError::Malformed(_))
+        ));
+        // Too big to send.
+        let big = Envelope::new(AgentToCoordinator::Elites {
+            mission: "m".into(),
+            vehicle: "auv1".into(),
+            iteration: 0,
+            particles: vec![WireParticle {
+                x: vec![0.0; 600_000],
+                v: vec![],
+                cost: 0.0,
+                best_x: vec![],
+                best_cost: 0.0,
+            }],
+        });
+        assert!(encode(&big).is_err());
+        Ok(())
+    }
+
+    fn particle() -> impl Strategy<Value = WireParticle> {
+        (proptest::collection::vec(-1e4f64..1e4, 0..40), -1e3f64..1e3).prop_map(|(x, c)| {
+            WireParticle {
+                v: x.iter().map(|a| a * 0.5).collect(),
+                best_x: x.iter().rev().copied().collect(),
+                x,
+                cost: c,
+                best_cost: c - 1.0,
+            }
+        })
+    }
+
+    proptest! {
+        #[test]
+        fn messages_round_trip(
+            mission in "[a-z0-9-]{1,12}",
+            particles in proptest::collection::vec(particle(), 0..5),
+            samples in proptest::collection::vec(proptest::array::uniform4(-1e4f64..1e4), 0..40),
+            it in 0u32..10_000,
+        ) {
+            let up = Envelope::new(AgentToCoordinator::Elites {
+                mission: mission.clone(), vehicle: "auv1".into(), iteration: it, particles: particles.clone(),
+            });
+            prop_assert_eq!(decode::<AgentToCoordinator>(&encode(&up).map_err(|e| TestCaseError::fail(e.to_string()))?), Ok(up));
+            let down = Envelope::new(CoordinatorToAgent::Context {
+                mission, iteration: it, arrival_s: 2700.0,
+                trajectories: vec![WireTrajectory { vehicle: "auv2".into(), samples }],
+            });
+            prop_assert_eq!(decode::<CoordinatorToAgent>(&encode(&down).map_err(|e| TestCaseError::fail(e.to_string()))?), Ok(down));
+        }
+
+        #[test]
+        fn garbage_is_an_error_never_a_panic(bytes in proptest::collection::vec(any::<u8>(), 0..200)) {
+            let _ = decode::<AgentToCoordinator>(&bytes);
+            let _ = decode::<CoordinatorToAgent>(&bytes);
+        }
+    }
+}

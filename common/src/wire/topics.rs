@@ -1,0 +1,139 @@
+//! Every Zenoh key expression Shoal uses, and nothing else builds one.
+//!
+//! ```text
+//! shoal/<mission>/fleet                  coordinator → all agents of a mission (context, stop)
+//! shoal/<mission>/vehicle/<id>/in        coordinator → one agent (assign, migrants)
+//! shoal/<mission>/vehicle/<id>/out       one agent → coordinator (elites, done)
+//! shoal/*/vehicle/<id>/in                what an agent listens on: its vehicle, any mission
+//! shoal/<mission>/vehicle/*/out          what the coordinator listens on for a mission
+//! shoal-alive/<id>                       an agent's liveliness token (agents outlive missions)
+//! ```
+//!
+//! Mission and vehicle ids become key chunks, so they are restricted to letters, digits, `-`, `_`
+//! and `.`: no `/`, no wildcards, nothing empty.
+
+/// Why an id cannot be used in a key expression.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("{kind} id {id:?} is not usable on the network: use 1-64 letters, digits, '-', '_' or '.'")]
+pub struct IdError {
+    /// "mission" or "vehicle".
+    pub kind: &'static str,
+    /// The id.
+    pub id: String,
+}
+
+/// Checks that `id` can be one chunk of a key expression.
+pub fn check_id(kind: &'static str, id: &str) -> Result<(), IdError> {
+    let ok = (1..=64).contains(&id.len())
+        && id
+            .bytes()
+            .all(|b| b.is_ascii_alphanumeric() || matches!(b, b'-' | b'_' | b'.'));
+    if ok {
+        Ok(())
+    } else {
+        Err(IdError {
+            kind,
+            id: id.to_string(),
+        })
+    }
+}
+
+/// Coordinator → every agent of `mission`.
+pub fn fleet(mission: &str) -> Result<String, IdError> {
+    check_id("mission", mission)?;
+    Ok(format!("shoal/{mission}/fleet"))
+}
+
+/// Coordinator → the agent of `vehicle` in `mission`.
+pub fn to_agent(mission: &str, vehicle: &str) -> Result<String, IdError> {
+    check_id("mission", mission)?;
+    check_id("vehicle", vehicle)?;
+    Ok(format!("shoal/{mission}/vehicle/{vehicle}/in"))
+}
+
+/// The agent of `vehicle` → the coordinator of `mission`.
+pub fn to_coordinator(mission: &str, vehicle: &str) -> Result<String, IdError> {
+    check_id("mission", mission)?;
+    check_id("vehicle", vehicle)?;
+    Ok(format!("shoal/{mission}/vehicle/{vehicle}/out"))
+}
+
+/// What an agent subscribes to: messages for its vehicle in any mission.
+pub fn agent_inbox(vehicle: &str) -> Result<String, IdError> {
+    check_id("vehicle", vehicle)?;
+    Ok(format!("shoal/*/vehicle/{vehicle}/in"))
+}
+
+/// What the coordinator subscribes to: every agent's messages in `mission`.
+pub fn coordinator_inbox(mission: &str) -> Result<String, IdError> {
+    check_id("mission", mission)?;
+    Ok(format!("shoal/{mission}/vehicle/*/out"))
+}
+
+/// The liveliness token of `vehicle`'s agent.
+pub fn liveliness(vehicle: &str) -> Result<String, IdError> {
+    check_id("vehicle", vehicle)?;
+    Ok(format!("shoal-alive/{vehicle}"))
+}
+
+/// Every agent's liveliness token.
+pub const ALL_LIVELINESS: &str = "shoal-alive/*";
+
+/// The vehicle whose liveliness token `key` is, if it is one.
+pub fn vehicle_of_liveliness(key: &str) -> Option<&str> {
+    let id = key.strip_prefix("shoal-alive/")?;
+    check_id("vehicle", id).ok().map(|()| id)
+}
+
+/// `(mission, vehicle)` of a key built by [`to_agent`] or [`to_coordinator`].
+pub fn mission_and_vehicle(key: &str) -> Option<(&str, &str)> {
+    let rest = key.strip_prefix("shoal/")?;
+    let mut parts = rest.split('/');
+    let (mission, kw, vehicle, dir) = (parts.next()?, parts.next()?, parts.next()?, parts.next()?);
+    if parts.next().is_some() || kw != "vehicle" || !matches!(dir, "in" | "out") {
+        return None;
+    }
+    check_id("mission", mission).ok()?;
+    check_id("vehicle", vehicle).ok()?;
+    Some((mission, vehicle))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn keys_are_built_and_read_back() -> Result<(), IdError> {
+        assert_eq!(fleet("m-1")?, "shoal/m-1/fleet");
+        assert_eq!(to_agent("m-1", "auv3")?, "shoal/m-1/vehicle/auv3/in");
+        assert_eq!(to_coordinator("m-1", "auv3")?, "shoal/m-1/vehicle/auv3/out");
+        assert_eq!(agent_inbox("auv3")?, "shoal/*/vehicle/auv3/in");
+        assert_eq!(coordinator_inbox("m-1")?, "shoal/m-1/vehicle/*/out");
+        assert_eq!(liveliness("auv3")?, "shoal-alive/auv3");
+        assert_eq!(vehicle_of_liveliness("shoal-alive/auv3"), Some("auv3"));
+        assert_eq!(vehicle_of_liveliness("shoal-alive/a/b"), None);
+        assert_eq!(
+            mission_and_vehicle(&to_coordinator("m-1", "auv3")?),
+            Some(("m-1", "auv3"))
+        );
+        assert_eq!(mission_and_vehicle("shoal/m-1/vehicle/auv3/sideways"), None);
+        assert_eq!(
+            mission_and_vehicle("shoal/m-1/vehicle/auv3/out/extra"),
+            None
+        );
+        Ok(())
+    }
+
+    #[test]
+    fn ids_that_would_change_a_key_are_refused() {
+        for bad in ["", "a/b", "*", "**", "a b", "$x", "auv?", &"x".repeat(65)] {
+            assert!(check_id("vehicle", bad).is_err(), "{bad:?}");
+            assert!(to_agent("m", bad).is_err());
+        }
+        let e = fleet("two missions")
+            .err()
+            .map(|e| e.to_string())
+            .unwrap_or_default();
+        assert!(e.contains("mission id \"two missions\""), "{e}");
+    }
+}
