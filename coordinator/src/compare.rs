@@ -3,6 +3,7 @@
 
 use std::fmt::Write;
 use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 use shoal_common::plan::Plan;
 use shoal_common::scenario::{Algorithm, Scenario};
@@ -83,27 +84,30 @@ pub fn cell(scenario: &str, algorithm: Algorithm, plans: &[Plan], d_min: f64) ->
     }
 }
 
-/// Runs `algorithms` × `seeds` on every scenario; `progress` sees each finished plan.
+/// Runs `algorithms` × `seeds` on every scenario; `progress` sees each finished plan. When
+/// `stop` is raised it finishes the plan in hand and returns the cells completed so far.
 pub fn compare(
     scenarios: &[Scenario],
     algorithms: &[Algorithm],
     seeds: std::ops::Range<u64>,
+    stop: &AtomicBool,
     progress: &mut dyn FnMut(&Plan),
 ) -> Vec<Cell> {
     let mut cells = Vec::new();
     for s in scenarios {
         for &a in algorithms {
-            let plans: Vec<Plan> = seeds
-                .clone()
-                .map(|seed| {
-                    let mut s = s.clone();
-                    s.optimizer.algorithm = a;
-                    s.optimizer.seed = seed;
-                    let p = plan_in_process(&s, None, &mut |_| {});
-                    progress(&p);
-                    p
-                })
-                .collect();
+            let mut plans = Vec::new();
+            for seed in seeds.clone() {
+                if stop.load(Ordering::Relaxed) {
+                    return cells;
+                }
+                let mut s = s.clone();
+                s.optimizer.algorithm = a;
+                s.optimizer.seed = seed;
+                let p = plan_in_process(&s, None, &mut |_| {});
+                progress(&p);
+                plans.push(p);
+            }
             cells.push(cell(&s.name, a, &plans, s.fleet.d_min_m));
         }
     }

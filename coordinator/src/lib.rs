@@ -31,11 +31,11 @@ pub const EXIT_VIOLATIONS: i32 = 3;
 pub fn run(command: Command, shutdown: Arc<AtomicBool>) -> anyhow::Result<i32> {
     match command {
         Command::Plan(args) => plan_command(&args, shutdown),
-        Command::Compare(args) => compare_command(&args),
+        Command::Compare(args) => compare_command(&args, &shutdown),
     }
 }
 
-fn compare_command(args: &compare::CompareArgs) -> anyhow::Result<i32> {
+fn compare_command(args: &compare::CompareArgs, stop: &AtomicBool) -> anyhow::Result<i32> {
     let scenarios = args
         .scenarios
         .iter()
@@ -50,18 +50,27 @@ fn compare_command(args: &compare::CompareArgs) -> anyhow::Result<i32> {
         .collect::<anyhow::Result<Vec<_>>>()?;
     let total = scenarios.len() * args.algorithms.len() * args.seeds as usize;
     let mut done = 0;
-    let cells = compare::compare(&scenarios, &args.algorithms, 1..args.seeds + 1, &mut |p| {
-        done += 1;
-        eprintln!(
-            "[{done}/{total}] {} {} seed {}: fitness {:.4}, {} in {:.2} s",
-            p.scenario,
-            p.algorithm,
-            p.seed,
-            p.fitness,
-            if p.feasible { "feasible" } else { "infeasible" },
-            p.runtime_s
-        );
-    });
+    let cells = compare::compare(
+        &scenarios,
+        &args.algorithms,
+        1..args.seeds + 1,
+        stop,
+        &mut |p| {
+            done += 1;
+            eprintln!(
+                "[{done}/{total}] {} {} seed {}: fitness {:.4}, {} in {:.2} s",
+                p.scenario,
+                p.algorithm,
+                p.seed,
+                p.fitness,
+                if p.feasible { "feasible" } else { "infeasible" },
+                p.runtime_s
+            );
+        },
+    );
+    if stop.load(std::sync::atomic::Ordering::Relaxed) {
+        eprintln!("interrupted: the table has only the cells completed before Ctrl-C");
+    }
     let table = compare::markdown(&cells);
     say(&table);
     if let Some(out) = &args.out {

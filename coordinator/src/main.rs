@@ -24,7 +24,7 @@ fn main() -> ExitCode {
         if flag.swap(true, Ordering::SeqCst) {
             std::process::exit(130);
         }
-        eprintln!("interrupted: finishing the current iteration and writing the best plan so far (Ctrl-C again to quit now)");
+        eprintln!("interrupted: finishing the work in hand and writing what is done so far (Ctrl-C again to quit now)");
     }) {
         tracing::warn!("cannot install the Ctrl-C handler: {e}");
     }
