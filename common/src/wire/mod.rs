@@ -5,10 +5,14 @@
 //!   direction, each a serde enum inside a versioned [`Envelope`].
 //! - [`codec`] is the only code that names the codec (bincode 1.3.3, size-limited, trailing
 //!   bytes rejected).
+//! - [`session`] is the only code that builds a Zenoh configuration (coordinator = embedded
+//!   router, agents = clients, multicast scouting off). Note: in zenoh 1.10 `open(...).await`
+//!   runs synchronously, so a timeout around it bounds nothing; open on a thread of its own.
 
 pub mod agent_to_coordinator;
 pub mod codec;
 pub mod coordinator_to_agent;
+pub mod session;
 pub mod topics;
 
 use serde::{Deserialize, Serialize};

@@ -1,0 +1,349 @@
+//! The only place that builds a Zenoh [`Config`]: the coordinator embeds a router that listens,
+//! every vehicle agent is a client that connects to it (a star; since Zenoh 1.9 peers no longer
+//! relay for each other). Multicast scouting is off everywhere: endpoints are always explicit,
+//! and multicast fails inside Docker networks and CI sandboxes.
+//!
+//! Endpoints come from users (CLI flags, `SHOAL_*` variables), so each is checked here and a bad
+//! one is an error naming it. Only `tcp/<host>:<port>` is accepted: it is the only transport
+//! built in, and a client waiting for its router would otherwise retry a typo forever.
+//!
+//! Beware: in zenoh 1.10, `zenoh::open(config).await` (like every builder but `close`) resolves
+//! synchronously inside `into_future`, so `tokio::time::timeout` around it bounds nothing. To
+//! bound or cancel a client waiting for its router, open on a thread of its own (see the tests).
+
+use std::str::FromStr;
+
+use zenoh::config::EndPoint;
+use zenoh::Config;
+
+use super::codec::MAX_MESSAGE_BYTES;
+
+/// Transports compiled into zenoh (the workspace enables only `transport_tcp`); extend together
+/// with the zenoh features.
+const SUPPORTED_PROTOCOLS: &[&str] = &["tcp"];
+
+/// Why a Zenoh configuration could not be built.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum SessionError {
+    /// Nothing to listen on or connect to (multicast scouting is off, so nothing would be found).
+    #[error("no endpoint given for {setting}: give at least one, e.g. tcp/127.0.0.1:7447")]
+    NoEndpoints {
+        /// `listen/endpoints` or `connect/endpoints`.
+        setting: &'static str,
+    },
+    /// An endpoint string that cannot work.
+    #[error("{setting}: {endpoint:?} is not a usable endpoint: {reason}")]
+    BadEndpoint {
+        /// `listen/endpoints` or `connect/endpoints`.
+        setting: &'static str,
+        /// The string as given.
+        endpoint: String,
+        /// What is wrong with it.
+        reason: String,
+    },
+    /// Zenoh refused a setting (a bug here rather than bad input: inputs are checked first).
+    #[error("zenoh refused {key} = {value}: {reason}")]
+    Setting {
+        /// Configuration key.
+        key: &'static str,
+        /// JSON5 value.
+        value: String,
+        /// Zenoh's message.
+        reason: String,
+    },
+}
+
+/// The coordinator's configuration: an embedded router listening on `listen`
+/// (e.g. `tcp/0.0.0.0:7447`). Opening it fails at once if an endpoint cannot be bound.
+pub fn router_config(listen: &[String]) -> Result<Config, SessionError> {
+    let mut config = base("router")?;
+    let listen = endpoints("listen/endpoints", listen)?;
+    set(&mut config, "listen/endpoints", &listen)?;
+    Ok(config)
+}
+
+/// A vehicle agent's configuration: a client of the router at `connect`.
+///
+/// With `wait_for_router`, opening waits (retrying after 1 s, backing off to every 4 s) until a
+/// router answers, so an agent may start before the coordinator. Without it, opening fails at
+/// once when no router is up. Either way a client reconnects by itself if the router restarts.
+pub fn client_config(connect: &[String], wait_for_router: bool) -> Result<Config, SessionError> {
+    let mut config = base("client")?;
+    let connect = endpoints("connect/endpoints", connect)?;
+    set(&mut config, "connect/endpoints", &connect)?;
+    // Whole connect phase, i64 ms: -1 = forever, 0 = one try (the client default). Clients take
+    // zenoh's single-link path, which never reads `connect/exit_on_failure`.
+    let timeout_ms = if wait_for_router { "-1" } else { "0" };
+    set(&mut config, "connect/timeout_ms", timeout_ms)?;
+    Ok(config)
+}
+
+/// Settings both sides share.
+fn base(mode: &str) -> Result<Config, SessionError> {
+    let mut config = Config::default();
+    set(&mut config, "mode", &format!("{mode:?}"))?;
+    set(&mut config, "scouting/multicast/enabled", "false")?;
+    // Largest message zenoh reassembles (default 1 GiB): the codec refuses anything over
+    // MAX_MESSAGE_BYTES anyway, so don't let a peer make us buffer more than twice that.
+    let max = (2 * MAX_MESSAGE_BYTES).to_string();
+    set(&mut config, "transport/link/rx/max_message_size", &max)?;
+    Ok(config)
+}
+
+fn set(config: &mut Config, key: &'static str, value: &str) -> Result<(), SessionError> {
+    config
+        .insert_json5(key, value)
+        .map_err(|e| SessionError::Setting {
+            key,
+            value: value.to_string(),
+            reason: e.to_string(),
+        })
+}
+
+/// Checks every endpoint and returns them as a JSON array (quoted by serde, never by hand).
+fn endpoints(setting: &'static str, given: &[String]) -> Result<String, SessionError> {
+    if given.is_empty() {
+        return Err(SessionError::NoEndpoints { setting });
+    }
+    for endpoint in given {
+        check_endpoint(endpoint).map_err(|reason| SessionError::BadEndpoint {
+            setting,
+            endpoint: endpoint.clone(),
+            reason,
+        })?;
+    }
+    Ok(serde_json::Value::from(given.to_vec()).to_string())
+}
+
+fn check_endpoint(s: &str) -> Result<(), String> {
+    let endpoint = EndPoint::from_str(s).map_err(|e| e.to_string())?;
+    let protocol = endpoint.protocol().as_str();
+    if !SUPPORTED_PROTOCOLS.contains(&protocol) {
+        return Err(format!(
+            "transport {protocol:?} is not built in (supported: {SUPPORTED_PROTOCOLS:?})"
+        ));
+    }
+    match endpoint.address().as_str().rsplit_once(':') {
+        Some((host, port)) if !host.is_empty() && port.parse::<u16>().is_ok() => Ok(()),
+        _ => Err("the address must be <host>:<port>, e.g. tcp/127.0.0.1:7447".to_string()),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::wire::agent_to_coordinator::AgentToCoordinator;
+    use crate::wire::{codec, topics, Envelope};
+    use std::future::IntoFuture;
+    use std::slice::from_ref;
+    use std::time::Duration;
+    use tokio::sync::oneshot;
+    use zenoh::handlers::FifoChannelHandler;
+    use zenoh::pubsub::Subscriber;
+    use zenoh::qos::CongestionControl;
+    use zenoh::sample::{Sample, SampleKind};
+    use zenoh::{Session, Wait};
+
+    type TestResult = Result<(), Box<dyn std::error::Error + Send + Sync>>;
+
+    const LIMIT: Duration = Duration::from_secs(10);
+
+    /// `f` under the test time limit; the error names the step that hung. (Zenoh builders
+    /// other than `close` resolve synchronously, so for them this is a label, not a bound.)
+    async fn within<F: IntoFuture>(step: &str, f: F) -> Result<F::Output, String> {
+        tokio::time::timeout(LIMIT, f)
+            .await
+            .map_err(|_| format!("{step}: no result within {LIMIT:?}"))
+    }
+
+    /// Opens on a detached thread, so that waiting for it can be bounded and a hung open cannot
+    /// block the runtime's shutdown.
+    fn open_in_thread(config: Config) -> oneshot::Receiver<zenoh::Result<Session>> {
+        let (tx, rx) = oneshot::channel();
+        std::thread::spawn(move || tx.send(zenoh::open(config).wait()));
+        rx
+    }
+
+    async fn open(step: &str, config: Config) -> zenoh::Result<Session> {
+        within(step, open_in_thread(config)).await??
+    }
+
+    /// A loopback endpoint on a port that was free a moment ago.
+    fn free_endpoint() -> std::io::Result<String> {
+        let listener = std::net::TcpListener::bind("127.0.0.1:0")?;
+        Ok(format!("tcp/127.0.0.1:{}", listener.local_addr()?.port()))
+    }
+
+    async fn router_and_client() -> zenoh::Result<(Session, Session)> {
+        let endpoint = free_endpoint()?;
+        let router = open("router open", router_config(from_ref(&endpoint))?).await?;
+        let client = open("client open", client_config(&[endpoint], false)?).await?;
+        Ok((router, client))
+    }
+
+    #[test]
+    fn settings_read_back() -> TestResult {
+        let wait = client_config(&["tcp/coordinator:7447".into()], true)?;
+        let once = client_config(&["tcp/10.0.0.1:7447".into()], false)?;
+        // A quote in a user string stays inside its endpoint (a bad host, found at open).
+        let router = router_config(&["tcp/[::]:7447".into(), r#"tcp/a",b:1"#.into()])?;
+        let expected = [
+            (&wait, "mode", r#""client""#),
+            (&wait, "connect/endpoints", r#"["tcp/coordinator:7447"]"#),
+            (&wait, "connect/timeout_ms", "-1"),
+            (&once, "connect/timeout_ms", "0"),
+            (&router, "mode", r#""router""#),
+            (
+                &router,
+                "listen/endpoints",
+                r#"["tcp/[::]:7447","tcp/a\",b:1"]"#,
+            ),
+        ];
+        for (config, key, value) in expected {
+            assert_eq!(config.get_json(key)?, value, "{key}");
+        }
+        for config in [&wait, &once, &router] {
+            assert_eq!(config.get_json("scouting/multicast/enabled")?, "false");
+            assert_eq!(
+                config.get_json("transport/link/rx/max_message_size")?,
+                "8388608"
+            );
+        }
+        Ok(())
+    }
+
+    #[test]
+    fn bad_endpoints_are_errors_naming_them() {
+        let bad = [
+            "not an endpoint",
+            "tcp/nonsense",
+            "tcp/:7447",
+            "tcp/127.0.0.1:99999",
+        ];
+        for s in bad
+            .into_iter()
+            .chain(["udp/127.0.0.1:7447", "tls/127.0.0.1:7447"])
+        {
+            let results = [
+                client_config(&[s.into()], false),
+                client_config(&["tcp/127.0.0.1:7447".into(), s.into()], true),
+                router_config(&[s.into()]),
+            ];
+            for result in results {
+                match result {
+                    Err(e @ SessionError::BadEndpoint { .. }) => {
+                        assert!(e.to_string().contains(&format!("{s:?}")), "{e}")
+                    }
+                    other => panic!("{s:?} gave {other:?}"),
+                }
+            }
+        }
+        let e = client_config(&[], true).err().map(|e| e.to_string());
+        assert!(e.is_some_and(|e| e.contains("connect/endpoints")));
+        let e = router_config(&[]).err().map(|e| e.to_string());
+        assert!(e.is_some_and(|e| e.contains("listen/endpoints")));
+    }
+
+    #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+    async fn open_fails_on_a_busy_port_or_a_missing_router() -> TestResult {
+        // Both errors are zenoh's, at open time; each names the endpoint.
+        let busy = std::net::TcpListener::bind("127.0.0.1:0")?;
+        let endpoint = format!("tcp/127.0.0.1:{}", busy.local_addr()?.port());
+        let router = open("router on a busy port", router_config(from_ref(&endpoint))?).await;
+        let e = router.err().map(|e| e.to_string()).unwrap_or_default();
+        assert!(e.contains(&endpoint), "router on a busy port: {e:?}");
+        let endpoint = free_endpoint()?;
+        let client = open(
+            "client, no router",
+            client_config(from_ref(&endpoint), false)?,
+        )
+        .await;
+        let e = client.err().map(|e| e.to_string()).unwrap_or_default();
+        assert!(e.contains(&endpoint), "client without a router: {e:?}");
+        Ok(())
+    }
+
+    #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+    async fn a_waiting_client_connects_once_the_router_starts() -> TestResult {
+        let endpoint = free_endpoint()?;
+        let mut client = open_in_thread(client_config(from_ref(&endpoint), true)?);
+        tokio::time::sleep(Duration::from_millis(500)).await;
+        assert!(client.try_recv().is_err(), "the client did not wait");
+        let router = open("router open", router_config(&[endpoint])?).await?;
+        let client = within("client open", client).await???;
+        within("client close", client.close()).await??;
+        within("router close", router.close()).await??;
+        Ok(())
+    }
+
+    #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+    async fn an_agent_message_reaches_the_coordinator() -> TestResult {
+        let (router, client) = router_and_client().await?;
+        let inbox = router.declare_subscriber(topics::coordinator_inbox("m1")?);
+        let inbox = within("subscribe", inbox).await??;
+        let sent = Envelope::new(AgentToCoordinator::Done {
+            mission: "m1".into(),
+            vehicle: "auv1".into(),
+            iterations: 200,
+            elites_sent: 12,
+            dropped: 0,
+        });
+        let bytes = codec::encode(&sent)?;
+        let key = topics::to_coordinator("m1", "auv1")?;
+        // The subscription may not have reached the client yet: resend until one arrives.
+        let sample = within("first message", async {
+            loop {
+                let put = client.put(key.as_str(), bytes.clone());
+                put.congestion_control(CongestionControl::Block).await?;
+                let wait = tokio::time::timeout(Duration::from_millis(100), inbox.recv_async());
+                if let Ok(Ok(sample)) = wait.await {
+                    return Ok::<_, zenoh::Error>(sample);
+                }
+            }
+        });
+        let sample = sample.await??;
+        let key = sample.key_expr().as_str();
+        assert_eq!(topics::mission_and_vehicle(key), Some(("m1", "auv1")));
+        let received = codec::decode::<AgentToCoordinator>(&sample.payload().to_bytes())?;
+        assert_eq!(received, sent);
+        within("client close", client.close()).await??;
+        within("router close", router.close()).await??;
+        Ok(())
+    }
+
+    /// Kind and vehicle of the next liveliness change.
+    async fn next_change(
+        alive: &Subscriber<FifoChannelHandler<Sample>>,
+        step: &str,
+    ) -> zenoh::Result<(SampleKind, String)> {
+        let change = within(step, alive.recv_async()).await??;
+        let key = change.key_expr().as_str();
+        let vehicle = topics::vehicle_of_liveliness(key).ok_or(format!("not a token: {key}"))?;
+        Ok((change.kind(), vehicle.to_string()))
+    }
+
+    #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+    async fn liveliness_shows_agents_coming_and_going() -> TestResult {
+        let (router, client) = router_and_client().await?;
+        let alive = router.liveliness();
+        let alive = alive
+            .declare_subscriber(topics::ALL_LIVELINESS)
+            .history(true);
+        let alive = within("liveliness subscribe", alive).await??;
+        let (put, delete) = (SampleKind::Put, SampleKind::Delete);
+        let liveliness = client.liveliness();
+        let token = liveliness.declare_token(topics::liveliness("auv1")?);
+        let token = within("token", token).await??;
+        assert_eq!(next_change(&alive, "token").await?, (put, "auv1".into()));
+        drop(token);
+        assert_eq!(next_change(&alive, "drop").await?, (delete, "auv1".into()));
+        // An agent whose session ends (exit, crash) disappears the same way.
+        let token = liveliness.declare_token(topics::liveliness("auv2")?);
+        let _token = within("second token", token).await??;
+        assert_eq!(next_change(&alive, "token 2").await?, (put, "auv2".into()));
+        within("client close", client.close()).await??;
+        assert_eq!(next_change(&alive, "close").await?, (delete, "auv2".into()));
+        within("router close", router.close()).await??;
+        Ok(())
+    }
+}
