@@ -156,47 +156,19 @@ fn bend_for_length(a: Vec3, b: Vec3, m: usize, shape: &[Vec3], target: f64, max_
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::fixtures;
     use crate::scenario::Scenario;
     use rand::SeedableRng;
 
-    pub(crate) fn two_vehicle_scenario() -> Result<Scenario, crate::scenario::ScenarioError> {
-        Scenario::parse(
-            r#"
-name = "two"
-[bounds]
-min = [0.0, 0.0, 0.0]
-max = [1000.0, 1000.0, 500.0]
-[[obstacles]]
-id = "H"
-kind = "hard"
-centre = [500.0, 500.0, 250.0]
-radius_m = 100.0
-inflation_m = 20.0
-[[vehicles]]
-id = "a"
-kind = "auv"
-start = [100.0, 100.0, 250.0]
-goal = [900.0, 900.0, 250.0]
-speed_min_mps = 0.5
-speed_max_mps = 1.5
-max_turn_deg = 35.0
-max_pitch_deg = 20.0
-[[vehicles]]
-id = "b"
-kind = "auv"
-start = [100.0, 900.0, 250.0]
-goal = [900.0, 100.0, 250.0]
-speed_min_mps = 0.5
-speed_max_mps = 1.5
-max_turn_deg = 35.0
-max_pitch_deg = 20.0
-[fleet]
-d_min_m = 50.0
-mission_time_s = 1000.0
-[optimizer]
-waypoints = 6
-"#,
-            std::path::Path::new("two.toml"),
+    fn two_vehicle_scenario() -> Result<Scenario, crate::scenario::ScenarioError> {
+        let hard = "[[obstacles]]\nid = \"H\"\nkind = \"hard\"\ncentre = [500.0, 500.0, 250.0]\nradius_m = 100.0\ninflation_m = 20.0\n";
+        fixtures::scenario(
+            1000.0,
+            hard,
+            &[
+                fixtures::vehicle_toml("a", [100.0, 100.0, 250.0], [900.0, 900.0, 250.0]),
+                fixtures::vehicle_toml("b", [100.0, 900.0, 250.0], [900.0, 100.0, 250.0]),
+            ],
         )
     }
 
@@ -246,14 +218,7 @@ waypoints = 6
         let model = FleetModel::new(&two_vehicle_scenario()?);
         // Both fly their straight diagonals at one speed: they cross the hard sphere and meet
         // in its centre at the same instant.
-        let mut x = Vec::new();
-        for v in &model.scenario.vehicles {
-            for j in 1..=6 {
-                let p = v.start() + (v.goal() - v.start()) * (j as f64 / 7.0);
-                x.extend_from_slice(&[p.x, p.y, p.z]);
-            }
-            x.extend_from_slice(&[1.0; 6]);
-        }
+        let x = fixtures::straight_particle(&model);
         let e = model.evaluate(&x);
         assert!(e.vehicles.iter().all(|t| t.hard_hits > 0));
         assert!(e.separation_penalty > 1.0);

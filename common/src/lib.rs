@@ -2,6 +2,8 @@
 //! fitness of seed 004 and the swarm optimizers.
 
 pub mod cost;
+#[cfg(test)]
+mod fixtures;
 pub mod fleet;
 pub mod geometry;
 pub mod plan;

@@ -132,6 +132,7 @@ impl Problem for VehicleProblem<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::fixtures;
     use crate::scenario::Scenario;
     use crate::swarm::pso::Pso;
     use crate::swarm::{Executor, SolverState};
@@ -139,51 +140,19 @@ mod tests {
     use rand::SeedableRng;
 
     fn scenario() -> Result<Scenario, crate::scenario::ScenarioError> {
-        Scenario::parse(
-            r#"
-name = "pair"
-[bounds]
-min = [0.0, 0.0, 0.0]
-max = [1000.0, 1000.0, 500.0]
-[[vehicles]]
-id = "a"
-kind = "auv"
-start = [100.0, 500.0, 250.0]
-goal = [900.0, 500.0, 250.0]
-speed_min_mps = 0.5
-speed_max_mps = 1.5
-max_turn_deg = 35.0
-max_pitch_deg = 20.0
-[[vehicles]]
-id = "b"
-kind = "auv"
-start = [500.0, 100.0, 250.0]
-goal = [500.0, 900.0, 250.0]
-speed_min_mps = 0.5
-speed_max_mps = 1.5
-max_turn_deg = 35.0
-max_pitch_deg = 20.0
-[fleet]
-d_min_m = 50.0
-mission_time_s = 800.0
-[optimizer]
-waypoints = 6
-"#,
-            std::path::Path::new("pair.toml"),
+        fixtures::scenario(
+            800.0,
+            "",
+            &[
+                fixtures::vehicle_toml("a", [100.0, 500.0, 250.0], [900.0, 500.0, 250.0]),
+                fixtures::vehicle_toml("b", [500.0, 100.0, 250.0], [500.0, 900.0, 250.0]),
+            ],
         )
     }
 
     /// Both vehicles on their straight lines at one speed: they cross (500, 500) at t = 400 s.
     fn straight_particle(model: &FleetModel) -> Vec<f64> {
-        let mut x = Vec::new();
-        for v in &model.scenario.vehicles {
-            for j in 1..=6 {
-                let p = v.start() + (v.goal() - v.start()) * (j as f64 / 7.0);
-                x.extend_from_slice(&[p.x, p.y, p.z]);
-            }
-            x.extend_from_slice(&[1.0; 6]);
-        }
-        x
+        fixtures::straight_particle(model)
     }
 
     #[test]

@@ -1,0 +1,42 @@
+//! Test fixtures shared by the unit tests of several modules: small scenarios written as TOML
+//! (so they go through the real parser) and hand-built particles.
+
+use crate::cost::FleetModel;
+use crate::scenario::{Scenario, ScenarioError};
+
+/// A `[[vehicles]]` block with the limits every fixture uses (0.5–1.5 m/s, 35°, 20°).
+pub fn vehicle_toml(id: &str, start: [f64; 3], goal: [f64; 3]) -> String {
+    format!(
+        "[[vehicles]]\nid = \"{id}\"\nkind = \"auv\"\nstart = {start:?}\ngoal = {goal:?}\n\
+         speed_min_mps = 0.5\nspeed_max_mps = 1.5\nmax_turn_deg = 35.0\nmax_pitch_deg = 20.0\n"
+    )
+}
+
+/// A 1000 × 1000 × 500 m box with 6 waypoints per vehicle, d_min 50 m, the given mission time,
+/// extra TOML (obstacles) and vehicles.
+pub fn scenario(
+    mission_time_s: f64,
+    extra: &str,
+    vehicles: &[String],
+) -> Result<Scenario, ScenarioError> {
+    let text = format!(
+        "name = \"fixture\"\n[bounds]\nmin = [0.0, 0.0, 0.0]\nmax = [1000.0, 1000.0, 500.0]\n{extra}\n{}\
+         [fleet]\nd_min_m = 50.0\nmission_time_s = {mission_time_s:?}\n[optimizer]\nwaypoints = 6\n",
+        vehicles.concat()
+    );
+    Scenario::parse(&text, std::path::Path::new("fixture.toml"))
+}
+
+/// Every vehicle on its straight line (waypoints evenly spaced) at a requested 1 m/s.
+pub fn straight_particle(model: &FleetModel) -> Vec<f64> {
+    let m = model.layout.waypoints;
+    let mut x = Vec::new();
+    for v in &model.scenario.vehicles {
+        for j in 1..=m {
+            let p = v.start() + (v.goal() - v.start()) * (j as f64 / (m + 1) as f64);
+            x.extend_from_slice(&[p.x, p.y, p.z]);
+        }
+        x.extend(std::iter::repeat_n(1.0, m));
+    }
+    x
+}
