@@ -235,7 +235,7 @@ pub fn assess(scenario: &Scenario, trajectories: &[Trajectory]) -> Assessment {
 
 /// Plain-words notes that are not violations: why the common arrival differs from the mission
 /// time, and capabilities a vehicle would need that are not built yet.
-pub fn timing_notices(
+pub fn notices(
     scenario: &Scenario,
     trajectories: &[Trajectory],
     common_arrival: f64,
@@ -454,7 +454,7 @@ mission_time_s = 1000.0
             line(s.vehicles[1].start, s.vehicles[1].goal, 500.0),
         ];
         // Both fly 1000 m flat at 2 m/s at best: no path makes 300 s.
-        let n = timing_notices(&s, &t, 500.0);
+        let n = notices(&s, &t, 500.0);
         assert_eq!(n.len(), 2);
         assert!(
             n[0].contains("a cannot arrive by the mission time of 300 s whatever its path"),
@@ -477,13 +477,13 @@ mission_time_s = 1000.0
                 Vec3::new(1000.0, 0.0, 0.0),
             ],
         };
-        let n = timing_notices(&s, &[detour, t[1].clone()], 750.0);
+        let n = notices(&s, &[detour, t[1].clone()], 750.0);
         assert_eq!(n.len(), 1, "{n:?}");
         assert!(n[0].starts_with("a's planned path of 1500 m"), "{}", n[0]);
         assert!(n[0].contains("would take 500 s"), "{}", n[0]);
         // A crawler is planned as a swimmer, and the plan says so.
         s.vehicles[1].kind = crate::scenario::VehicleKind::Crawler;
-        let n = timing_notices(&s, &t, 500.0);
+        let n = notices(&s, &t, 500.0);
         assert!(n[0].contains("b is a crawler"), "{}", n[0]);
         Ok(())
     }

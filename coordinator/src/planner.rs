@@ -4,7 +4,7 @@ use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
 
 use shoal_common::cost::FleetModel;
-use shoal_common::plan::{assess, timing_notices, Plan};
+use shoal_common::plan::{assess, notices, Plan};
 use shoal_common::scenario::{Algorithm, Scenario};
 use shoal_common::swarm::multi::MultiPso;
 use shoal_common::swarm::population::Schedule;
@@ -74,7 +74,7 @@ pub fn plan_in_process(
     };
     let eval = model.evaluate(&run.best_x);
     let assessment = assess(scenario, &eval.trajectories);
-    let mut notices = timing_notices(scenario, &eval.trajectories, eval.common_arrival);
+    let mut notices = notices(scenario, &eval.trajectories, eval.common_arrival);
     if run.termination == Termination::Interrupted {
         notices.push(format!(
             "planning was interrupted after {} of {} iterations: this is the best plan found so far",

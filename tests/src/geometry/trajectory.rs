@@ -91,17 +91,11 @@ pub struct Approach {
 /// `d(s) = d0 + (d1 − d0) s`, `s ∈ [0, 1]`, is linear too and its smallest norm is at the
 /// clamped projection of the origin onto that segment.
 pub fn min_separation(a: &[[f64; 4]], b: &[[f64; 4]]) -> Approach {
-    let ts = breakpoints(a, b);
     let mut best = Approach {
         distance: dist(&position_at(a, 0.0), &position_at(b, 0.0)),
         time: 0.0,
     };
-    for w in ts.windows(2) {
-        let (t0, t1) = (w[0], w[1]);
-        let (a0, a1) = piece(a, t0, t1);
-        let (b0, b1) = piece(b, t0, t1);
-        let d0 = sub(&b0, &a0);
-        let d1 = sub(&b1, &a1);
+    for (t0, t1, d0, d1) in relative_pieces(a, b) {
         let s = closest_param(&d0, &d1, &[0.0; 3]);
         let d = norm(&lerp(&d0, &d1, s));
         if d < best.distance {
@@ -114,16 +108,25 @@ pub fn min_separation(a: &[[f64; 4]], b: &[[f64; 4]]) -> Approach {
     best
 }
 
-/// Total time in `[0, max arrival]` during which `a` and `b` are strictly closer than `limit`.
-pub fn breach_time(a: &[[f64; 4]], b: &[[f64; 4]], limit: f64) -> f64 {
+/// Between consecutive breakpoints of `a` and `b`, the relative position `b − a` moves linearly:
+/// `(t0, t1, d(t0), d(t1))` for each such piece.
+fn relative_pieces<'a>(
+    a: &'a [[f64; 4]],
+    b: &'a [[f64; 4]],
+) -> impl Iterator<Item = (f64, f64, P3, P3)> + 'a {
     let ts = breakpoints(a, b);
-    let mut total = 0.0;
-    for w in ts.windows(2) {
-        let (t0, t1) = (w[0], w[1]);
+    (1..ts.len()).map(move |k| {
+        let (t0, t1) = (ts[k - 1], ts[k]);
         let (a0, a1) = piece(a, t0, t1);
         let (b0, b1) = piece(b, t0, t1);
-        let d0 = sub(&b0, &a0);
-        let d1 = sub(&b1, &a1);
+        (t0, t1, sub(&b0, &a0), sub(&b1, &a1))
+    })
+}
+
+/// Total time in `[0, max arrival]` during which `a` and `b` are strictly closer than `limit`.
+pub fn breach_time(a: &[[f64; 4]], b: &[[f64; 4]], limit: f64) -> f64 {
+    let mut total = 0.0;
+    for (t0, t1, d0, d1) in relative_pieces(a, b) {
         let (s0, s1) = param_interval_within(&d0, &d1, &[0.0; 3], limit);
         total += (s1 - s0).max(0.0) * (t1 - t0);
     }
