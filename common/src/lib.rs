@@ -2,6 +2,7 @@
 //! fitness of seed 004 and the swarm optimizers.
 
 pub mod cost;
+pub mod distributed;
 #[cfg(test)]
 mod fixtures;
 pub mod fleet;

@@ -56,7 +56,7 @@ impl MultiPso {
 }
 
 /// Seed of population `k`: distinct streams from one user seed.
-fn stream_seed(seed: u64, k: u64) -> u64 {
+pub fn stream_seed(seed: u64, k: u64) -> u64 {
     seed ^ (k + 1).wrapping_mul(0x9E37_79B9_7F4A_7C15)
 }
 

@@ -10,6 +10,9 @@ use serde::{Deserialize, Serialize};
 
 use crate::geometry::Vec3;
 
+mod optimizer;
+pub use optimizer::{Algorithm, DistributedSettings, OptimizerSettings};
+
 /// One knot in metres per second (1852 m / 3600 s), for scenario comments and tests.
 pub const KNOT_MPS: f64 = 1852.0 / 3600.0;
 
@@ -157,104 +160,6 @@ pub struct Fleet {
     pub d_min_m: f64,
     /// Time at which every vehicle should reach its goal, seconds after the start (t_e).
     pub mission_time_s: f64,
-}
-
-/// The optimizers `plan` can run.
-#[derive(Debug, Clone, Copy, Serialize, Deserialize, PartialEq, Eq, Default)]
-#[serde(rename_all = "kebab-case")]
-pub enum Algorithm {
-    /// Adaptive multi-population PSO (seed 004).
-    #[default]
-    AmpPso,
-    /// Classic single-population PSO with fixed coefficients (Table 5).
-    Pso,
-    /// Multi-population PSO with fixed coefficients, c3 = 1.5 (Table 5).
-    MpPso,
-    /// Single-population PSO with the adaptive coefficients of eq. (7) (Table 5).
-    APso,
-}
-
-impl Algorithm {
-    /// Name as written in files and on the command line.
-    pub fn as_str(self) -> &'static str {
-        match self {
-            Algorithm::AmpPso => "amp-pso",
-            Algorithm::Pso => "pso",
-            Algorithm::MpPso => "mp-pso",
-            Algorithm::APso => "a-pso",
-        }
-    }
-    /// Every algorithm, in the order of seed 004 Table 5.
-    pub const ALL: [Algorithm; 4] = [
-        Algorithm::AmpPso,
-        Algorithm::APso,
-        Algorithm::MpPso,
-        Algorithm::Pso,
-    ];
-}
-
-impl std::str::FromStr for Algorithm {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, Self::Err> {
-        Algorithm::ALL
-            .into_iter()
-            .find(|a| a.as_str() == s)
-            .ok_or_else(|| {
-                format!("unknown algorithm `{s}` (expected amp-pso, pso, mp-pso or a-pso)")
-            })
-    }
-}
-
-/// Optimizer budget and objective weights. Defaults are seed 004 Table 5 and §4.1.4.
-#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
-#[serde(deny_unknown_fields, default)]
-pub struct OptimizerSettings {
-    /// Which optimizer.
-    pub algorithm: Algorithm,
-    /// Follower populations for the multi-population algorithms (Table 5: 20).
-    pub populations: usize,
-    /// Particles per population (Table 5: 50).
-    pub particles: usize,
-    /// Original particles of the leader population, besides the immigrants (§3.2.2 leaves the
-    /// number open; 20 keeps the leader as large as the set of immigrants).
-    pub leader_particles: usize,
-    /// Iterations (Table 5: 200).
-    pub iterations: usize,
-    /// Inner waypoints per vehicle, M (Table 4: 30).
-    pub waypoints: usize,
-    /// Leader/follower exchange period in iterations (§3.2.2 exchanges every iteration).
-    pub exchange_every: usize,
-    /// RNG seed; the same seed gives the same plan.
-    pub seed: u64,
-    /// λ1..λ5 of eq. (12): length, depth, soft threat, time, space (§4.1.4).
-    pub weights: [f64; 5],
-    /// Weight of the constraint penalties (hard obstacles, turn, pitch, separation) that turn the
-    /// constrained problem into an unconstrained one (§3.3.1, ref. [30]).
-    pub penalty_weight: f64,
-    /// Velocity limit per dimension as a fraction of that dimension's range. Eq. (7) starts ω at 2,
-    /// which diverges without a limit; 0.1 is the common PSO choice.
-    pub max_velocity_fraction: f64,
-    /// Worker threads for population steps (results do not depend on it).
-    pub threads: usize,
-}
-
-impl Default for OptimizerSettings {
-    fn default() -> Self {
-        OptimizerSettings {
-            algorithm: Algorithm::AmpPso,
-            populations: 20,
-            particles: 50,
-            leader_particles: 20,
-            iterations: 200,
-            waypoints: 30,
-            exchange_every: 1,
-            seed: 1,
-            weights: [0.2, 0.1, 0.3, 0.1, 0.3],
-            penalty_weight: 10.0,
-            max_velocity_fraction: 0.1,
-            threads: 2,
-        }
-    }
 }
 
 impl Scenario {
@@ -408,41 +313,7 @@ impl Scenario {
                 "must be a positive number of seconds",
             ));
         }
-        let o = &self.optimizer;
-        let positive = [
-            ("optimizer.populations", o.populations),
-            ("optimizer.particles", o.particles),
-            ("optimizer.iterations", o.iterations),
-            ("optimizer.waypoints", o.waypoints),
-            ("optimizer.exchange_every", o.exchange_every),
-            ("optimizer.threads", o.threads),
-        ];
-        for (field, value) in positive {
-            if value == 0 {
-                return Err(bad(field.into(), "0".into(), "must be at least 1"));
-            }
-        }
-        if let Some(k) = o.weights.iter().position(|w| !(w.is_finite() && *w >= 0.0)) {
-            return Err(bad(
-                format!("optimizer.weights[{k}]"),
-                o.weights[k].to_string(),
-                "must be a finite weight >= 0",
-            ));
-        }
-        if !(o.penalty_weight.is_finite() && o.penalty_weight > 0.0) {
-            return Err(bad(
-                "optimizer.penalty_weight".into(),
-                o.penalty_weight.to_string(),
-                "must be positive",
-            ));
-        }
-        if !(o.max_velocity_fraction > 0.0 && o.max_velocity_fraction <= 1.0) {
-            return Err(bad(
-                "optimizer.max_velocity_fraction".into(),
-                o.max_velocity_fraction.to_string(),
-                "must be in (0, 1]",
-            ));
-        }
+        self.optimizer.validate(&bad)?;
         Ok(())
     }
 
