@@ -334,6 +334,51 @@ pub struct Plan {
     pub fleet: FleetFigures,
     /// Best fitness after each iteration.
     pub convergence: Vec<f64>,
+    /// Distributed runs only: how the mission went over the network.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub distributed: Option<DistributedFigures>,
+}
+
+/// What a distributed run adds to `plan.json`.
+#[derive(Debug, Clone, Default, Serialize, Deserialize, PartialEq)]
+pub struct DistributedFigures {
+    /// Mission id (the key prefix `shoal/<mission>/…`).
+    pub mission: String,
+    /// Leader/follower exchanges done.
+    pub exchanges: u32,
+    /// Messages the coordinator dropped (malformed, wrong version, unknown mission or vehicle,
+    /// out of turn).
+    pub messages_dropped: u64,
+    /// Per agent, in scenario order.
+    pub agents: Vec<AgentFigures>,
+    /// Vehicles whose followers the coordinator ran itself, and why.
+    pub degraded: Vec<DegradedVehicle>,
+}
+
+/// One agent's share of a distributed run.
+#[derive(Debug, Clone, Default, Serialize, Deserialize, PartialEq)]
+pub struct AgentFigures {
+    /// Vehicle id.
+    pub vehicle: String,
+    /// Iterations its followers ran (in the agent, then in the coordinator if degraded).
+    pub iterations: u32,
+    /// Elite messages the coordinator received from it.
+    pub elites_sent: u32,
+    /// Messages the agent dropped (its own count, when it reported one).
+    pub messages_dropped: Option<u32>,
+    /// True when the coordinator took its followers over.
+    pub degraded: bool,
+}
+
+/// A vehicle planned in degraded mode.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+pub struct DegradedVehicle {
+    /// Vehicle id.
+    pub vehicle: String,
+    /// Exchange round from which the coordinator ran its followers.
+    pub from_round: u32,
+    /// Why, in plain words.
+    pub reason: String,
 }
 
 #[cfg(test)]

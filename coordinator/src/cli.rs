@@ -6,6 +6,8 @@ use std::path::PathBuf;
 use clap::{Parser, Subcommand};
 use shoal_common::scenario::Algorithm;
 
+use crate::distributed::AgentsMode;
+
 /// Shoal fleet coordinator: plans collision-free, time-coordinated paths for a fleet of
 /// underwater vehicles.
 #[derive(Debug, Parser)]
@@ -58,4 +60,30 @@ pub struct PlanArgs {
     /// No progress output on stderr.
     #[arg(long, short, env = "SHOAL_QUIET")]
     pub quiet: bool,
+    /// Distributed mode: start one agent per vehicle here (embedded) or wait for agents started
+    /// elsewhere to connect (external).
+    #[arg(long, env = "SHOAL_AGENTS", value_enum, default_value_t = AgentsMode::Embedded)]
+    pub agents: AgentsMode,
+    /// Distributed mode: endpoint(s) the embedded Zenoh router listens on (comma-separated).
+    /// Default: tcp/127.0.0.1:0 (a free port) with embedded agents, tcp/0.0.0.0:7447 with
+    /// external ones.
+    #[arg(long, env = "SHOAL_LISTEN", value_delimiter = ',')]
+    pub listen: Vec<String>,
+    /// Distributed mode: other Zenoh routers to link to, e.g. another coordinator's endpoint, so
+    /// two missions share one network and its agents (comma-separated).
+    #[arg(long, env = "SHOAL_ROUTERS", value_delimiter = ',')]
+    pub router: Vec<String>,
+    /// Distributed mode: seconds the agents have to join.
+    #[arg(long, env = "SHOAL_JOIN_TIMEOUT", default_value_t = 30.0)]
+    pub join_timeout: f64,
+    /// Distributed mode: seconds a round waits for an agent's elites before the coordinator
+    /// plans that vehicle itself (degraded mode).
+    #[arg(long, env = "SHOAL_ROUND_TIMEOUT", default_value_t = 10.0)]
+    pub round_timeout: f64,
+    /// Distributed mode: mission id (default: scenario name, process id and time).
+    #[arg(long, env = "SHOAL_MISSION")]
+    pub mission: Option<String>,
+    /// Distributed mode: the shoal-agent binary for embedded agents (default: next to this one).
+    #[arg(long, env = "SHOAL_AGENT_BIN")]
+    pub agent_bin: Option<PathBuf>,
 }

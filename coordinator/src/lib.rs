@@ -3,6 +3,7 @@
 
 pub mod cli;
 pub mod compare;
+pub mod distributed;
 pub mod planner;
 pub mod summary;
 pub mod svg;
@@ -106,26 +107,65 @@ pub fn load_scenario(args: &PlanArgs) -> anyhow::Result<Scenario> {
     Ok(s)
 }
 
-fn plan_command(args: &PlanArgs, shutdown: Arc<AtomicBool>) -> anyhow::Result<i32> {
-    if !args.in_process {
-        bail!(
-            "distributed planning (coordinator + one shoal-agent per vehicle over Zenoh) is not built yet; \
-             run `shoal-coordinator plan {} --in-process --out {}`",
-            args.scenario.display(),
-            args.out.display()
-        );
+/// A duration from a number of seconds given by the user, or an error naming the flag.
+fn seconds(flag: &str, value: f64) -> anyhow::Result<std::time::Duration> {
+    match std::time::Duration::try_from_secs_f64(value) {
+        Ok(d) if value > 0.0 => Ok(d),
+        _ => bail!("{flag} = {value}: must be a positive number of seconds"),
     }
+}
+
+/// The distributed-mode settings the command line gives.
+pub fn distributed_options(
+    args: &PlanArgs,
+    scenario: &Scenario,
+) -> anyhow::Result<distributed::DistributedOptions> {
+    let listen = if args.listen.is_empty() {
+        vec![match args.agents {
+            distributed::AgentsMode::Embedded => "tcp/127.0.0.1:0".to_string(),
+            distributed::AgentsMode::External => "tcp/0.0.0.0:7447".to_string(),
+        }]
+    } else {
+        args.listen.clone()
+    };
+    Ok(distributed::DistributedOptions {
+        mission: args
+            .mission
+            .clone()
+            .unwrap_or_else(|| distributed::default_mission_id(scenario)),
+        agents: args.agents,
+        listen,
+        routers: args.router.clone(),
+        join_timeout: seconds("--join-timeout (SHOAL_JOIN_TIMEOUT)", args.join_timeout)?,
+        round_timeout: seconds("--round-timeout (SHOAL_ROUND_TIMEOUT)", args.round_timeout)?,
+        agent_bin: args.agent_bin.clone(),
+        log_dir: args.out.join("logs"),
+    })
+}
+
+fn plan_command(args: &PlanArgs, shutdown: Arc<AtomicBool>) -> anyhow::Result<i32> {
     let scenario = load_scenario(args)?;
+    let options = if args.in_process {
+        None
+    } else {
+        Some(distributed_options(args, &scenario)?)
+    };
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("cannot create output directory {}", args.out.display()))?;
     tracing::info!(
         scenario = %scenario.name,
         algorithm = scenario.optimizer.algorithm.as_str(),
         seed = scenario.optimizer.seed,
-        "planning in-process"
+        distributed = options.is_some(),
+        "planning"
     );
     let mut progress = Progress::new(scenario.optimizer.iterations, args.quiet);
-    let plan = planner::plan_in_process(&scenario, Some(shutdown), &mut |r| progress.update(r));
+    let plan = match &options {
+        None => planner::plan_in_process(&scenario, Some(shutdown), &mut |r| progress.update(r)),
+        Some(o) => distributed::plan_distributed(&scenario, o, &shutdown, &mut |s| {
+            progress.update_distributed(s)
+        })?,
+    };
     progress.finish();
     write_outputs(&args.out, &plan)?;
     write_svg(&args.out, &scenario, &plan)?;
@@ -201,15 +241,27 @@ impl Progress {
             "best fitness {:.4}, {} evaluations",
             r.best_cost, r.evaluations
         );
+        self.show(r.iteration, r.max_iterations, msg);
+    }
+
+    fn update_distributed(&mut self, s: &distributed::mission::Status) {
+        let msg = format!(
+            "best fitness {:.4}, agents alive {}/{}",
+            s.best_cost, s.alive, s.vehicles
+        );
+        self.show(s.iteration, s.max_iterations, msg);
+    }
+
+    fn show(&mut self, iteration: usize, max_iterations: usize, msg: String) {
         if let Some(b) = &self.bar {
-            b.set_position(r.iteration as u64);
+            b.set_position(iteration as u64);
             b.set_message(msg);
         } else if !self.quiet {
             let due = self.last.is_none_or(|t| t.elapsed() >= PROGRESS_EVERY)
-                || r.iteration.is_multiple_of(self.every)
-                || r.iteration == r.max_iterations;
+                || iteration.is_multiple_of(self.every)
+                || iteration == max_iterations;
             if due {
-                eprintln!("iteration {}/{}: {msg}", r.iteration, r.max_iterations);
+                eprintln!("iteration {iteration}/{max_iterations}: {msg}");
                 self.last = Some(std::time::Instant::now());
             }
         }

@@ -11,13 +11,18 @@ use shoal_common::swarm::population::Schedule;
 use shoal_common::swarm::pso::Pso;
 use shoal_common::swarm::{Executor, IterationReport, Solver, SolverState, Termination};
 
-/// What an optimizer run leaves behind, whatever the algorithm.
-struct RunResult {
-    best_x: Vec<f64>,
-    convergence: Vec<f64>,
-    evaluations: u64,
-    termination: Termination,
-    runtime_s: f64,
+/// What an optimizer run leaves behind, whatever the algorithm and the mode.
+pub struct RunResult {
+    /// Best fleet position (a true evaluation).
+    pub best_x: Vec<f64>,
+    /// Best fitness after each iteration.
+    pub convergence: Vec<f64>,
+    /// Cost evaluations.
+    pub evaluations: u64,
+    /// Why it stopped.
+    pub termination: Termination,
+    /// Wall time, seconds.
+    pub runtime_s: f64,
 }
 
 fn run_solver<S: Solver<FleetModel>>(
@@ -72,6 +77,12 @@ pub fn plan_in_process(
         Algorithm::APso => run_solver(&model, single(Schedule::Adaptive), &executor, observe),
         Algorithm::Pso => run_solver(&model, single(Schedule::TABLE5_FIXED), &executor, observe),
     };
+    to_plan(scenario, &model, run, "in-process")
+}
+
+/// The validated plan of a run: the fleet figures are recomputed from the trajectories.
+pub fn to_plan(scenario: &Scenario, model: &FleetModel, run: RunResult, mode: &str) -> Plan {
+    let o = &scenario.optimizer;
     let eval = model.evaluate(&run.best_x);
     let assessment = assess(scenario, &eval.trajectories);
     let mut notices = notices(scenario, &eval.trajectories, eval.common_arrival);
@@ -85,7 +96,7 @@ pub fn plan_in_process(
     Plan {
         scenario: scenario.name.clone(),
         algorithm: o.algorithm.as_str().to_string(),
-        mode: "in-process".to_string(),
+        mode: mode.to_string(),
         seed: o.seed,
         runtime_s: run.runtime_s,
         fitness: eval.total,
@@ -103,5 +114,6 @@ pub fn plan_in_process(
         vehicles: assessment.vehicles,
         fleet: assessment.fleet,
         convergence: run.convergence,
+        distributed: None,
     }
 }

@@ -497,6 +497,7 @@ goal = [1000.0, 0.0, 50.0]
             vehicles: a.vehicles,
             fleet: a.fleet,
             convergence,
+            distributed: None,
         }
     }
 

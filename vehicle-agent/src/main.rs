@@ -1,20 +1,36 @@
-//! `shoal-agent`: one process per vehicle. Distributed planning (follower populations over
-//! Zenoh) arrives with issue 3; until then the binary only reports its version and says so.
+//! `shoal-agent`: parses the command line, sets up logging, and calls the library's `run`.
+
+use std::process::ExitCode;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
 
 use clap::Parser;
+use shoal_agent::AgentArgs;
 
-/// Shoal vehicle agent (distributed planning is not built yet: plan with
-/// `shoal-coordinator plan SCENARIO --in-process`).
-#[derive(Debug, Parser)]
-#[command(name = "shoal-agent", version, about)]
-struct Cli {}
-
-fn main() {
-    let _ = Cli::parse();
-    println!(
-        "shoal-agent {} (shoal-common {}): distributed planning is not available yet; \
-         use `shoal-coordinator plan <SCENARIO> --in-process`",
-        env!("CARGO_PKG_VERSION"),
-        shoal_common::VERSION
-    );
+fn main() -> ExitCode {
+    let args = AgentArgs::parse();
+    tracing_subscriber::fmt()
+        .with_env_filter(
+            tracing_subscriber::EnvFilter::try_from_default_env()
+                .unwrap_or_else(|_| tracing_subscriber::EnvFilter::new("info")),
+        )
+        .with_writer(std::io::stderr)
+        .init();
+    let shutdown = Arc::new(AtomicBool::new(false));
+    // First Ctrl-C / SIGTERM: leave after telling the coordinator; second: at once.
+    let flag = Arc::clone(&shutdown);
+    if let Err(e) = ctrlc::set_handler(move || {
+        if flag.swap(true, Ordering::SeqCst) {
+            std::process::exit(130);
+        }
+    }) {
+        tracing::warn!("cannot install the Ctrl-C handler: {e}");
+    }
+    match shoal_agent::run(args, shutdown) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::FAILURE
+        }
+    }
 }

@@ -2,21 +2,24 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::WireParticle;
+use super::WireChromosome;
 
-/// Agent → coordinator.
+/// Agent → coordinator. Variants are only ever added at the end: their index is on the wire.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub enum AgentToCoordinator {
-    /// The best particles of the agent's followers (seed 004 Fig. 5a), for the leader.
+    /// The best chromosome of each of the agent's follower populations after exchange round
+    /// `round`'s iterations (seed 004 Fig. 5a), for the leader.
     Elites {
         /// Mission id.
         mission: String,
         /// The vehicle they belong to.
         vehicle: String,
-        /// Agent iteration.
+        /// Exchange round.
+        round: u32,
+        /// Iterations the agent has run.
         iteration: u32,
-        /// The particles, this vehicle's chromosome each.
-        particles: Vec<WireParticle>,
+        /// The chromosomes, one per follower population.
+        particles: Vec<WireChromosome>,
     },
     /// The agent finished its share of the mission.
     Done {
@@ -28,8 +31,17 @@ pub enum AgentToCoordinator {
         iterations: u32,
         /// Elite messages it sent.
         elites_sent: u32,
+        /// Cost evaluations its followers made.
+        evaluations: u64,
         /// Messages it dropped (malformed, wrong version, unknown mission or vehicle).
         dropped: u32,
+    },
+    /// The agent took the assignment and is planning.
+    Joined {
+        /// Mission id.
+        mission: String,
+        /// The vehicle.
+        vehicle: String,
     },
 }
 
@@ -38,7 +50,8 @@ impl AgentToCoordinator {
     pub fn mission(&self) -> &str {
         match self {
             AgentToCoordinator::Elites { mission, .. }
-            | AgentToCoordinator::Done { mission, .. } => mission,
+            | AgentToCoordinator::Done { mission, .. }
+            | AgentToCoordinator::Joined { mission, .. } => mission,
         }
     }
 
@@ -46,7 +59,8 @@ impl AgentToCoordinator {
     pub fn vehicle(&self) -> &str {
         match self {
             AgentToCoordinator::Elites { vehicle, .. }
-            | AgentToCoordinator::Done { vehicle, .. } => vehicle,
+            | AgentToCoordinator::Done { vehicle, .. }
+            | AgentToCoordinator::Joined { vehicle, .. } => vehicle,
         }
     }
 }

@@ -76,7 +76,7 @@ mod tests {
     use super::*;
     use crate::wire::agent_to_coordinator::AgentToCoordinator;
     use crate::wire::coordinator_to_agent::CoordinatorToAgent;
-    use crate::wire::{WireParticle, WireTrajectory};
+    use crate::wire::{WireChromosome, WireContext, WireTrajectory};
     use proptest::prelude::*;
 
     #[test]
@@ -108,6 +108,7 @@ mod tests {
             vehicle: "auv1".into(),
             iterations: 200,
             elites_sent: 200,
+            evaluations: 100_000,
             dropped: 0,
         });
         let mut bytes = encode(&m)?;
@@ -144,28 +145,21 @@ mod tests {
         let big = Envelope::new(AgentToCoordinator::Elites {
             mission: "m".into(),
             vehicle: "auv1".into(),
+            round: 0,
             iteration: 0,
-            particles: vec![WireParticle {
+            particles: vec![WireChromosome {
                 x: vec![0.0; 600_000],
                 v: vec![],
-                cost: 0.0,
-                best_x: vec![],
-                best_cost: 0.0,
             }],
         });
         assert!(encode(&big).is_err());
         Ok(())
     }
 
-    fn particle() -> impl Strategy<Value = WireParticle> {
-        (proptest::collection::vec(-1e4f64..1e4, 0..40), -1e3f64..1e3).prop_map(|(x, c)| {
-            WireParticle {
-                v: x.iter().map(|a| a * 0.5).collect(),
-                best_x: x.iter().rev().copied().collect(),
-                x,
-                cost: c,
-                best_cost: c - 1.0,
-            }
+    fn particle() -> impl Strategy<Value = WireChromosome> {
+        proptest::collection::vec(-1e4f64..1e4, 0..40).prop_map(|x| WireChromosome {
+            v: x.iter().map(|a| a * 0.5).collect(),
+            x,
         })
     }
 
@@ -178,12 +172,12 @@ mod tests {
             it in 0u32..10_000,
         ) {
             let up = Envelope::new(AgentToCoordinator::Elites {
-                mission: mission.clone(), vehicle: "auv1".into(), iteration: it, particles: particles.clone(),
+                mission: mission.clone(), vehicle: "auv1".into(), round: it, iteration: it, particles: particles.clone(),
             });
             prop_assert_eq!(decode::<AgentToCoordinator>(&encode(&up).map_err(|e| TestCaseError::fail(e.to_string()))?), Ok(up));
             let down = Envelope::new(CoordinatorToAgent::Context {
-                mission, iteration: it, arrival_s: 2700.0,
-                trajectories: vec![WireTrajectory { vehicle: "auv2".into(), samples }],
+                mission, context: WireContext { round: it, arrival_s: 2700.0,
+                trajectories: vec![WireTrajectory { vehicle: "auv2".into(), samples }] },
             });
             prop_assert_eq!(decode::<CoordinatorToAgent>(&encode(&down).map_err(|e| TestCaseError::fail(e.to_string()))?), Ok(down));
         }

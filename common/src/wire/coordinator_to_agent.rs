@@ -2,43 +2,43 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::{WireParticle, WireTrajectory};
+use super::{WireChromosome, WireContext};
 
-/// Coordinator → agent.
+/// Coordinator → agent. Variants are only ever added at the end: their index is on the wire.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub enum CoordinatorToAgent {
-    /// Start planning `vehicle` in `mission`.
+    /// Plan `vehicle` in `mission`; repeated until the agent answers `Joined`.
     Assign {
         /// Mission id (keeps two missions on one network apart).
         mission: String,
         /// The vehicle this agent plans.
         vehicle: String,
-        /// The scenario, as the TOML text the coordinator loaded.
+        /// The scenario with every override applied, as TOML.
         scenario_toml: String,
-        /// Seed of this agent's random streams.
-        seed: u64,
+        /// The first context (the leader's initial best plan).
+        context: WireContext,
     },
-    /// The fleet's current best plan: the context the agent scores its particles against.
+    /// The fleet's current best plan, broadcast on the mission's fleet key: the context the
+    /// agents score their particles against.
     Context {
         /// Mission id.
         mission: String,
-        /// Coordinator iteration it comes from.
-        iteration: u32,
-        /// The common arrival time the plan is timed for, seconds.
-        arrival_s: f64,
-        /// Every vehicle's trajectory.
-        trajectories: Vec<WireTrajectory>,
+        /// The plan.
+        context: WireContext,
     },
-    /// Updated immigrants returning to the agent's followers (seed 004 Fig. 5c).
+    /// Updated immigrants returning to the agent's followers (seed 004 Fig. 5c), one per
+    /// follower population, after exchange `round`.
     Migrants {
         /// Mission id.
         mission: String,
         /// The vehicle they belong to.
         vehicle: String,
-        /// Coordinator iteration.
-        iteration: u32,
-        /// The particles, one vehicle's chromosome each.
-        particles: Vec<WireParticle>,
+        /// Exchange round they answer.
+        round: u32,
+        /// Round of the context the agent must be using before it takes them in.
+        context_round: u32,
+        /// The chromosomes.
+        particles: Vec<WireChromosome>,
     },
     /// The mission is over (or abandoned): stop planning it.
     Stop {

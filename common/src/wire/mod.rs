@@ -17,7 +17,7 @@ pub mod topics;
 
 use serde::{Deserialize, Serialize};
 
-use crate::swarm::population::Particle;
+use crate::distributed::{Chromosome, Context};
 use crate::trajectory::Trajectory;
 
 /// Protocol version every message carries; a peer speaking another version is ignored.
@@ -43,46 +43,92 @@ impl<T> Envelope<T> {
     }
 }
 
-/// One vehicle's particle on the wire: a chromosome, its velocity and its memory.
+/// One vehicle's chromosome on the wire: its genes and its velocity (seed 004 Fig. 5: what an
+/// emigrant carries up to the leader and a migrant carries back).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct WireParticle {
+pub struct WireChromosome {
     /// Position (the chromosome's genes).
     pub x: Vec<f64>,
     /// Velocity.
     pub v: Vec<f64>,
-    /// Cost of `x` where it was evaluated.
-    pub cost: f64,
-    /// Personal best position.
-    pub best_x: Vec<f64>,
-    /// Cost of `best_x`.
-    pub best_cost: f64,
 }
 
-impl From<&Particle> for WireParticle {
-    fn from(p: &Particle) -> Self {
-        WireParticle {
-            x: p.x.clone(),
-            v: p.v.clone(),
-            cost: p.cost,
-            best_x: p.best_x.clone(),
-            best_cost: p.best_cost,
+impl From<&Chromosome> for WireChromosome {
+    fn from(c: &Chromosome) -> Self {
+        WireChromosome {
+            x: c.x.clone(),
+            v: c.v.clone(),
         }
     }
 }
 
-impl WireParticle {
-    /// A one-block particle (the receiver re-evaluates it in its own context before trusting
-    /// the costs).
-    pub fn into_particle(self) -> Particle {
-        Particle {
-            parts: vec![self.cost],
-            best_parts: vec![self.best_cost],
-            x: self.x,
-            v: self.v,
-            cost: self.cost,
-            best_x: self.best_x,
-            best_cost: self.best_cost,
+impl From<WireChromosome> for Chromosome {
+    fn from(c: WireChromosome) -> Self {
+        Chromosome { x: c.x, v: c.v }
+    }
+}
+
+/// The fleet plan the followers score against ([`Context`]) on the wire.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct WireContext {
+    /// Exchange round it comes from.
+    pub round: u32,
+    /// Common arrival time, seconds.
+    pub arrival_s: f64,
+    /// Every vehicle's trajectory, in scenario order.
+    pub trajectories: Vec<WireTrajectory>,
+}
+
+impl WireContext {
+    /// `c` on the wire; `ids` names the vehicles in scenario order.
+    pub fn new(c: &Context, ids: &[&str]) -> WireContext {
+        WireContext {
+            round: c.round,
+            arrival_s: c.arrival,
+            trajectories: c
+                .trajectories
+                .iter()
+                .zip(ids)
+                .map(|(t, id)| WireTrajectory::new(id, t))
+                .collect(),
         }
+    }
+
+    /// Back to a context for a fleet of `ids` (scenario order), or why it does not fit.
+    pub fn to_context(&self, ids: &[&str]) -> Result<Context, String> {
+        if self.trajectories.len() != ids.len() {
+            return Err(format!(
+                "context has {} trajectories for a fleet of {}",
+                self.trajectories.len(),
+                ids.len()
+            ));
+        }
+        let mut trajectories = Vec::with_capacity(ids.len());
+        for (t, id) in self.trajectories.iter().zip(ids) {
+            if t.vehicle != *id {
+                return Err(format!(
+                    "context names {:?} where {id:?} was expected",
+                    t.vehicle
+                ));
+            }
+            let ok = !t.samples.is_empty()
+                && t.samples.iter().flatten().all(|v| v.is_finite())
+                && t.samples.windows(2).all(|w| w[1][0] >= w[0][0]);
+            if !ok {
+                return Err(format!(
+                    "trajectory of {id} is empty, not finite or not timed in order"
+                ));
+            }
+            trajectories.push(t.to_trajectory());
+        }
+        if !self.arrival_s.is_finite() {
+            return Err(format!("arrival time {} is not finite", self.arrival_s));
+        }
+        Ok(Context {
+            round: self.round,
+            arrival: self.arrival_s,
+            trajectories,
+        })
     }
 }
 

@@ -55,10 +55,18 @@ pub enum SessionError {
 
 /// The coordinator's configuration: an embedded router listening on `listen`
 /// (e.g. `tcp/0.0.0.0:7447`). Opening it fails at once if an endpoint cannot be bound.
-pub fn router_config(listen: &[String]) -> Result<Config, SessionError> {
+///
+/// `routers` (usually empty) are other routers this one links to, retrying until they answer:
+/// a second coordinator joins the first one's network this way, so two missions share one
+/// Zenoh network and the same agents.
+pub fn router_config(listen: &[String], routers: &[String]) -> Result<Config, SessionError> {
     let mut config = base("router")?;
     let listen = endpoints("listen/endpoints", listen)?;
     set(&mut config, "listen/endpoints", &listen)?;
+    if !routers.is_empty() {
+        let connect = endpoints("connect/endpoints", routers)?;
+        set(&mut config, "connect/endpoints", &connect)?;
+    }
     Ok(config)
 }
 
@@ -176,7 +184,7 @@ mod tests {
 
     async fn router_and_client() -> zenoh::Result<(Session, Session)> {
         let endpoint = free_endpoint()?;
-        let router = open("router open", router_config(from_ref(&endpoint))?).await?;
+        let router = open("router open", router_config(from_ref(&endpoint), &[])?).await?;
         let client = open("client open", client_config(&[endpoint], false)?).await?;
         Ok((router, client))
     }
@@ -186,7 +194,10 @@ mod tests {
         let wait = client_config(&["tcp/coordinator:7447".into()], true)?;
         let once = client_config(&["tcp/10.0.0.1:7447".into()], false)?;
         // A quote in a user string stays inside its endpoint (a bad host, found at open).
-        let router = router_config(&["tcp/[::]:7447".into(), r#"tcp/a",b:1"#.into()])?;
+        let router = router_config(
+            &["tcp/[::]:7447".into(), r#"tcp/a",b:1"#.into()],
+            &["tcp/first:7447".into()],
+        )?;
         let expected = [
             (&wait, "mode", r#""client""#),
             (&wait, "connect/endpoints", r#"["tcp/coordinator:7447"]"#),
@@ -198,6 +209,7 @@ mod tests {
                 "listen/endpoints",
                 r#"["tcp/[::]:7447","tcp/a\",b:1"]"#,
             ),
+            (&router, "connect/endpoints", r#"["tcp/first:7447"]"#),
         ];
         for (config, key, value) in expected {
             assert_eq!(config.get_json(key)?, value, "{key}");
@@ -227,7 +239,7 @@ mod tests {
             let results = [
                 client_config(&[s.into()], false),
                 client_config(&["tcp/127.0.0.1:7447".into(), s.into()], true),
-                router_config(&[s.into()]),
+                router_config(&[s.into()], &[]),
             ];
             for result in results {
                 match result {
@@ -240,7 +252,7 @@ mod tests {
         }
         let e = client_config(&[], true).err().map(|e| e.to_string());
         assert!(e.is_some_and(|e| e.contains("connect/endpoints")));
-        let e = router_config(&[]).err().map(|e| e.to_string());
+        let e = router_config(&[], &[]).err().map(|e| e.to_string());
         assert!(e.is_some_and(|e| e.contains("listen/endpoints")));
     }
 
@@ -249,7 +261,11 @@ mod tests {
         // Both errors are zenoh's, at open time; each names the endpoint.
         let busy = std::net::TcpListener::bind("127.0.0.1:0")?;
         let endpoint = format!("tcp/127.0.0.1:{}", busy.local_addr()?.port());
-        let router = open("router on a busy port", router_config(from_ref(&endpoint))?).await;
+        let router = open(
+            "router on a busy port",
+            router_config(from_ref(&endpoint), &[])?,
+        )
+        .await;
         let e = router.err().map(|e| e.to_string()).unwrap_or_default();
         assert!(e.contains(&endpoint), "router on a busy port: {e:?}");
         let endpoint = free_endpoint()?;
@@ -269,7 +285,7 @@ mod tests {
         let mut client = open_in_thread(client_config(from_ref(&endpoint), true)?);
         tokio::time::sleep(Duration::from_millis(500)).await;
         assert!(client.try_recv().is_err(), "the client did not wait");
-        let router = open("router open", router_config(&[endpoint])?).await?;
+        let router = open("router open", router_config(&[endpoint], &[])?).await?;
         let client = within("client open", client).await???;
         within("client close", client.close()).await??;
         within("router close", router.close()).await??;
@@ -286,6 +302,7 @@ mod tests {
             vehicle: "auv1".into(),
             iterations: 200,
             elites_sent: 12,
+            evaluations: 100_000,
             dropped: 0,
         });
         let bytes = codec::encode(&sent)?;

@@ -5,8 +5,10 @@
 //! shoal/<mission>/vehicle/<id>/in        coordinator → one agent (assign, migrants)
 //! shoal/<mission>/vehicle/<id>/out       one agent → coordinator (elites, done)
 //! shoal/*/vehicle/<id>/in                what an agent listens on: its vehicle, any mission
+//! shoal/*/fleet                          what an agent listens on for contexts
 //! shoal/<mission>/vehicle/*/out          what the coordinator listens on for a mission
 //! shoal-alive/<id>                       an agent's liveliness token (agents outlive missions)
+//! shoal-coordinator/<mission>            the coordinator's liveliness token for a mission
 //! ```
 //!
 //! Mission and vehicle ids become key chunks, so they are restricted to letters, digits, `-`, `_`
@@ -76,8 +78,24 @@ pub fn liveliness(vehicle: &str) -> Result<String, IdError> {
     Ok(format!("shoal-alive/{vehicle}"))
 }
 
+/// The liveliness token of the coordinator of `mission` (outside `shoal-alive/`, so it is never
+/// mistaken for an agent's).
+pub fn coordinator_liveliness(mission: &str) -> Result<String, IdError> {
+    check_id("mission", mission)?;
+    Ok(format!("shoal-coordinator/{mission}"))
+}
+
 /// Every agent's liveliness token.
 pub const ALL_LIVELINESS: &str = "shoal-alive/*";
+
+/// What an agent subscribes to for contexts: every mission's fleet key.
+pub const ALL_FLEETS: &str = "shoal/*/fleet";
+
+/// The mission of a key built by [`fleet`].
+pub fn mission_of_fleet(key: &str) -> Option<&str> {
+    let mission = key.strip_prefix("shoal/")?.strip_suffix("/fleet")?;
+    check_id("mission", mission).ok().map(|()| mission)
+}
 
 /// The vehicle whose liveliness token `key` is, if it is one.
 pub fn vehicle_of_liveliness(key: &str) -> Option<&str> {
@@ -111,6 +129,9 @@ mod tests {
         assert_eq!(coordinator_inbox("m-1")?, "shoal/m-1/vehicle/*/out");
         assert_eq!(liveliness("auv3")?, "shoal-alive/auv3");
         assert_eq!(vehicle_of_liveliness("shoal-alive/auv3"), Some("auv3"));
+        assert_eq!(mission_of_fleet(&fleet("m-1")?), Some("m-1"));
+        assert_eq!(coordinator_liveliness("m-1")?, "shoal-coordinator/m-1");
+        assert_eq!(mission_of_fleet("shoal/a/b/fleet"), None);
         assert_eq!(vehicle_of_liveliness("shoal-alive/a/b"), None);
         assert_eq!(
             mission_and_vehicle(&to_coordinator("m-1", "auv3")?),

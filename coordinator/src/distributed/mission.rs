@@ -1,0 +1,534 @@
+//! The coordinator's mission loop: agents join, then exchange rounds (seed 004 Fig. 5) until
+//! the budget is spent. Each round every agent's elites come up, the leader exchanges, and the
+//! new context (when due) and the migrants go back down. A vehicle whose agent vanishes or
+//! stops answering is planned here from its last elites (degraded mode) and the plan says so.
+//!
+//! With every agent answering in time a run is the lockstep reference
+//! ([`shoal_common::distributed::lockstep`]) message for message, so the same seed gives the
+//! same plan.
+
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+use shoal_common::cost::FleetModel;
+use shoal_common::distributed::follower::{FollowerSettings, Followers};
+use shoal_common::distributed::leader::Leader;
+use shoal_common::distributed::lockstep::context_due;
+use shoal_common::distributed::{round_iterations, rounds, Chromosome, Context};
+use shoal_common::plan::{AgentFigures, DegradedVehicle, DistributedFigures};
+use shoal_common::scenario::Scenario;
+use shoal_common::swarm::{Progress, Termination};
+use shoal_common::wire::agent_to_coordinator::AgentToCoordinator;
+use shoal_common::wire::coordinator_to_agent::CoordinatorToAgent;
+use shoal_common::wire::{WireChromosome, WireContext};
+
+use super::agents::LocalAgents;
+use super::network::{Event, Network};
+use crate::planner::RunResult;
+
+/// How patient the coordinator is.
+#[derive(Debug, Clone)]
+pub struct Timing {
+    /// How long agents have to join.
+    pub join: Duration,
+    /// How long one round may wait for an agent's elites before planning its vehicle here.
+    pub round: Duration,
+}
+
+/// Progress of a distributed run, for stderr.
+#[derive(Debug, Clone, Copy)]
+pub struct Status {
+    /// Iterations done.
+    pub iteration: usize,
+    /// Iteration budget.
+    pub max_iterations: usize,
+    /// Best fitness so far.
+    pub best_cost: f64,
+    /// Agents planning their own vehicle.
+    pub alive: usize,
+    /// Vehicles.
+    pub vehicles: usize,
+}
+
+/// One vehicle's seat in the mission.
+struct Seat {
+    id: String,
+    alive: bool,
+    joined: bool,
+    /// Followers run here after the agent was lost.
+    local: Option<Followers>,
+    degraded: Option<DegradedVehicle>,
+    last_elites: Vec<Chromosome>,
+    this_round: Option<Vec<Chromosome>>,
+    elites_received: u32,
+    agent_iterations: u32,
+    done: Option<(u32, u64, u32)>,
+}
+
+/// Everything the loop shares.
+struct Run<'a> {
+    scenario: &'a Scenario,
+    model: Arc<FleetModel>,
+    net: &'a mut Network,
+    seats: Vec<Seat>,
+    timing: Timing,
+    mission: String,
+}
+
+/// Runs the mission and returns the best plan's run result and the network figures.
+pub fn run(
+    scenario: &Scenario,
+    net: &mut Network,
+    mission: &str,
+    timing: Timing,
+    mut local: Option<&mut LocalAgents>,
+    stop: &AtomicBool,
+    observe: &mut dyn FnMut(&Status),
+) -> anyhow::Result<(RunResult, DistributedFigures)> {
+    let started = Instant::now();
+    let o = scenario.optimizer.clone();
+    let model = Arc::new(FleetModel::new(scenario));
+    let settings = FollowerSettings::of(&o);
+    let mut leader = Leader::new(Arc::clone(&model), &o, settings.schedule);
+    let mut context = leader.context(0);
+    let seats = scenario
+        .vehicles
+        .iter()
+        .map(|v| Seat {
+            id: v.id.clone(),
+            alive: false,
+            joined: false,
+            local: None,
+            degraded: None,
+            last_elites: Vec::new(),
+            this_round: None,
+            elites_received: 0,
+            agent_iterations: 0,
+            done: None,
+        })
+        .collect();
+    let mut r = Run {
+        scenario,
+        model,
+        net,
+        seats,
+        timing,
+        mission: mission.to_string(),
+    };
+    r.join(&context, local.as_deref_mut(), stop)?;
+    let total_rounds = rounds(o.iterations, o.exchange_every);
+    let mut convergence = Vec::with_capacity(o.iterations);
+    let mut iteration = 0usize;
+    let mut stale = false;
+    let mut interrupted = false;
+    for round in 0..total_rounds {
+        if stop.load(Ordering::Relaxed) {
+            interrupted = true;
+            break;
+        }
+        let n = round_iterations(o.iterations, o.exchange_every, round);
+        r.collect(round as u32, iteration, &context, local.as_deref_mut())?;
+        for seat in &mut r.seats {
+            if let Some(f) = &mut seat.local {
+                for k in 0..n {
+                    f.step(Progress {
+                        iteration: iteration + k,
+                        max_iterations: o.iterations,
+                    });
+                }
+                seat.this_round = Some(f.emigrants());
+            }
+        }
+        for _ in 0..n {
+            convergence.push(leader.best_cost());
+        }
+        iteration += n;
+        let elites: Vec<Vec<Chromosome>> = r
+            .seats
+            .iter_mut()
+            .map(|s| {
+                let e = s.this_round.take().unwrap_or_else(|| s.last_elites.clone());
+                s.last_elites.clone_from(&e);
+                e
+            })
+            .collect();
+        let progress = Progress {
+            iteration: iteration.saturating_sub(1),
+            max_iterations: o.iterations,
+        };
+        let (migrants, improved) = leader.exchange(&elites, progress);
+        stale |= improved;
+        if stale && context_due(round, o.distributed.context_every) {
+            stale = false;
+            context = leader.context(round as u32 + 1);
+            if round + 1 < total_rounds {
+                let ids = r.ids();
+                let ids: Vec<&str> = ids.iter().map(String::as_str).collect();
+                r.net.broadcast(CoordinatorToAgent::Context {
+                    mission: r.mission.clone(),
+                    context: WireContext::new(&context, &ids),
+                })?;
+            }
+            for seat in &mut r.seats {
+                if let Some(f) = &mut seat.local {
+                    f.set_context(context.clone());
+                }
+            }
+        }
+        if let Some(last) = convergence.last_mut() {
+            *last = leader.best_cost();
+        }
+        if round + 1 < total_rounds {
+            r.send_migrants(round as u32, context.round, migrants)?;
+        }
+        observe(&Status {
+            iteration,
+            max_iterations: o.iterations,
+            best_cost: leader.best_cost(),
+            alive: r.seats.iter().filter(|s| s.local.is_none()).count(),
+            vehicles: r.seats.len(),
+        });
+    }
+    r.finish(if interrupted {
+        "the coordinator was interrupted"
+    } else {
+        "plan complete"
+    });
+    let agents_evaluations: u64 = r
+        .seats
+        .iter()
+        .map(|s| s.done.map_or(0, |d| d.1) + s.local.as_ref().map_or(0, |f| f.evaluations))
+        .sum();
+    let figures = DistributedFigures {
+        mission: r.mission.clone(),
+        exchanges: leader.exchanges,
+        messages_dropped: r.net.dropped,
+        agents: r
+            .seats
+            .iter()
+            .map(|s| AgentFigures {
+                vehicle: s.id.clone(),
+                iterations: s
+                    .local
+                    .as_ref()
+                    .map_or(s.agent_iterations, |f| f.iterations as u32),
+                elites_sent: s.elites_received,
+                messages_dropped: s.done.map(|d| d.2),
+                degraded: s.degraded.is_some(),
+            })
+            .collect(),
+        degraded: r.seats.iter().filter_map(|s| s.degraded.clone()).collect(),
+    };
+    let result = RunResult {
+        best_x: leader.best_x().to_vec(),
+        convergence,
+        evaluations: leader.evaluations + agents_evaluations,
+        termination: if interrupted {
+            Termination::Interrupted
+        } else {
+            Termination::MaxIterations
+        },
+        runtime_s: started.elapsed().as_secs_f64(),
+    };
+    Ok((result, figures))
+}
+
+impl Run<'_> {
+    fn ids(&self) -> Vec<String> {
+        self.seats.iter().map(|s| s.id.clone()).collect()
+    }
+
+    fn index(&self, vehicle: &str) -> Option<usize> {
+        self.seats.iter().position(|s| s.id == vehicle)
+    }
+
+    fn assign(&self, i: usize, context: &Context) -> anyhow::Result<()> {
+        let ids = self.ids();
+        let ids: Vec<&str> = ids.iter().map(String::as_str).collect();
+        self.net.send(
+            &self.seats[i].id,
+            CoordinatorToAgent::Assign {
+                mission: self.mission.clone(),
+                vehicle: self.seats[i].id.clone(),
+                scenario_toml: toml::to_string(self.scenario)?,
+                context: WireContext::new(context, &ids),
+            },
+        )
+    }
+
+    /// Waits until every vehicle's agent is up and has accepted the mission, re-sending the
+    /// assignment every second (a message sent just as a subscriber appears can be lost).
+    fn join(
+        &mut self,
+        context: &Context,
+        mut local: Option<&mut LocalAgents>,
+        stop: &AtomicBool,
+    ) -> anyhow::Result<()> {
+        let deadline = Instant::now() + self.timing.join;
+        let mut resend = Instant::now();
+        while self.seats.iter().any(|s| !s.joined) {
+            if stop.load(Ordering::Relaxed) {
+                anyhow::bail!("interrupted while waiting for the agents to join");
+            }
+            if let Some(agents) = local.as_deref_mut() {
+                if let Some((v, status)) = agents.exited().into_iter().next() {
+                    anyhow::bail!("the agent of {v} exited before joining ({status}); see its log");
+                }
+            }
+            let now = Instant::now();
+            if now >= deadline {
+                return Err(self.join_error());
+            }
+            if now >= resend {
+                for i in 0..self.seats.len() {
+                    if self.seats[i].alive && !self.seats[i].joined {
+                        self.assign(i, context)?;
+                    }
+                }
+                resend = now + Duration::from_secs(1);
+            }
+            match self
+                .net
+                .next(deadline.min(resend).min(now + super::network::POLL))
+            {
+                Some(Event::Alive(v)) => {
+                    if let Some(i) = self.index(&v) {
+                        self.seats[i].alive = true;
+                        self.assign(i, context)?;
+                    }
+                }
+                Some(Event::Gone(v)) => {
+                    if let Some(i) = self.index(&v) {
+                        self.seats[i].alive = false;
+                        self.seats[i].joined = false;
+                    }
+                }
+                Some(Event::Message(AgentToCoordinator::Joined { vehicle, .. })) => {
+                    if let Some(i) = self.index(&vehicle) {
+                        if !self.seats[i].joined {
+                            tracing::info!("the agent of {vehicle} joined");
+                        }
+                        self.seats[i].joined = true;
+                        self.seats[i].alive = true;
+                    }
+                }
+                Some(Event::Message(m)) => self
+                    .net
+                    .out_of_turn(&format!("{} sent {m:?} before joining", m.vehicle())),
+                None => {}
+            }
+        }
+        Ok(())
+    }
+
+    fn join_error(&self) -> anyhow::Error {
+        let missing: Vec<&str> = self
+            .seats
+            .iter()
+            .filter(|s| !s.alive)
+            .map(|s| s.id.as_str())
+            .collect();
+        let silent: Vec<&str> = self
+            .seats
+            .iter()
+            .filter(|s| s.alive && !s.joined)
+            .map(|s| s.id.as_str())
+            .collect();
+        let mut parts = Vec::new();
+        if !missing.is_empty() {
+            parts.push(format!(
+                "no agent joined for vehicle(s) {} (start one per vehicle: shoal-agent --vehicle <ID> --connect {})",
+                missing.join(", "),
+                self.net.endpoints.join(",")
+            ));
+        }
+        if !silent.is_empty() {
+            parts.push(format!(
+                "the agent(s) of {} are up but did not accept mission {}",
+                silent.join(", "),
+                self.mission
+            ));
+        }
+        anyhow::anyhow!(
+            "{} within {:.0} s",
+            parts.join("; "),
+            self.timing.join.as_secs_f64()
+        )
+    }
+
+    /// Plans vehicle `i` here from now on.
+    fn degrade(&mut self, i: usize, round: u32, iteration: usize, context: &Context, why: String) {
+        if self.seats[i].local.is_some() {
+            return;
+        }
+        let o = &self.scenario.optimizer;
+        let settings = FollowerSettings::of(o);
+        let seat = &mut self.seats[i];
+        tracing::warn!(
+            "planning {} in the coordinator from round {round}: {why}",
+            seat.id
+        );
+        seat.local = Some(Followers::resume(
+            Arc::clone(&self.model),
+            i,
+            settings,
+            context.clone(),
+            &seat.last_elites,
+            iteration,
+        ));
+        seat.alive = false;
+        seat.degraded = Some(DegradedVehicle {
+            vehicle: seat.id.clone(),
+            from_round: round,
+            reason: why,
+        });
+    }
+
+    /// Gathers round `round`'s elites from every agent still planning.
+    fn collect(
+        &mut self,
+        round: u32,
+        iteration: usize,
+        context: &Context,
+        mut local: Option<&mut LocalAgents>,
+    ) -> anyhow::Result<()> {
+        let deadline = Instant::now() + self.timing.round;
+        loop {
+            let waiting: Vec<usize> = (0..self.seats.len())
+                .filter(|&i| self.seats[i].local.is_none() && self.seats[i].this_round.is_none())
+                .collect();
+            if waiting.is_empty() {
+                return Ok(());
+            }
+            if let Some(agents) = local.as_deref_mut() {
+                for (v, status) in agents.exited() {
+                    if let Some(i) = self.index(&v) {
+                        let why = format!("its agent process exited ({status})");
+                        self.degrade(i, round, iteration, context, why);
+                    }
+                }
+            }
+            if Instant::now() >= deadline {
+                for i in waiting {
+                    let why = format!(
+                        "no elites from its agent within {:.1} s in round {round}",
+                        self.timing.round.as_secs_f64()
+                    );
+                    self.degrade(i, round, iteration, context, why);
+                }
+                return Ok(());
+            }
+            let until = deadline.min(Instant::now() + super::network::POLL);
+            match self.net.next(until) {
+                Some(Event::Message(AgentToCoordinator::Elites {
+                    vehicle,
+                    round: r,
+                    iteration: it,
+                    particles,
+                    ..
+                })) => {
+                    let Some(i) = self.index(&vehicle) else {
+                        continue;
+                    };
+                    let seat = &mut self.seats[i];
+                    if r != round || seat.local.is_some() {
+                        self.net.out_of_turn(&format!(
+                            "elites of round {r} from {vehicle} during round {round}"
+                        ));
+                        continue;
+                    }
+                    seat.elites_received += 1;
+                    seat.agent_iterations = it;
+                    seat.this_round = Some(particles.into_iter().map(Chromosome::from).collect());
+                }
+                Some(Event::Message(AgentToCoordinator::Done {
+                    vehicle,
+                    iterations,
+                    evaluations,
+                    dropped,
+                    ..
+                })) => {
+                    if let Some(i) = self.index(&vehicle) {
+                        self.seats[i].done = Some((iterations, evaluations, dropped));
+                        // After its last round an agent is done at once; before, it gave up.
+                        if (iterations as usize) < self.scenario.optimizer.iterations {
+                            let why = "its agent ended the mission early (shut down or lost the coordinator)";
+                            self.degrade(i, round, iteration, context, why.into());
+                        }
+                    }
+                }
+                Some(Event::Gone(v)) => {
+                    if let Some(i) = self.index(&v) {
+                        let why = "its agent left the network (liveliness token gone)".to_string();
+                        self.degrade(i, round, iteration, context, why);
+                    }
+                }
+                Some(Event::Alive(_)) | Some(Event::Message(AgentToCoordinator::Joined { .. })) => {
+                }
+                None => {}
+            }
+        }
+    }
+
+    fn send_migrants(
+        &mut self,
+        round: u32,
+        context_round: u32,
+        migrants: Vec<Vec<Chromosome>>,
+    ) -> anyhow::Result<()> {
+        for (i, ms) in migrants.into_iter().enumerate() {
+            let seat = &mut self.seats[i];
+            match &mut seat.local {
+                Some(f) => {
+                    for (k, m) in ms.into_iter().enumerate() {
+                        f.immigrate(k, m);
+                    }
+                }
+                None => self.net.send(
+                    &seat.id,
+                    CoordinatorToAgent::Migrants {
+                        mission: self.mission.clone(),
+                        vehicle: seat.id.clone(),
+                        round,
+                        context_round,
+                        particles: ms.iter().map(WireChromosome::from).collect(),
+                    },
+                )?,
+            }
+        }
+        Ok(())
+    }
+
+    /// Tells the agents the mission is over and collects their figures (2 s at most).
+    fn finish(&mut self, reason: &str) {
+        if let Err(e) = self.net.broadcast(CoordinatorToAgent::Stop {
+            mission: self.mission.clone(),
+            reason: reason.to_string(),
+        }) {
+            tracing::warn!("cannot tell the agents to stop: {e:#}");
+        }
+        let deadline = Instant::now() + Duration::from_secs(2);
+        while self
+            .seats
+            .iter()
+            .any(|s| s.local.is_none() && s.done.is_none())
+        {
+            match self.net.next(deadline) {
+                Some(Event::Message(AgentToCoordinator::Done {
+                    vehicle,
+                    iterations,
+                    evaluations,
+                    dropped,
+                    ..
+                })) => {
+                    if let Some(i) = self.index(&vehicle) {
+                        self.seats[i].done = Some((iterations, evaluations, dropped));
+                    }
+                }
+                Some(_) => {}
+                None => break,
+            }
+        }
+    }
+}

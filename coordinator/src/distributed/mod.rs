@@ -1,0 +1,150 @@
+//! Distributed planning (`plan` without `--in-process`): the coordinator embeds a Zenoh router,
+//! the vehicle agents run their vehicles' follower populations, and the coordinator holds the
+//! leader population (seed 004 §3.2, split over processes as
+//! [`shoal_common::distributed`] describes).
+//!
+//! - [`network`]: the router, the mission's keys, decoding and counting bad messages;
+//! - [`agents`]: the coordinator's own agent processes (`--agents embedded`);
+//! - [`mission`]: joining, exchange rounds, degraded mode.
+
+pub mod agents;
+pub mod mission;
+pub mod network;
+
+use std::path::PathBuf;
+use std::sync::atomic::AtomicBool;
+use std::time::Duration;
+
+use shoal_common::cost::FleetModel;
+use shoal_common::plan::Plan;
+use shoal_common::scenario::{Algorithm, Scenario};
+use shoal_common::wire::topics;
+
+use crate::planner::to_plan;
+
+/// Who starts the agents.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
+pub enum AgentsMode {
+    /// The coordinator starts one `shoal-agent` process per vehicle on this machine.
+    #[default]
+    Embedded,
+    /// Agents are started elsewhere (docker compose, vehicles) and connect to `--listen`.
+    External,
+}
+
+/// Everything a distributed run needs besides the scenario.
+#[derive(Debug, Clone)]
+pub struct DistributedOptions {
+    /// Mission id (keys `shoal/<mission>/…`).
+    pub mission: String,
+    /// Who starts the agents.
+    pub agents: AgentsMode,
+    /// Endpoints the embedded router listens on.
+    pub listen: Vec<String>,
+    /// Other routers to link to (a second coordinator joining a first one's network).
+    pub routers: Vec<String>,
+    /// How long agents have to join.
+    pub join_timeout: Duration,
+    /// How long a round waits for an agent before planning its vehicle here.
+    pub round_timeout: Duration,
+    /// The `shoal-agent` binary for embedded agents (found next to this one by default).
+    pub agent_bin: Option<PathBuf>,
+    /// Where embedded agents write their logs.
+    pub log_dir: PathBuf,
+}
+
+/// A mission id for `scenario` unique enough for one network: its name, this process and the
+/// time (not an algorithm's randomness, so `--seed` runs stay reproducible).
+pub fn default_mission_id(scenario: &Scenario) -> String {
+    let name: String = scenario
+        .name
+        .chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '-' || c == '_' {
+                c
+            } else {
+                '-'
+            }
+        })
+        .take(40)
+        .collect();
+    let nanos = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0, |d| d.subsec_nanos());
+    format!("{name}-{:x}{:05x}", std::process::id(), nanos & 0xfffff)
+}
+
+/// Plans `scenario` with one agent per vehicle. `observe` sees every round.
+pub fn plan_distributed(
+    scenario: &Scenario,
+    options: &DistributedOptions,
+    stop: &AtomicBool,
+    observe: &mut dyn FnMut(&mission::Status),
+) -> anyhow::Result<Plan> {
+    topics::check_id("mission", &options.mission)?;
+    if !matches!(
+        scenario.optimizer.algorithm,
+        Algorithm::AmpPso | Algorithm::MpPso
+    ) {
+        anyhow::bail!(
+            "distributed planning runs the multi-population algorithms (amp-pso, mp-pso); {} is a single-population algorithm: plan it with --in-process",
+            scenario.optimizer.algorithm.as_str()
+        );
+    }
+    let ids: Vec<String> = scenario.vehicles.iter().map(|v| v.id.clone()).collect();
+    let mut net =
+        network::Network::open(&options.listen, &options.routers, &options.mission, &ids)?;
+    tracing::info!(
+        mission = %options.mission,
+        "coordinator listening on {}",
+        net.endpoints.join(", ")
+    );
+    let mut local = match options.agents {
+        AgentsMode::Embedded => {
+            let bin = agents::agent_binary(options.agent_bin.as_deref())?;
+            let endpoint = net.endpoints.first().cloned().unwrap_or_default();
+            Some(agents::LocalAgents::spawn(
+                &bin,
+                &ids,
+                &endpoint,
+                &options.log_dir,
+            )?)
+        }
+        AgentsMode::External => {
+            eprintln!(
+                "mission {}: waiting up to {:.0} s for one agent per vehicle ({}) on {}",
+                options.mission,
+                options.join_timeout.as_secs_f64(),
+                ids.join(", "),
+                net.endpoints.join(", ")
+            );
+            None
+        }
+    };
+    let timing = mission::Timing {
+        join: options.join_timeout,
+        round: options.round_timeout,
+    };
+    let outcome = mission::run(
+        scenario,
+        &mut net,
+        &options.mission,
+        timing,
+        local.as_mut(),
+        stop,
+        observe,
+    );
+    drop(local);
+    net.close();
+    let (run, figures) = outcome?;
+    let model = FleetModel::new(scenario);
+    let mut plan = to_plan(scenario, &model, run, "distributed");
+    for d in &figures.degraded {
+        plan.notices.push(format!(
+            "{} was planned in degraded mode by the coordinator from exchange round {}: {}",
+            d.vehicle, d.from_round, d.reason
+        ));
+    }
+    plan.distributed = Some(figures);
+    Ok(plan)
+}

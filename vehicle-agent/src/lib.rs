@@ -1,0 +1,63 @@
+//! Shoal's vehicle agent as a library: the binary parses its command line and calls [`run`];
+//! tests call [`run`] directly.
+//!
+//! An agent serves one vehicle. It connects to the coordinator's router as a Zenoh client
+//! (waiting for it if it is not up yet), declares a liveliness token so the coordinator sees it,
+//! and serves every mission that assigns its vehicle — several at once if they come — until it
+//! is stopped. The layers stay apart so a vehicle link can be added without touching the swarm:
+//! - [`network`]: the Zenoh session, subscriptions, decoding and counting of bad messages;
+//! - [`mission`]: one mission's planning loop, fed messages through a channel and sending
+//!   through a closure, with no knowledge of Zenoh.
+
+pub mod mission;
+pub mod network;
+
+use std::sync::atomic::AtomicBool;
+use std::sync::Arc;
+use std::time::Duration;
+
+/// Shoal vehicle agent: plans one vehicle's share of the fleet's missions (its follower
+/// populations of distributed AMP-PSO) with the coordinator over Zenoh.
+#[derive(Debug, Clone, clap::Parser)]
+#[command(name = "shoal-agent", version, about)]
+pub struct AgentArgs {
+    /// The vehicle this agent serves (a vehicle id of the scenarios it will be given).
+    #[arg(long, env = "SHOAL_VEHICLE")]
+    pub vehicle: String,
+    /// The coordinator's Zenoh endpoint(s), e.g. tcp/coordinator:7447 (comma-separated).
+    #[arg(
+        long,
+        env = "SHOAL_CONNECT",
+        value_delimiter = ',',
+        default_value = "tcp/127.0.0.1:7447"
+    )]
+    pub connect: Vec<String>,
+    /// Leave after the first mission ends (the coordinator's own agents do).
+    #[arg(long, env = "SHOAL_ONCE")]
+    pub once: bool,
+    /// Threads stepping the follower populations.
+    #[arg(long, env = "SHOAL_THREADS", default_value_t = 1)]
+    pub threads: usize,
+    /// Abandon a mission whose coordinator has been silent this long, seconds.
+    #[arg(long, env = "SHOAL_IDLE_TIMEOUT", default_value_t = 30.0)]
+    pub idle_timeout: f64,
+}
+
+impl AgentArgs {
+    /// The idle timeout as a duration (a bad value falls back to 30 s).
+    pub fn idle(&self) -> Duration {
+        Duration::try_from_secs_f64(self.idle_timeout).unwrap_or(Duration::from_secs(30))
+    }
+}
+
+/// Runs the agent until `shutdown` is raised (or, with `--once`, until its first mission ends).
+pub fn run(args: AgentArgs, shutdown: Arc<AtomicBool>) -> anyhow::Result<()> {
+    shoal_common::wire::topics::check_id("vehicle", &args.vehicle)?;
+    if !(args.idle_timeout.is_finite() && args.idle_timeout > 0.0) {
+        anyhow::bail!(
+            "--idle-timeout (SHOAL_IDLE_TIMEOUT) = {}: must be a positive number of seconds",
+            args.idle_timeout
+        );
+    }
+    network::serve(&args, &shutdown)
+}
