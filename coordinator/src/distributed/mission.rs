@@ -313,9 +313,28 @@ impl Run<'_> {
                         self.seats[i].alive = true;
                     }
                 }
-                Some(Event::Message(m)) => self
-                    .net
-                    .out_of_turn(&format!("{} sent {m:?} before joining", m.vehicle())),
+                // An agent plans as soon as it joins: its first elites can come before the
+                // last agent has joined. Keep them for round 0.
+                Some(Event::Message(AgentToCoordinator::Elites {
+                    vehicle,
+                    round: 0,
+                    iteration,
+                    particles,
+                    ..
+                })) => {
+                    if let Some(i) = self.index(&vehicle) {
+                        let seat = &mut self.seats[i];
+                        seat.joined = true;
+                        seat.elites_received += 1;
+                        seat.agent_iterations = iteration;
+                        seat.this_round =
+                            Some(particles.into_iter().map(Chromosome::from).collect());
+                    }
+                }
+                Some(Event::Message(m)) => self.net.out_of_turn(&format!(
+                    "{} sent a message out of turn while the fleet was joining",
+                    m.vehicle()
+                )),
                 None => {}
             }
         }

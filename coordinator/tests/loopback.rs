@@ -1,0 +1,191 @@
+//! The coordinator and its agents over real Zenoh sessions on loopback, all in this process:
+//! the agents are `shoal_agent::run` on threads, the coordinator `plan_distributed` in external
+//! mode. Every wait is bounded.
+
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::mpsc;
+use std::sync::Arc;
+use std::thread::JoinHandle;
+use std::time::Duration;
+
+use shoal_agent::AgentArgs;
+use shoal_common::distributed::lockstep;
+use shoal_common::plan::Plan;
+use shoal_common::scenario::Scenario;
+use shoal_coordinator::distributed::{plan_distributed, AgentsMode, DistributedOptions};
+
+type TestResult = Result<(), Box<dyn std::error::Error>>;
+
+/// Longest any test waits for a plan.
+const LIMIT: Duration = Duration::from_secs(90);
+
+/// Scenario 2 (three AUVs) with a budget small enough for a debug build.
+fn scenario() -> Result<Scenario, Box<dyn std::error::Error>> {
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../scenarios/amp-pso-2.toml");
+    let mut s = Scenario::load(&path)?;
+    s.optimizer.iterations = 16;
+    s.optimizer.particles = 12;
+    s.optimizer.leader_particles = 4;
+    s.optimizer.distributed.agent_populations = 3;
+    s.optimizer.distributed.context_every = 2;
+    Ok(s)
+}
+
+fn free_endpoint() -> std::io::Result<String> {
+    let l = std::net::TcpListener::bind("127.0.0.1:0")?;
+    Ok(format!("tcp/127.0.0.1:{}", l.local_addr()?.port()))
+}
+
+fn options(mission: &str, endpoint: &str, join_s: u64) -> DistributedOptions {
+    DistributedOptions {
+        mission: mission.into(),
+        agents: AgentsMode::External,
+        listen: vec![endpoint.into()],
+        routers: vec![],
+        join_timeout: Duration::from_secs(join_s),
+        round_timeout: Duration::from_secs(10),
+        agent_bin: None,
+        log_dir: std::env::temp_dir(),
+    }
+}
+
+/// An agent on a thread, with its own stop flag.
+struct Agent {
+    stop: Arc<AtomicBool>,
+    handle: JoinHandle<anyhow::Result<()>>,
+}
+
+fn agent(vehicle: &str, endpoint: &str) -> Agent {
+    let stop = Arc::new(AtomicBool::new(false));
+    let args = AgentArgs {
+        vehicle: vehicle.into(),
+        connect: vec![endpoint.into()],
+        once: true,
+        threads: 1,
+        idle_timeout: 10.0,
+    };
+    let flag = Arc::clone(&stop);
+    Agent {
+        stop,
+        handle: std::thread::spawn(move || shoal_agent::run(args, flag)),
+    }
+}
+
+/// Runs the coordinator on a thread and waits for it at most [`LIMIT`]; `on_iteration` sees
+/// every round's iteration count.
+fn coordinate(
+    s: &Scenario,
+    o: DistributedOptions,
+    on_iteration: impl Fn(usize) + Send + 'static,
+) -> Result<anyhow::Result<Plan>, String> {
+    let (tx, rx) = mpsc::channel();
+    let s = s.clone();
+    std::thread::spawn(move || {
+        let stop = AtomicBool::new(false);
+        let plan = plan_distributed(&s, &o, &stop, &mut |st| on_iteration(st.iteration));
+        let _ = tx.send(plan);
+    });
+    rx.recv_timeout(LIMIT)
+        .map_err(|_| format!("no plan within {LIMIT:?}"))
+}
+
+fn finish(agents: Vec<Agent>) -> TestResult {
+    for a in agents {
+        a.stop.store(true, Ordering::Relaxed);
+        match a.handle.join() {
+            Ok(r) => r?,
+            Err(_) => return Err("an agent thread panicked".into()),
+        }
+    }
+    Ok(())
+}
+
+#[test]
+fn agents_over_loopback_give_the_lockstep_plan() -> TestResult {
+    let s = scenario()?;
+    let endpoint = free_endpoint()?;
+    // Agents first: they wait for the coordinator's router.
+    let agents: Vec<Agent> = ["auv1", "auv2", "auv3"]
+        .iter()
+        .map(|v| agent(v, &endpoint))
+        .collect();
+    let plan = coordinate(&s, options("loopback-same", &endpoint, 30), |_| {})??;
+    finish(agents)?;
+    let reference = lockstep::run(&s, None, &mut |_| {});
+    assert!(
+        (plan.fitness - reference.best_cost).abs() < 1e-12,
+        "distributed {} vs lockstep {}",
+        plan.fitness,
+        reference.best_cost
+    );
+    assert_eq!(plan.mode, "distributed");
+    assert_eq!(plan.convergence, reference.convergence);
+    let d = plan.distributed.ok_or("no distributed figures")?;
+    assert_eq!(d.mission, "loopback-same");
+    assert_eq!(d.exchanges, 16);
+    assert_eq!(d.messages_dropped, 0);
+    assert!(d.degraded.is_empty(), "{:?}", d.degraded);
+    for a in &d.agents {
+        assert_eq!((a.iterations, a.elites_sent), (16, 16), "{a:?}");
+        assert_eq!(a.messages_dropped, Some(0), "{a:?}");
+        assert!(!a.degraded);
+    }
+    Ok(())
+}
+
+#[test]
+fn a_lost_agent_is_planned_by_the_coordinator() -> TestResult {
+    let s = scenario()?;
+    let endpoint = free_endpoint()?;
+    let agents: Vec<Agent> = ["auv1", "auv2", "auv3"]
+        .iter()
+        .map(|v| agent(v, &endpoint))
+        .collect();
+    // auv2's agent shuts down once the coordinator reports round 5.
+    let auv2 = Arc::clone(&agents[1].stop);
+    let plan = coordinate(&s, options("loopback-lost", &endpoint, 30), move |it| {
+        if it >= 5 {
+            auv2.store(true, Ordering::Relaxed);
+        }
+    })??;
+    finish(agents)?;
+    let d = plan.distributed.as_ref().ok_or("no distributed figures")?;
+    let names: Vec<&str> = d.degraded.iter().map(|x| x.vehicle.as_str()).collect();
+    assert_eq!(names, ["auv2"], "{:?}", d.degraded);
+    assert!(d.degraded[0].from_round >= 5, "{:?}", d.degraded);
+    assert!(
+        plan.notices
+            .iter()
+            .any(|n| n.contains("auv2") && n.contains("degraded")),
+        "{:?}",
+        plan.notices
+    );
+    // Every vehicle still has a whole plan and every iteration ran.
+    assert_eq!(plan.vehicles.len(), 3);
+    assert!(
+        d.agents.iter().all(|a| a.iterations == 16),
+        "{:?}",
+        d.agents
+    );
+    assert_eq!(plan.convergence.len(), 16);
+    assert!(plan.fitness.is_finite());
+    Ok(())
+}
+
+#[test]
+fn agents_that_never_join_are_named() -> TestResult {
+    let s = scenario()?;
+    let endpoint = free_endpoint()?;
+    let agents = vec![agent("auv1", &endpoint)];
+    let outcome = coordinate(&s, options("loopback-missing", &endpoint, 2), |_| {})?;
+    finish(agents)?;
+    let e = match outcome {
+        Ok(_) => return Err("planned without agents".into()),
+        Err(e) => e.to_string(),
+    };
+    assert!(e.contains("auv2") && e.contains("auv3"), "{e}");
+    assert!(!e.contains("auv1,") && !e.contains("auv1 "), "{e}");
+    assert!(e.contains(&endpoint), "{e}");
+    Ok(())
+}
