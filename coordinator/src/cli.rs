@@ -25,6 +25,8 @@ pub enum Command {
     Plan(PlanArgs),
     /// Compare the optimizers over several seeds (markdown table on stdout).
     Compare(crate::compare::CompareArgs),
+    /// Write a random fleet scenario of any size (for scaling runs).
+    Generate(crate::generate::GenerateArgs),
 }
 
 /// `shoal-coordinator plan`.

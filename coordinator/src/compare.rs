@@ -8,6 +8,9 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use shoal_common::plan::Plan;
 use shoal_common::scenario::{Algorithm, Scenario};
 
+use std::time::Instant;
+
+use crate::distributed::{default_mission_id, plan_distributed, DistributedOptions};
 use crate::planner::plan_in_process;
 
 /// Aggregates of one (scenario, algorithm) cell over all seeds.
@@ -17,6 +20,8 @@ pub struct Cell {
     pub scenario: String,
     /// Algorithm.
     pub algorithm: Algorithm,
+    /// `in-process` or `distributed`.
+    pub mode: String,
     /// Seeds run.
     pub runs: usize,
     /// Plans with no violation at all.
@@ -29,8 +34,11 @@ pub struct Cell {
     pub median_fitness: f64,
     /// Best and worst fitness.
     pub fitness_range: (f64, f64),
-    /// Median wall time, seconds.
+    /// Median planning time (plan.json's runtime_s), seconds.
     pub median_runtime_s: f64,
+    /// Median wall time of the whole call (for distributed runs: router, agent processes,
+    /// joining, planning and teardown), seconds.
+    pub median_wall_s: f64,
     /// Mean hard collisions per plan.
     pub mean_collisions: f64,
     /// Smallest separation over all seeds, metres.
@@ -51,9 +59,16 @@ fn median(v: &mut [f64]) -> f64 {
     }
 }
 
-/// Summarises the plans of one cell.
-pub fn cell(scenario: &str, algorithm: Algorithm, plans: &[Plan], d_min: f64) -> Cell {
+/// Summarises the plans of one cell; `walls` are the wall times of the calls that made them.
+pub fn cell(
+    scenario: &str,
+    algorithm: Algorithm,
+    plans: &[Plan],
+    walls: &[f64],
+    d_min: f64,
+) -> Cell {
     let mut fitness: Vec<f64> = plans.iter().map(|p| p.fitness).collect();
+    let mut walls = walls.to_vec();
     let mut runtime: Vec<f64> = plans.iter().map(|p| p.runtime_s).collect();
     let evals: u64 = plans.iter().map(|p| p.evaluations).sum();
     let time: f64 = runtime.iter().sum();
@@ -61,6 +76,9 @@ pub fn cell(scenario: &str, algorithm: Algorithm, plans: &[Plan], d_min: f64) ->
     Cell {
         scenario: scenario.to_string(),
         algorithm,
+        mode: plans
+            .first()
+            .map_or_else(|| "in-process".to_string(), |p| p.mode.clone()),
         runs: plans.len(),
         feasible: plans.iter().filter(|p| p.feasible).count(),
         collision_free: plans
@@ -74,6 +92,7 @@ pub fn cell(scenario: &str, algorithm: Algorithm, plans: &[Plan], d_min: f64) ->
         ),
         median_fitness: median(&mut fitness),
         median_runtime_s: median(&mut runtime),
+        median_wall_s: median(&mut walls),
         mean_collisions: plans
             .iter()
             .map(|p| p.fleet.hard_collisions as f64)
@@ -84,48 +103,68 @@ pub fn cell(scenario: &str, algorithm: Algorithm, plans: &[Plan], d_min: f64) ->
     }
 }
 
-/// Runs `algorithms` × `seeds` on every scenario; `progress` sees each finished plan. When
-/// `stop` is raised it finishes the plan in hand and returns the cells completed so far.
+/// Runs `algorithms` × `seeds` on every scenario, in-process and, for the multi-population
+/// algorithms when `distributed` is given, also distributed (one agent process per vehicle);
+/// `progress` sees each finished plan. When `stop` is raised it finishes the plan in hand and
+/// returns the cells completed so far.
 pub fn compare(
     scenarios: &[Scenario],
     algorithms: &[Algorithm],
     seeds: std::ops::Range<u64>,
+    distributed: Option<&DistributedOptions>,
     stop: &AtomicBool,
     progress: &mut dyn FnMut(&Plan),
-) -> Vec<Cell> {
+) -> anyhow::Result<Vec<Cell>> {
     let mut cells = Vec::new();
     for s in scenarios {
         for &a in algorithms {
-            let mut plans = Vec::new();
-            for seed in seeds.clone() {
-                if stop.load(Ordering::Relaxed) {
-                    return cells;
+            let multi = matches!(a, Algorithm::AmpPso | Algorithm::MpPso);
+            for remote in [false, true] {
+                if remote && !(multi && distributed.is_some()) {
+                    continue;
                 }
-                let mut s = s.clone();
-                s.optimizer.algorithm = a;
-                s.optimizer.seed = seed;
-                let p = plan_in_process(&s, None, &mut |_| {});
-                progress(&p);
-                plans.push(p);
+                let mut plans = Vec::new();
+                let mut walls = Vec::new();
+                for seed in seeds.clone() {
+                    if stop.load(Ordering::Relaxed) {
+                        return Ok(cells);
+                    }
+                    let mut s = s.clone();
+                    s.optimizer.algorithm = a;
+                    s.optimizer.seed = seed;
+                    let started = Instant::now();
+                    let p = match distributed {
+                        Some(o) if remote => {
+                            let mut o = o.clone();
+                            o.mission = default_mission_id(&s);
+                            plan_distributed(&s, &o, stop, &mut |_| {})?
+                        }
+                        _ => plan_in_process(&s, None, &mut |_| {}),
+                    };
+                    walls.push(started.elapsed().as_secs_f64());
+                    progress(&p);
+                    plans.push(p);
+                }
+                cells.push(cell(&s.name, a, &plans, &walls, s.fleet.d_min_m));
             }
-            cells.push(cell(&s.name, a, &plans, s.fleet.d_min_m));
         }
     }
-    cells
+    Ok(cells)
 }
 
 /// The cells as a markdown table.
 pub fn markdown(cells: &[Cell]) -> String {
     let mut s = String::from(
-        "| scenario | algorithm | runs | feasible | no hard collision | separation ≥ d_min | mean collisions | worst separation (m) | median fitness | fitness best–worst | median run time (s) | evaluations/s |\n\
-         |---|---|---|---|---|---|---|---|---|---|---|---|\n",
+        "| scenario | algorithm | mode | runs | feasible | no hard collision | separation ≥ d_min | mean collisions | worst separation (m) | median fitness | fitness best–worst | median run time (s) | median wall time (s) | evaluations/s |\n\
+         |---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     for c in cells {
         let _ = writeln!(
             s,
-            "| {} | {} | {} | {} | {} | {} | {:.1} | {:.1} | {:.4} | {:.4}–{:.4} | {:.2} | {:.0} |",
+            "| {} | {} | {} | {} | {} | {} | {} | {:.1} | {:.1} | {:.4} | {:.4}–{:.4} | {:.2} | {:.2} | {:.0} |",
             c.scenario,
             c.algorithm.as_str(),
+            c.mode,
             c.runs,
             c.feasible,
             c.collision_free,
@@ -136,6 +175,7 @@ pub fn markdown(cells: &[Cell]) -> String {
             c.fitness_range.0,
             c.fitness_range.1,
             c.median_runtime_s,
+            c.median_wall_s,
             c.evals_per_s
         );
     }
@@ -162,6 +202,10 @@ pub struct CompareArgs {
     /// Iterations (overrides the scenarios').
     #[arg(long, env = "SHOAL_ITERATIONS")]
     pub iterations: Option<usize>,
+    /// Also plan every multi-population cell distributed: one local agent process per vehicle
+    /// over the embedded Zenoh router, side by side with the in-process run.
+    #[arg(long, env = "SHOAL_DISTRIBUTED")]
+    pub distributed: bool,
     /// Write the markdown table here too.
     #[arg(long, env = "SHOAL_OUT")]
     pub out: Option<PathBuf>,

@@ -4,6 +4,7 @@
 pub mod cli;
 pub mod compare;
 pub mod distributed;
+pub mod generate;
 pub mod planner;
 pub mod summary;
 pub mod svg;
@@ -15,7 +16,7 @@ use std::sync::Arc;
 
 use anyhow::{bail, Context};
 use shoal_common::plan::Plan;
-use shoal_common::scenario::Scenario;
+use shoal_common::scenario::{Algorithm, Scenario};
 use shoal_common::swarm::IterationReport;
 
 pub use cli::{Command, PlanArgs};
@@ -33,6 +34,11 @@ pub fn run(command: Command, shutdown: Arc<AtomicBool>) -> anyhow::Result<i32> {
     match command {
         Command::Plan(args) => plan_command(&args, shutdown),
         Command::Compare(args) => compare_command(&args, &shutdown),
+        Command::Generate(args) => {
+            generate::generate(&args)?;
+            say(&format!("Wrote {}\n", args.out.display()));
+            Ok(EXIT_FEASIBLE)
+        }
     }
 }
 
@@ -49,26 +55,44 @@ fn compare_command(args: &compare::CompareArgs, stop: &AtomicBool) -> anyhow::Re
             Ok(s)
         })
         .collect::<anyhow::Result<Vec<_>>>()?;
-    let total = scenarios.len() * args.algorithms.len() * args.seeds as usize;
+    let multi = args
+        .algorithms
+        .iter()
+        .filter(|a| matches!(a, Algorithm::AmpPso | Algorithm::MpPso))
+        .count();
+    let per_scenario = args.algorithms.len() + if args.distributed { multi } else { 0 };
+    let total = scenarios.len() * per_scenario * args.seeds as usize;
     let mut done = 0;
+    let distributed = args.distributed.then(|| distributed::DistributedOptions {
+        mission: String::new(),
+        agents: distributed::AgentsMode::Embedded,
+        listen: vec!["tcp/127.0.0.1:0".into()],
+        routers: Vec::new(),
+        join_timeout: std::time::Duration::from_secs(30),
+        round_timeout: std::time::Duration::from_secs(10),
+        agent_bin: None,
+        log_dir: std::env::temp_dir().join("shoal-compare-logs"),
+    });
     let cells = compare::compare(
         &scenarios,
         &args.algorithms,
         1..args.seeds + 1,
+        distributed.as_ref(),
         stop,
         &mut |p| {
             done += 1;
             eprintln!(
-                "[{done}/{total}] {} {} seed {}: fitness {:.4}, {} in {:.2} s",
+                "[{done}/{total}] {} {} {} seed {}: fitness {:.4}, {} in {:.2} s",
                 p.scenario,
                 p.algorithm,
+                p.mode,
                 p.seed,
                 p.fitness,
                 if p.feasible { "feasible" } else { "infeasible" },
                 p.runtime_s
             );
         },
-    );
+    )?;
     if stop.load(std::sync::atomic::Ordering::Relaxed) {
         eprintln!("interrupted: the table has only the cells completed before Ctrl-C");
     }

@@ -72,7 +72,7 @@ fn open(args: &AgentArgs, shutdown: &AtomicBool) -> anyhow::Result<Option<Sessio
                     return Ok(None);
                 }
                 waited += Duration::from_millis(100);
-                if waited.as_millis() % 10_000 == 0 {
+                if waited.as_millis().is_multiple_of(10_000) {
                     tracing::info!(
                         "waiting for the coordinator at {} ({} s so far)",
                         args.connect.join(", "),
