@@ -27,6 +27,9 @@ pub enum Command {
     Compare(crate::compare::CompareArgs),
     /// Write a random fleet scenario of any size (for scaling runs).
     Generate(crate::generate::GenerateArgs),
+    /// Run only a Zenoh router (what `zenohd` does) until Ctrl-C: a hub that outlives missions,
+    /// so several coordinators (`plan --router`) and one set of agents can share it.
+    Router(RouterArgs),
 }
 
 /// `shoal-coordinator plan`.
@@ -88,4 +91,17 @@ pub struct PlanArgs {
     /// Distributed mode: the shoal-agent binary for embedded agents (default: next to this one).
     #[arg(long, env = "SHOAL_AGENT_BIN")]
     pub agent_bin: Option<PathBuf>,
+}
+
+/// `shoal-coordinator router`.
+#[derive(Debug, Clone, clap::Args)]
+pub struct RouterArgs {
+    /// Endpoint(s) to listen on (comma-separated).
+    #[arg(
+        long,
+        env = "SHOAL_LISTEN",
+        value_delimiter = ',',
+        default_value = "tcp/0.0.0.0:7447"
+    )]
+    pub listen: Vec<String>,
 }

@@ -34,6 +34,10 @@ pub fn run(command: Command, shutdown: Arc<AtomicBool>) -> anyhow::Result<i32> {
     match command {
         Command::Plan(args) => plan_command(&args, shutdown),
         Command::Compare(args) => compare_command(&args, &shutdown),
+        Command::Router(args) => {
+            distributed::network::serve_router(&args.listen, &shutdown)?;
+            Ok(EXIT_FEASIBLE)
+        }
         Command::Generate(args) => {
             generate::generate(&args)?;
             say(&format!("Wrote {}\n", args.out.display()));

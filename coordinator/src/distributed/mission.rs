@@ -130,6 +130,10 @@ pub fn run(
         let n = round_iterations(o.iterations, o.exchange_every, round);
         r.collect(round as u32, iteration, &context, local.as_deref_mut())?;
         for seat in &mut r.seats {
+            // An agent lost after it sent this round's elites is planned here from the next.
+            if seat.this_round.is_some() {
+                continue;
+            }
             if let Some(f) = &mut seat.local {
                 for k in 0..n {
                     f.step(Progress {
@@ -376,6 +380,15 @@ impl Run<'_> {
         )
     }
 
+    /// Vehicle `i`'s agent is gone: plan it here from now on, unless it had already run every
+    /// iteration (an agent may leave once its share is done, e.g. with `--once`).
+    fn lost(&mut self, i: usize, round: u32, iteration: usize, context: &Context, why: String) {
+        self.seats[i].alive = false;
+        if (self.seats[i].agent_iterations as usize) < self.scenario.optimizer.iterations {
+            self.degrade(i, round, iteration, context, why);
+        }
+    }
+
     /// Plans vehicle `i` here from now on.
     fn degrade(&mut self, i: usize, round: u32, iteration: usize, context: &Context, why: String) {
         if self.seats[i].local.is_some() {
@@ -424,7 +437,7 @@ impl Run<'_> {
                 for (v, status) in agents.exited() {
                     if let Some(i) = self.index(&v) {
                         let why = format!("its agent process exited ({status})");
-                        self.degrade(i, round, iteration, context, why);
+                        self.lost(i, round, iteration, context, why);
                     }
                 }
             }
@@ -470,17 +483,16 @@ impl Run<'_> {
                 })) => {
                     if let Some(i) = self.index(&vehicle) {
                         self.seats[i].done = Some((iterations, evaluations, dropped));
-                        // After its last round an agent is done at once; before, it gave up.
-                        if (iterations as usize) < self.scenario.optimizer.iterations {
-                            let why = "its agent ended the mission early (shut down or lost the coordinator)";
-                            self.degrade(i, round, iteration, context, why.into());
-                        }
+                        self.seats[i].agent_iterations = iterations;
+                        let why =
+                            "its agent ended the mission early (shut down or lost the coordinator)";
+                        self.lost(i, round, iteration, context, why.into());
                     }
                 }
                 Some(Event::Gone(v)) => {
                     if let Some(i) = self.index(&v) {
-                        let why = "its agent left the network (liveliness token gone)".to_string();
-                        self.degrade(i, round, iteration, context, why);
+                        let why = "its agent left the network (liveliness token gone)";
+                        self.lost(i, round, iteration, context, why.to_string());
                     }
                 }
                 Some(Event::Alive(_)) | Some(Event::Message(AgentToCoordinator::Joined { .. })) => {

@@ -223,6 +223,25 @@ impl Network {
     }
 }
 
+/// Runs a bare router on `listen` until `shutdown` is raised (`shoal-coordinator router`).
+pub fn serve_router(
+    listen: &[String],
+    shutdown: &std::sync::atomic::AtomicBool,
+) -> anyhow::Result<()> {
+    let config = session::router_config(listen, &[])?;
+    let session = zenoh::open(config)
+        .wait()
+        .map_err(|e| anyhow::anyhow!("cannot open a Zenoh router on {}: {e}", listen.join(", ")))?;
+    eprintln!("router listening on {}; Ctrl-C to stop", listen.join(", "));
+    while !shutdown.load(std::sync::atomic::Ordering::Relaxed) {
+        std::thread::sleep(POLL);
+    }
+    if let Err(e) = session.close().wait() {
+        tracing::warn!("closing the router: {e}");
+    }
+    Ok(())
+}
+
 /// `tcp/HOST:0` → `tcp/HOST:<a port free right now>`; other endpoints unchanged. (Zenoh 1.10
 /// reports the bound port only through an unstable API, and agents need to know it.)
 fn resolve_port_zero(endpoint: &str) -> anyhow::Result<String> {

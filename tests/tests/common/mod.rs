@@ -1,5 +1,6 @@
-//! Helpers shared by the end-to-end tests of `shoal-coordinator plan --in-process`: run the real
-//! binary on a real scenario, then check `plan.json` with the independent checker of this crate.
+//! Helpers shared by the end-to-end tests of `shoal-coordinator plan`: run the real binary on a
+//! real scenario (in process here, distributed with real agents through [`fleet`]), then check
+//! `plan.json` with the independent checker of this crate.
 //!
 //! CLI contract under test:
 //! `shoal-coordinator plan <SCENARIO.toml> --in-process --out <DIR> [--seed N]
@@ -10,6 +11,7 @@
 //! Every test file compiles its own copy of this module and uses only part of it.
 #![allow(dead_code)]
 
+pub mod fleet;
 mod process;
 
 use std::error::Error;
@@ -19,7 +21,7 @@ use std::process::Command;
 use serde_json::Value;
 use shoal_tests::{check, geometry, parse_plan};
 
-pub use process::{coordinator, root, Run};
+pub use process::{agent, coordinator, root, Run};
 use process::{run, RUN_TIMEOUT};
 
 pub type TestResult = Result<(), Box<dyn Error>>;
@@ -34,12 +36,7 @@ pub fn scenario(name: &str) -> PathBuf {
 /// `shoal-coordinator plan <scenario> --in-process --out <out> <extra...>`.
 pub fn plan(scenario: &Path, out: &Path, extra: &[&str]) -> Run {
     let mut cmd = Command::new(coordinator());
-    // Every flag has a SHOAL_* environment fallback: keep the caller's environment out.
-    for (k, _) in std::env::vars_os() {
-        if k.to_string_lossy().starts_with("SHOAL_") {
-            cmd.env_remove(k);
-        }
-    }
+    without_shoal_env(&mut cmd);
     cmd.current_dir(root())
         .arg("plan")
         .arg(scenario)
@@ -50,10 +47,28 @@ pub fn plan(scenario: &Path, out: &Path, extra: &[&str]) -> Run {
     run(cmd, RUN_TIMEOUT)
 }
 
-/// Runs a plan that must succeed (exit 0 or 3) and checks it end to end; returns the plan JSON.
+/// Every flag has a SHOAL_* environment fallback: keeps the caller's environment out of `cmd`.
+pub fn without_shoal_env(cmd: &mut Command) {
+    for (k, _) in std::env::vars_os() {
+        if k.to_string_lossy().starts_with("SHOAL_") {
+            cmd.env_remove(k);
+        }
+    }
+}
+
+/// Runs an in-process plan that must succeed (exit 0 or 3) and checks it end to end (see
+/// [`check_plan_run`]); returns the plan JSON.
 pub fn plan_and_check(name: &str, out: &Path, extra: &[&str]) -> Result<Value, Box<dyn Error>> {
+    let r = plan(&scenario(name), out, extra);
+    check_plan_run(name, out, &r)
+}
+
+/// Checks a finished plan run `r` of scenario `name` that wrote into `out`, however it was
+/// planned: exit 0 or 3, and exactly 0 when the plan is feasible; every violation printed; a
+/// summary on stdout; the independent checker agrees with `plan.json`; exact and sampled
+/// separations agree; `plan.svg` is an SVG. Returns the plan JSON.
+pub fn check_plan_run(name: &str, out: &Path, r: &Run) -> Result<Value, Box<dyn Error>> {
     let scenario_path = scenario(name);
-    let r = plan(&scenario_path, out, extra);
     let code = r.code();
     assert!(
         code == Some(0) || code == Some(3),

@@ -1,6 +1,6 @@
 //! Child processes for the end-to-end tests: running a command with a time limit while draining
-//! its output, and locating (and building, once per test process) the `shoal-coordinator` binary
-//! of the profile the tests run in.
+//! its output, and locating (and building, once per test process) the `shoal-coordinator` and
+//! `shoal-agent` binaries of the profile the tests run in.
 
 use std::fmt;
 use std::io::Read;
@@ -119,18 +119,37 @@ pub fn root() -> PathBuf {
 
 /// `target/<profile>/shoal-coordinator`, built once per test process.
 ///
-/// The directory is the parent of the `deps` directory this test executable lives in. The binary
-/// is (re)built with `cargo build -p shoal-coordinator` in the same profile so that a stale binary
-/// from an earlier build is never tested; this is a no-op when it is up to date.
+/// The directory is the parent of the `deps` directory this test executable lives in. The
+/// binaries are (re)built with `cargo build -p shoal-coordinator -p shoal-agent` in the same
+/// profile so that a stale binary from an earlier build is never tested; this is a no-op when
+/// they are up to date.
 pub fn coordinator() -> &'static Path {
-    static BIN: OnceLock<Result<PathBuf, String>> = OnceLock::new();
+    &binaries().coordinator
+}
+
+/// `target/<profile>/shoal-agent`, built together with [`coordinator`] (the coordinator finds
+/// it there when it starts its own agents).
+pub fn agent() -> &'static Path {
+    &binaries().agent
+}
+
+/// The two binaries under test.
+pub struct Binaries {
+    /// `shoal-coordinator`.
+    pub coordinator: PathBuf,
+    /// `shoal-agent`.
+    pub agent: PathBuf,
+}
+
+fn binaries() -> &'static Binaries {
+    static BIN: OnceLock<Result<Binaries, String>> = OnceLock::new();
     match BIN.get_or_init(locate_and_build) {
-        Ok(p) => p,
+        Ok(b) => b,
         Err(e) => panic!("{e}"),
     }
 }
 
-fn locate_and_build() -> Result<PathBuf, String> {
+fn locate_and_build() -> Result<Binaries, String> {
     let exe =
         std::env::current_exe().map_err(|e| format!("cannot find the test executable: {e}"))?;
     let deps = exe
@@ -142,14 +161,18 @@ fn locate_and_build() -> Result<PathBuf, String> {
     } else {
         deps
     };
-    let bin = profile_dir.join(format!("shoal-coordinator{}", std::env::consts::EXE_SUFFIX));
+    let bin = |name: &str| profile_dir.join(format!("{name}{}", std::env::consts::EXE_SUFFIX));
     let mut cmd = Command::new(env!("CARGO"));
     cmd.current_dir(root()).args([
         "build",
         "-p",
         "shoal-coordinator",
+        "-p",
+        "shoal-agent",
         "--bin",
         "shoal-coordinator",
+        "--bin",
+        "shoal-agent",
     ]);
     match profile_dir.file_name().and_then(|n| n.to_str()) {
         Some("debug") | None => {}
@@ -162,13 +185,21 @@ fn locate_and_build() -> Result<PathBuf, String> {
     }
     let build = run(cmd, BUILD_TIMEOUT);
     if !build.status.success() {
-        return Err(format!("building shoal-coordinator failed:\n{build}"));
-    }
-    if !bin.is_file() {
         return Err(format!(
-            "cargo build succeeded but {} does not exist (is CARGO_TARGET_DIR or --target different from this test's?)\n{build}",
-            bin.display()
+            "building shoal-coordinator and shoal-agent failed:\n{build}"
         ));
     }
-    Ok(bin)
+    let binaries = Binaries {
+        coordinator: bin("shoal-coordinator"),
+        agent: bin("shoal-agent"),
+    };
+    for b in [&binaries.coordinator, &binaries.agent] {
+        if !b.is_file() {
+            return Err(format!(
+                "cargo build succeeded but {} does not exist (is CARGO_TARGET_DIR or --target different from this test's?)\n{build}",
+                b.display()
+            ));
+        }
+    }
+    Ok(binaries)
 }
