@@ -64,7 +64,14 @@ struct Seat {
     elites_received: u32,
     agent_iterations: u32,
     done: Option<(u32, u64, u32)>,
+    /// When and why its agent was seen to go (token gone, process exited).
+    gone: Option<(Instant, String)>,
 }
+
+/// How long a vehicle whose agent was seen to go keeps its seat: Zenoh sends declarations
+/// (the liveliness token's end) ahead of queued data, so an agent that leaves right after its
+/// last elites can be "gone" before they arrive, and an agent whose link blinked may be back.
+const GONE_GRACE: Duration = Duration::from_secs(1);
 
 /// Everything the loop shares.
 struct Run<'a> {
@@ -106,6 +113,7 @@ pub fn run(
             elites_received: 0,
             agent_iterations: 0,
             done: None,
+            gone: None,
         })
         .collect();
     let mut r = Run {
@@ -380,13 +388,19 @@ impl Run<'_> {
         )
     }
 
-    /// Vehicle `i`'s agent is gone: plan it here from now on, unless it had already run every
-    /// iteration (an agent may leave once its share is done, e.g. with `--once`).
-    fn lost(&mut self, i: usize, round: u32, iteration: usize, context: &Context, why: String) {
-        self.seats[i].alive = false;
-        if (self.seats[i].agent_iterations as usize) < self.scenario.optimizer.iterations {
-            self.degrade(i, round, iteration, context, why);
+    /// Vehicle `i`'s agent was seen to go: after [`GONE_GRACE`] without its elites it is
+    /// planned here (see [`Run::collect`]).
+    fn lost(&mut self, i: usize, why: String) {
+        let seat = &mut self.seats[i];
+        seat.alive = false;
+        if seat.gone.is_none() {
+            seat.gone = Some((Instant::now(), why));
         }
+    }
+
+    /// Whether vehicle `i`'s agent ran every iteration (it may then leave, e.g. with `--once`).
+    fn finished(&self, i: usize) -> bool {
+        self.seats[i].agent_iterations as usize >= self.scenario.optimizer.iterations
     }
 
     /// Plans vehicle `i` here from now on.
@@ -436,8 +450,19 @@ impl Run<'_> {
             if let Some(agents) = local.as_deref_mut() {
                 for (v, status) in agents.exited() {
                     if let Some(i) = self.index(&v) {
-                        let why = format!("its agent process exited ({status})");
-                        self.lost(i, round, iteration, context, why);
+                        self.lost(i, format!("its agent process exited ({status})"));
+                    }
+                }
+            }
+            for &i in &waiting {
+                let expired = self.seats[i]
+                    .gone
+                    .as_ref()
+                    .filter(|(since, _)| since.elapsed() >= GONE_GRACE)
+                    .map(|(_, why)| why.clone());
+                if let Some(why) = expired {
+                    if !self.finished(i) {
+                        self.degrade(i, round, iteration, context, why);
                     }
                 }
             }
@@ -484,19 +509,25 @@ impl Run<'_> {
                     if let Some(i) = self.index(&vehicle) {
                         self.seats[i].done = Some((iterations, evaluations, dropped));
                         self.seats[i].agent_iterations = iterations;
-                        let why =
-                            "its agent ended the mission early (shut down or lost the coordinator)";
-                        self.lost(i, round, iteration, context, why.into());
+                        if !self.finished(i) {
+                            let why = "its agent ended the mission early (shut down or lost the coordinator)";
+                            self.degrade(i, round, iteration, context, why.into());
+                        }
                     }
                 }
                 Some(Event::Gone(v)) => {
                     if let Some(i) = self.index(&v) {
                         let why = "its agent left the network (liveliness token gone)";
-                        self.lost(i, round, iteration, context, why.to_string());
+                        self.lost(i, why.to_string());
                     }
                 }
-                Some(Event::Alive(_)) | Some(Event::Message(AgentToCoordinator::Joined { .. })) => {
+                Some(Event::Alive(v)) => {
+                    if let Some(i) = self.index(&v) {
+                        self.seats[i].gone = None;
+                        self.seats[i].alive = true;
+                    }
                 }
+                Some(Event::Message(AgentToCoordinator::Joined { .. })) => {}
                 None => {}
             }
         }
