@@ -43,6 +43,7 @@ fn main() -> Result<(), Box<dyn std::error::Error + Send + Sync>> {
         vehicle: "auv1".into(),
         round: 7,
         iteration: 8,
+        evaluations: 4000,
         particles: vec![chromosome(0); per_agent],
     }))?;
     let migrants = codec::encode(&Envelope::new(CoordinatorToAgent::Migrants {

@@ -118,6 +118,7 @@ pub fn run(
             vehicle: a.vehicle.clone(),
             round: round as u32,
             iteration: iteration as u32,
+            evaluations: followers.evaluations,
             particles: followers
                 .emigrants()
                 .iter()

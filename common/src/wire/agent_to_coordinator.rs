@@ -18,6 +18,8 @@ pub enum AgentToCoordinator {
         round: u32,
         /// Iterations the agent has run.
         iteration: u32,
+        /// Cost evaluations its followers have made so far.
+        evaluations: u64,
         /// The chromosomes, one per follower population.
         particles: Vec<WireChromosome>,
     },

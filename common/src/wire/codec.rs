@@ -147,6 +147,7 @@ mod tests {
             vehicle: "auv1".into(),
             round: 0,
             iteration: 0,
+            evaluations: 0,
             particles: vec![WireChromosome {
                 x: vec![0.0; 600_000],
                 v: vec![],
@@ -172,7 +173,7 @@ mod tests {
             it in 0u32..10_000,
         ) {
             let up = Envelope::new(AgentToCoordinator::Elites {
-                mission: mission.clone(), vehicle: "auv1".into(), round: it, iteration: it, particles: particles.clone(),
+                mission: mission.clone(), vehicle: "auv1".into(), round: it, iteration: it, evaluations: 7, particles: particles.clone(),
             });
             prop_assert_eq!(decode::<AgentToCoordinator>(&encode(&up).map_err(|e| TestCaseError::fail(e.to_string()))?), Ok(up));
             let down = Envelope::new(CoordinatorToAgent::Context {

@@ -63,6 +63,8 @@ struct Seat {
     this_round: Option<Vec<Chromosome>>,
     elites_received: u32,
     agent_iterations: u32,
+    /// Evaluations the agent last reported.
+    agent_evaluations: u64,
     done: Option<(u32, u64, u32)>,
     /// When and why its agent was seen to go (token gone, process exited).
     gone: Option<(Instant, String)>,
@@ -112,6 +114,7 @@ pub fn run(
             this_round: None,
             elites_received: 0,
             agent_iterations: 0,
+            agent_evaluations: 0,
             done: None,
             gone: None,
         })
@@ -210,7 +213,11 @@ pub fn run(
     let agents_evaluations: u64 = r
         .seats
         .iter()
-        .map(|s| s.done.map_or(0, |d| d.1) + s.local.as_ref().map_or(0, |f| f.evaluations))
+        .map(|s| {
+            s.done
+                .map_or(s.agent_evaluations, |d| d.1.max(s.agent_evaluations))
+                + s.local.as_ref().map_or(0, |f| f.evaluations)
+        })
         .sum();
     let figures = DistributedFigures {
         mission: r.mission.clone(),
@@ -331,6 +338,7 @@ impl Run<'_> {
                     vehicle,
                     round: 0,
                     iteration,
+                    evaluations,
                     particles,
                     ..
                 })) => {
@@ -339,6 +347,7 @@ impl Run<'_> {
                         seat.joined = true;
                         seat.elites_received += 1;
                         seat.agent_iterations = iteration;
+                        seat.agent_evaluations = evaluations;
                         seat.this_round =
                             Some(particles.into_iter().map(Chromosome::from).collect());
                     }
@@ -482,6 +491,7 @@ impl Run<'_> {
                     vehicle,
                     round: r,
                     iteration: it,
+                    evaluations,
                     particles,
                     ..
                 })) => {
@@ -497,6 +507,7 @@ impl Run<'_> {
                     }
                     seat.elites_received += 1;
                     seat.agent_iterations = it;
+                    seat.agent_evaluations = evaluations;
                     seat.this_round = Some(particles.into_iter().map(Chromosome::from).collect());
                 }
                 Some(Event::Message(AgentToCoordinator::Done {
