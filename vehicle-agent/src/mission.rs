@@ -99,14 +99,14 @@ pub fn run(
     let mut latest = a.context;
     let mut elites_sent = 0;
     let mut iteration = 0usize;
-    let total_rounds = rounds(o.iterations, o.exchange_every);
+    let total_rounds = rounds(o.iterations, o.distributed.exchange_every);
     let mut outcome = "complete".to_string();
     for round in 0..total_rounds {
         if stop.load(Ordering::Relaxed) {
             outcome = "the agent is shutting down".into();
             break;
         }
-        for _ in 0..round_iterations(o.iterations, o.exchange_every, round) {
+        for _ in 0..round_iterations(o.iterations, o.distributed.exchange_every, round) {
             followers.step(Progress {
                 iteration,
                 max_iterations: o.iterations,

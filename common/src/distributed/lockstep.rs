@@ -55,12 +55,12 @@ pub fn run(
     let mut interrupted = false;
     // The best plan improved since the followers' context was last set.
     let mut stale = false;
-    for round in 0..rounds(o.iterations, o.exchange_every) {
+    for round in 0..rounds(o.iterations, o.distributed.exchange_every) {
         if stop.is_some_and(|s| s.load(Ordering::Relaxed)) {
             interrupted = true;
             break;
         }
-        for _ in 0..round_iterations(o.iterations, o.exchange_every, round) {
+        for _ in 0..round_iterations(o.iterations, o.distributed.exchange_every, round) {
             let progress = Progress {
                 iteration,
                 max_iterations: o.iterations,
@@ -135,9 +135,10 @@ mod tests {
         s.optimizer.particles = 15;
         s.optimizer.leader_particles = 4;
         s.optimizer.iterations = 40;
+        s.optimizer.distributed.exchange_every = 4;
         let mut seen = 0;
         let out = run(&s, None, &mut |r| seen = r.iteration);
-        assert_eq!((seen, out.convergence.len(), out.exchanges), (40, 40, 40));
+        assert_eq!((seen, out.convergence.len(), out.exchanges), (40, 40, 10));
         assert!(out.convergence.windows(2).all(|w| w[1] <= w[0]));
         let model = FleetModel::new(&s);
         let e = model.evaluate(&out.best_x);

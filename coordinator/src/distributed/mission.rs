@@ -128,7 +128,7 @@ pub fn run(
         mission: mission.to_string(),
     };
     r.join(&context, local.as_deref_mut(), stop)?;
-    let total_rounds = rounds(o.iterations, o.exchange_every);
+    let total_rounds = rounds(o.iterations, o.distributed.exchange_every);
     let mut convergence = Vec::with_capacity(o.iterations);
     let mut iteration = 0usize;
     let mut stale = false;
@@ -138,7 +138,7 @@ pub fn run(
             interrupted = true;
             break;
         }
-        let n = round_iterations(o.iterations, o.exchange_every, round);
+        let n = round_iterations(o.iterations, o.distributed.exchange_every, round);
         r.collect(round as u32, iteration, &context, local.as_deref_mut())?;
         for seat in &mut r.seats {
             // An agent lost after it sent this round's elites is planned here from the next.
