@@ -23,6 +23,8 @@ use shoal_common::wire::agent_to_coordinator::AgentToCoordinator;
 use shoal_common::wire::coordinator_to_agent::CoordinatorToAgent;
 use shoal_common::wire::{WireChromosome, WireContext};
 
+mod join;
+
 use super::agents::LocalAgents;
 use super::network::{Event, Network};
 use crate::planner::RunResult;
@@ -273,127 +275,6 @@ impl Run<'_> {
                 scenario_toml: toml::to_string(self.scenario)?,
                 context: WireContext::new(context, &ids),
             },
-        )
-    }
-
-    /// Waits until every vehicle's agent is up and has accepted the mission, re-sending the
-    /// assignment every second (a message sent just as a subscriber appears can be lost).
-    fn join(
-        &mut self,
-        context: &Context,
-        mut local: Option<&mut LocalAgents>,
-        stop: &AtomicBool,
-    ) -> anyhow::Result<()> {
-        let deadline = Instant::now() + self.timing.join;
-        let mut resend = Instant::now();
-        while self.seats.iter().any(|s| !s.joined) {
-            if stop.load(Ordering::Relaxed) {
-                anyhow::bail!("interrupted while waiting for the agents to join");
-            }
-            if let Some(agents) = local.as_deref_mut() {
-                if let Some((v, status)) = agents.exited().into_iter().next() {
-                    anyhow::bail!("the agent of {v} exited before joining ({status}); see its log");
-                }
-            }
-            let now = Instant::now();
-            if now >= deadline {
-                return Err(self.join_error());
-            }
-            if now >= resend {
-                for i in 0..self.seats.len() {
-                    if self.seats[i].alive && !self.seats[i].joined {
-                        self.assign(i, context)?;
-                    }
-                }
-                resend = now + Duration::from_secs(1);
-            }
-            match self
-                .net
-                .next(deadline.min(resend).min(now + super::network::POLL))
-            {
-                Some(Event::Alive(v)) => {
-                    if let Some(i) = self.index(&v) {
-                        self.seats[i].alive = true;
-                        self.assign(i, context)?;
-                    }
-                }
-                Some(Event::Gone(v)) => {
-                    if let Some(i) = self.index(&v) {
-                        self.seats[i].alive = false;
-                        self.seats[i].joined = false;
-                    }
-                }
-                Some(Event::Message(AgentToCoordinator::Joined { vehicle, .. })) => {
-                    if let Some(i) = self.index(&vehicle) {
-                        if !self.seats[i].joined {
-                            tracing::info!("the agent of {vehicle} joined");
-                        }
-                        self.seats[i].joined = true;
-                        self.seats[i].alive = true;
-                    }
-                }
-                // An agent plans as soon as it joins: its first elites can come before the
-                // last agent has joined. Keep them for round 0.
-                Some(Event::Message(AgentToCoordinator::Elites {
-                    vehicle,
-                    round: 0,
-                    iteration,
-                    evaluations,
-                    particles,
-                    ..
-                })) => {
-                    if let Some(i) = self.index(&vehicle) {
-                        let seat = &mut self.seats[i];
-                        seat.joined = true;
-                        seat.elites_received += 1;
-                        seat.agent_iterations = iteration;
-                        seat.agent_evaluations = evaluations;
-                        seat.this_round =
-                            Some(particles.into_iter().map(Chromosome::from).collect());
-                    }
-                }
-                Some(Event::Message(m)) => self.net.out_of_turn(&format!(
-                    "{} sent a message out of turn while the fleet was joining",
-                    m.vehicle()
-                )),
-                None => {}
-            }
-        }
-        Ok(())
-    }
-
-    fn join_error(&self) -> anyhow::Error {
-        let missing: Vec<&str> = self
-            .seats
-            .iter()
-            .filter(|s| !s.alive)
-            .map(|s| s.id.as_str())
-            .collect();
-        let silent: Vec<&str> = self
-            .seats
-            .iter()
-            .filter(|s| s.alive && !s.joined)
-            .map(|s| s.id.as_str())
-            .collect();
-        let mut parts = Vec::new();
-        if !missing.is_empty() {
-            parts.push(format!(
-                "no agent joined for vehicle(s) {} (start one per vehicle: shoal-agent --vehicle <ID> --connect {})",
-                missing.join(", "),
-                self.net.endpoints.join(",")
-            ));
-        }
-        if !silent.is_empty() {
-            parts.push(format!(
-                "the agent(s) of {} are up but did not accept mission {}",
-                silent.join(", "),
-                self.mission
-            ));
-        }
-        anyhow::anyhow!(
-            "{} within {:.0} s",
-            parts.join("; "),
-            self.timing.join.as_secs_f64()
         )
     }
 
