@@ -7,6 +7,7 @@ pub mod distributed;
 mod fixtures;
 pub mod fleet;
 pub mod geometry;
+pub mod health;
 pub mod plan;
 pub mod scenario;
 pub mod separation;

@@ -30,6 +30,8 @@ pub enum Command {
     /// Run only a Zenoh router (what `zenohd` does) until Ctrl-C: a hub that outlives missions,
     /// so several coordinators (`plan --router`) and one set of agents can share it.
     Router(RouterArgs),
+    /// Container healthcheck: exit 0 if the health file was rewritten in the last 10 s.
+    Health(HealthArgs),
 }
 
 /// `shoal-coordinator plan`.
@@ -91,6 +93,10 @@ pub struct PlanArgs {
     /// Distributed mode: the shoal-agent binary for embedded agents (default: next to this one).
     #[arg(long, env = "SHOAL_AGENT_BIN")]
     pub agent_bin: Option<PathBuf>,
+    /// Distributed mode: rewrite this file every 2 s while the router is open (for container
+    /// healthchecks: `shoal-coordinator health`).
+    #[arg(long, env = "SHOAL_HEALTH_FILE")]
+    pub health_file: Option<PathBuf>,
 }
 
 /// `shoal-coordinator router`.
@@ -104,4 +110,12 @@ pub struct RouterArgs {
         default_value = "tcp/0.0.0.0:7447"
     )]
     pub listen: Vec<String>,
+}
+
+/// `shoal-coordinator health`.
+#[derive(Debug, Clone, clap::Args)]
+pub struct HealthArgs {
+    /// The health file `plan --health-file` rewrites.
+    #[arg(long, env = "SHOAL_HEALTH_FILE")]
+    pub file: PathBuf,
 }

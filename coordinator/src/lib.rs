@@ -34,6 +34,11 @@ pub fn run(command: Command, shutdown: Arc<AtomicBool>) -> anyhow::Result<i32> {
     match command {
         Command::Plan(args) => plan_command(&args, shutdown),
         Command::Compare(args) => compare_command(&args, &shutdown),
+        Command::Health(args) => {
+            shoal_common::health::check(&args.file, std::time::Duration::from_secs(10))
+                .map_err(anyhow::Error::msg)?;
+            Ok(EXIT_FEASIBLE)
+        }
         Command::Router(args) => {
             distributed::network::serve_router(&args.listen, &shutdown)?;
             Ok(EXIT_FEASIBLE)
@@ -76,6 +81,7 @@ fn compare_command(args: &compare::CompareArgs, stop: &AtomicBool) -> anyhow::Re
         round_timeout: std::time::Duration::from_secs(10),
         agent_bin: None,
         log_dir: std::env::temp_dir().join("shoal-compare-logs"),
+        health_file: None,
     });
     let cells = compare::compare(
         &scenarios,
@@ -168,6 +174,7 @@ pub fn distributed_options(
         round_timeout: seconds("--round-timeout (SHOAL_ROUND_TIMEOUT)", args.round_timeout)?,
         agent_bin: args.agent_bin.clone(),
         log_dir: args.out.join("logs"),
+        health_file: args.health_file.clone(),
     })
 }
 

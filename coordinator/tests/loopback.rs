@@ -49,6 +49,7 @@ fn options(mission: &str, endpoint: &str, join_s: u64) -> DistributedOptions {
         round_timeout: Duration::from_secs(10),
         agent_bin: None,
         log_dir: std::env::temp_dir(),
+        health_file: None,
     }
 }
 
@@ -66,6 +67,8 @@ fn agent(vehicle: &str, endpoint: &str) -> Agent {
         once: true,
         threads: 1,
         idle_timeout: 10.0,
+        health_file: None,
+        health_check: false,
     };
     let flag = Arc::clone(&stop);
     Agent {

@@ -41,6 +41,14 @@ pub struct AgentArgs {
     /// Abandon a mission whose coordinator has been silent this long, seconds.
     #[arg(long, env = "SHOAL_IDLE_TIMEOUT", default_value_t = 30.0)]
     pub idle_timeout: f64,
+    /// Rewrite this file every 2 s while the agent serves (connected or waiting for a
+    /// coordinator), for container healthchecks.
+    #[arg(long, env = "SHOAL_HEALTH_FILE")]
+    pub health_file: Option<std::path::PathBuf>,
+    /// Do not run: exit 0 if the health file was rewritten in the last 10 s, else 1 (the
+    /// container healthcheck).
+    #[arg(long)]
+    pub health_check: bool,
 }
 
 impl AgentArgs {
@@ -50,8 +58,17 @@ impl AgentArgs {
     }
 }
 
+/// Oldest a health file may be for `--health-check` to pass.
+pub const HEALTH_MAX_AGE: Duration = Duration::from_secs(10);
+
 /// Runs the agent until `shutdown` is raised (or, with `--once`, until its first mission ends).
 pub fn run(args: AgentArgs, shutdown: Arc<AtomicBool>) -> anyhow::Result<()> {
+    if args.health_check {
+        let Some(file) = &args.health_file else {
+            anyhow::bail!("--health-check needs --health-file (SHOAL_HEALTH_FILE)");
+        };
+        return shoal_common::health::check(file, HEALTH_MAX_AGE).map_err(anyhow::Error::msg);
+    }
     shoal_common::wire::topics::check_id("vehicle", &args.vehicle)?;
     if !(args.idle_timeout.is_finite() && args.idle_timeout > 0.0) {
         anyhow::bail!(

@@ -116,6 +116,12 @@ pub fn serve(args: &AgentArgs, shutdown: &AtomicBool) -> anyhow::Result<()> {
         "agent for {vehicle}: connecting to {}",
         args.connect.join(", ")
     );
+    // Healthy = serving: waiting for a coordinator is part of the job (between missions no
+    // coordinator runs), so the file beats from the start.
+    let _health = args
+        .health_file
+        .as_deref()
+        .map(shoal_common::health::Heartbeat::start);
     let Some(session) = open(args, shutdown)? else {
         return Ok(());
     };

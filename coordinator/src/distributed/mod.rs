@@ -51,6 +51,8 @@ pub struct DistributedOptions {
     pub agent_bin: Option<PathBuf>,
     /// Where embedded agents write their logs.
     pub log_dir: PathBuf,
+    /// Rewritten every 2 s while the router is open (container healthchecks).
+    pub health_file: Option<PathBuf>,
 }
 
 /// A mission id for `scenario` unique enough for one network: its name, this process and the
@@ -94,6 +96,10 @@ pub fn plan_distributed(
     let ids: Vec<String> = scenario.vehicles.iter().map(|v| v.id.clone()).collect();
     let mut net =
         network::Network::open(&options.listen, &options.routers, &options.mission, &ids)?;
+    let health = options
+        .health_file
+        .as_deref()
+        .map(shoal_common::health::Heartbeat::start);
     tracing::info!(
         mission = %options.mission,
         "coordinator listening on {}",
@@ -136,6 +142,7 @@ pub fn plan_distributed(
     );
     drop(local);
     net.close();
+    drop(health);
     let (run, figures) = outcome?;
     let model = FleetModel::new(scenario);
     let mut plan = to_plan(scenario, &model, run, "distributed");
