@@ -1,7 +1,9 @@
 //! Shoal's shared model and algorithms: scenarios, geometry, timed trajectories, the fleet
 //! fitness of seed 004 and the swarm optimizers.
 
+pub mod bspline;
 pub mod cost;
+pub mod crawler;
 pub mod distributed;
 #[cfg(test)]
 mod fixtures;
@@ -12,6 +14,7 @@ pub mod plan;
 pub mod scenario;
 pub mod separation;
 pub mod swarm;
+pub mod terrain;
 pub mod trajectory;
 pub mod vehicle_problem;
 pub mod wire;

@@ -4,6 +4,7 @@
 //!
 //! A new variant (IPSO, EPA-PSO, DE-PSO…) is one file implementing [`Solver`].
 
+pub mod ipso;
 pub mod multi;
 pub mod parallel;
 pub mod population;

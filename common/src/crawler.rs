@@ -1,0 +1,351 @@
+//! A deep-sea mining crawler's path on the seabed (seed 000 §2.3–2.4): the particle is the
+//! horizontal position of a few B-spline control points between the start and the goal; the
+//! path is the smoothed clamped cubic B-spline through [start, control points…, goal], sampled
+//! densely and draped on the terrain (z = seabed + sensor height). Every term below is computed
+//! on that smoothed path, never on the control polygon.
+//!
+//! Cost terms (eq. (5)–(11)):
+//! - `f_d`, path length, metres (eq. (5));
+//! - `f_u`, undulation: the sum of elevation differences between consecutive samples, metres
+//!   (eq. (6));
+//! - `f_e`, energy, kWh (eq. (7)): `t1 P1 + t2 P2 + (t1 + t2) P3` with the travel time
+//!   `t2 = length / speed` and the mining time `t1` such that mining is `mining_share` of the
+//!   whole time (§5.1: 60 % mining, 40 % travel, so `t1 = 1.5 t2`);
+//! - `f_s`, crawler slip (eq. (8)–(9)): for each hazard (slip rate > 0.5) `D = 1` closer than
+//!   `d_safe_min`, `0` from `d_safe_max` on, and linear in between. The printed eq. (9) has
+//!   `(d_real − d_min)/(d_max − d_min)`, which grows *away* from the hazard and jumps from 1 to
+//!   0 at `d_min`; the text ("the smaller D, the safer") asks for the decreasing ramp
+//!   `(d_max − d_real)/(d_max − d_min)`, which Shoal uses. `f_s` is the sum over hazards.
+//!
+//! Standardisation: the paper z-scores each term over the swarm (`(x − μ)/σ`), which makes a
+//! particle's cost depend on the other particles and change between iterations. Shoal divides
+//! each of `f_d`, `f_u`, `f_e` by its value on the straight start→goal line draped on the same
+//! terrain (so each is dimensionless and about 1), keeps `f_s` as it is (already in [0, 1] per
+//! hazard), and weighs them with ω = (0.5, 0.2, 0.2, 0.1) as §2.3.5 assigns them (length 0.5,
+//! undulation 0.2, slip 0.2, energy 0.1).
+//!
+//! Constraints, as penalties of weight `penalty_weight`: a sample inside a hazard's circle
+//! (`1 + depth / radius` per intruding leg) and a leg steeper than `max_slope_deg`
+//! (`1 + excess / limit`).
+
+use crate::bspline;
+use crate::geometry::Vec3;
+use crate::swarm::Problem;
+use crate::terrain::{hazard_clearance, Hazard, Terrain};
+
+/// Everything the crawler cost needs.
+#[derive(Debug, Clone)]
+pub struct CrawlerModel {
+    /// The seabed.
+    pub terrain: Terrain,
+    /// Soft-substrate zones (slip rate > 0.5).
+    pub hazards: Vec<Hazard>,
+    /// Start and goal in the horizontal plane, metres.
+    pub start: [f64; 2],
+    /// Goal.
+    pub goal: [f64; 2],
+    /// Horizontal box the control points stay in: min x, min y, max x, max y.
+    pub area: [f64; 4],
+    /// B-spline control points between start and goal (the particle has twice as many genes).
+    pub control_points: usize,
+    /// Samples of the smoothed path.
+    pub samples: usize,
+    /// Height of the path above the seabed, metres.
+    pub sensor_height_m: f64,
+    /// Travel speed, m/s (§5.1: 1 m/s).
+    pub speed_mps: f64,
+    /// P1 (collection), P2 (travel), P3 (control and perception), kW (§5.1: 90, 50, 5).
+    pub power_kw: [f64; 3],
+    /// Share of the mission time spent mining (§5.1: 0.6).
+    pub mining_share: f64,
+    /// `d_safe_min` and `d_safe_max` of eq. (9), metres from the hazard's edge.
+    pub safe_distance_m: [f64; 2],
+    /// Steepest slope the crawler may climb or descend, degrees.
+    pub max_slope_deg: f64,
+    /// ω1..ω4 for length, undulation, slip, energy.
+    pub weights: [f64; 4],
+    /// Weight of the constraint penalties.
+    pub penalty_weight: f64,
+}
+
+/// The raw terms of one path.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CrawlerTerms {
+    /// f_d, metres.
+    pub length_m: f64,
+    /// f_u, metres.
+    pub undulation_m: f64,
+    /// f_e, kWh.
+    pub energy_kwh: f64,
+    /// f_s, dimensionless.
+    pub slip: f64,
+    /// Smallest horizontal distance from the path to a hazard's edge, metres (negative inside).
+    pub min_hazard_clearance_m: f64,
+    /// Steepest leg, degrees.
+    pub max_slope_deg: f64,
+    /// Unweighted constraint penalty (0 when admissible).
+    pub penalty: f64,
+}
+
+impl CrawlerModel {
+    /// The smoothed path of a particle, draped on the terrain.
+    pub fn path(&self, genes: &[f64]) -> Vec<Vec3> {
+        let mut control = Vec::with_capacity(self.control_points + 2);
+        control.push(Vec3::new(self.start[0], self.start[1], 0.0));
+        for xy in genes.chunks_exact(2) {
+            control.push(Vec3::new(xy[0], xy[1], 0.0));
+        }
+        control.push(Vec3::new(self.goal[0], self.goal[1], 0.0));
+        bspline::sample(&control, 3, self.samples)
+            .into_iter()
+            .map(|p| {
+                Vec3::new(
+                    p.x,
+                    p.y,
+                    self.terrain.elevation(p.x, p.y) + self.sensor_height_m,
+                )
+            })
+            .collect()
+    }
+
+    /// Energy of a path of `length` metres, kWh (eq. (7)).
+    pub fn energy_kwh(&self, length: f64) -> f64 {
+        let t2 = length / self.speed_mps / 3600.0;
+        let t1 = t2 * self.mining_share / (1.0 - self.mining_share);
+        let [p1, p2, p3] = self.power_kw;
+        t1 * p1 + t2 * p2 + (t1 + t2) * p3
+    }
+
+    /// Slip of one hazard at horizontal clearance `d` from its edge (eq. (9), as read above).
+    pub fn slip_of(&self, d: f64) -> f64 {
+        let [lo, hi] = self.safe_distance_m;
+        if d < lo {
+            1.0
+        } else if d >= hi || hi <= lo {
+            0.0
+        } else {
+            (hi - d) / (hi - lo)
+        }
+    }
+
+    /// Every term of a draped path.
+    pub fn terms(&self, path: &[Vec3]) -> CrawlerTerms {
+        let length = bspline::polyline_length(path);
+        let undulation: f64 = path.windows(2).map(|w| (w[1].z - w[0].z).abs()).sum();
+        let mut slip = 0.0;
+        let mut clearance = f64::INFINITY;
+        let mut penalty = 0.0;
+        for h in &self.hazards {
+            let d = path
+                .windows(2)
+                .map(|w| hazard_clearance(h, [w[0].x, w[0].y], [w[1].x, w[1].y]))
+                .fold(f64::INFINITY, f64::min);
+            clearance = clearance.min(d);
+            slip += self.slip_of(d);
+            if d < 0.0 {
+                penalty += 1.0 + (-d / h.radius_m.max(1e-9)).min(1.0);
+            }
+        }
+        let mut steepest: f64 = 0.0;
+        for w in path.windows(2) {
+            let horizontal = ((w[1].x - w[0].x).powi(2) + (w[1].y - w[0].y).powi(2)).sqrt();
+            let slope = (w[1].z - w[0].z).abs().atan2(horizontal).to_degrees();
+            steepest = steepest.max(slope);
+            if slope > self.max_slope_deg {
+                penalty += 1.0 + (slope - self.max_slope_deg) / self.max_slope_deg;
+            }
+        }
+        CrawlerTerms {
+            length_m: length,
+            undulation_m: undulation,
+            energy_kwh: self.energy_kwh(length),
+            slip,
+            min_hazard_clearance_m: clearance,
+            max_slope_deg: steepest,
+            penalty,
+        }
+    }
+
+    /// The straight start→goal path's terms: the scales of the standardisation.
+    pub fn reference(&self) -> CrawlerTerms {
+        let n = self.control_points;
+        let genes: Vec<f64> = (1..=n)
+            .flat_map(|j| {
+                let f = j as f64 / (n + 1) as f64;
+                [
+                    self.start[0] + f * (self.goal[0] - self.start[0]),
+                    self.start[1] + f * (self.goal[1] - self.start[1]),
+                ]
+            })
+            .collect();
+        self.terms(&self.path(&genes))
+    }
+
+    /// Eq. (10) with the standardisation above, plus the weighted penalty.
+    pub fn cost_of(&self, t: &CrawlerTerms, reference: &CrawlerTerms) -> f64 {
+        let scale = |v: f64, r: f64| if r > 1e-12 { v / r } else { v };
+        let [w1, w2, w3, w4] = self.weights;
+        w1 * scale(t.length_m, reference.length_m)
+            + w2 * scale(t.undulation_m, reference.undulation_m)
+            + w3 * t.slip
+            + w4 * scale(t.energy_kwh, reference.energy_kwh)
+            + self.penalty_weight * t.penalty
+    }
+}
+
+/// The crawler model as a swarm problem: genes are `(x, y)` of each control point.
+#[derive(Debug, Clone)]
+pub struct CrawlerProblem {
+    /// The model.
+    pub model: CrawlerModel,
+    reference: CrawlerTerms,
+    lower: Vec<f64>,
+    upper: Vec<f64>,
+}
+
+impl CrawlerProblem {
+    /// The problem of `model` (the straight path's terms are computed once here).
+    pub fn new(model: CrawlerModel) -> CrawlerProblem {
+        let [x0, y0, x1, y1] = model.area;
+        let n = model.control_points;
+        CrawlerProblem {
+            reference: model.reference(),
+            lower: [x0, y0].repeat(n),
+            upper: [x1, y1].repeat(n),
+            model,
+        }
+    }
+
+    /// Terms of a particle.
+    pub fn terms(&self, genes: &[f64]) -> CrawlerTerms {
+        self.model.terms(&self.model.path(genes))
+    }
+}
+
+impl Problem for CrawlerProblem {
+    fn lower(&self) -> &[f64] {
+        &self.lower
+    }
+    fn upper(&self) -> &[f64] {
+        &self.upper
+    }
+    fn cost(&self, x: &[f64]) -> f64 {
+        self.model.cost_of(&self.terms(x), &self.reference)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::swarm::ipso::Ipso;
+    use crate::swarm::{Executor, SolverState};
+    use crate::terrain::{BaseRelief, Mountain};
+    use approx::assert_abs_diff_eq;
+
+    fn level() -> BaseRelief {
+        BaseRelief {
+            a: 0.0,
+            b: 0.0,
+            c: 0.0,
+            d: 0.0,
+            e: 0.0,
+            f: 0.0,
+            g: 0.0,
+        }
+    }
+
+    fn flat() -> Terrain {
+        Terrain::Analytic {
+            base: level(),
+            mountains: vec![],
+        }
+    }
+
+    fn model(terrain: Terrain, hazards: Vec<Hazard>) -> CrawlerModel {
+        CrawlerModel {
+            terrain,
+            hazards,
+            start: [0.0, 0.0],
+            goal: [100.0, 0.0],
+            area: [0.0, -50.0, 100.0, 50.0],
+            control_points: 3,
+            samples: 101,
+            sensor_height_m: 0.5,
+            speed_mps: 1.0,
+            power_kw: [90.0, 50.0, 5.0],
+            mining_share: 0.6,
+            safe_distance_m: [2.0, 10.0],
+            max_slope_deg: 15.0,
+            weights: [0.5, 0.2, 0.2, 0.1],
+            penalty_weight: 10.0,
+        }
+    }
+
+    fn hazard(x: f64, y: f64, r: f64) -> Hazard {
+        Hazard {
+            id: "h".into(),
+            centre: [x, y],
+            radius_m: r,
+            height_m: 5.0,
+        }
+    }
+
+    #[test]
+    fn energy_and_slip_by_hand() {
+        let m = model(flat(), vec![]);
+        // 3600 m at 1 m/s: travel 1 h, mining 1.5 h → 1.5·90 + 1·50 + 2.5·5 = 197.5 kWh.
+        assert_abs_diff_eq!(m.energy_kwh(3600.0), 197.5, epsilon = 1e-9);
+        assert_eq!(m.slip_of(1.0), 1.0);
+        assert_abs_diff_eq!(m.slip_of(6.0), 0.5);
+        assert_eq!(m.slip_of(10.0), 0.0);
+    }
+
+    #[test]
+    fn the_straight_path_on_flat_ground_by_hand() {
+        let m = model(flat(), vec![hazard(50.0, 6.0, 2.0)]);
+        let r = m.reference();
+        // 100 m long, flat, at 4 m from the hazard's edge: D = (10 − 4)/8 = 0.75.
+        assert_abs_diff_eq!(r.length_m, 100.0, epsilon = 1e-9);
+        assert_abs_diff_eq!(r.undulation_m, 0.0, epsilon = 1e-12);
+        assert_abs_diff_eq!(r.min_hazard_clearance_m, 4.0, epsilon = 1e-9);
+        assert_abs_diff_eq!(r.slip, 0.75, epsilon = 1e-9);
+        assert_eq!((r.penalty, r.max_slope_deg), (0.0, 0.0));
+        assert_abs_diff_eq!(m.energy_kwh(100.0), r.energy_kwh, epsilon = 1e-12);
+        // Its standardised cost: 0.5 + 0.2·0 + 0.2·0.75 + 0.1.
+        assert_abs_diff_eq!(m.cost_of(&r, &r), 0.75, epsilon = 1e-9);
+    }
+
+    #[test]
+    fn the_path_is_draped_and_steep_legs_are_penalised() {
+        // A 10 m mountain of spread 5 m on the straight line: legs steeper than 15°.
+        let hill = Terrain::Analytic {
+            base: level(),
+            mountains: vec![Mountain {
+                centre: [50.0, 0.0],
+                height_m: 10.0,
+                spread_m: [5.0, 5.0],
+            }],
+        };
+        let m = model(hill, vec![]);
+        let r = m.reference();
+        assert!(r.max_slope_deg > 40.0, "{}", r.max_slope_deg);
+        assert!(r.penalty > 1.0);
+        assert_abs_diff_eq!(r.undulation_m, 20.0, epsilon = 0.1);
+        let p = m.path(&[25.0, 0.0, 50.0, 0.0, 75.0, 0.0]);
+        assert_abs_diff_eq!(p[50].z, 10.5, epsilon = 1e-6);
+    }
+
+    #[test]
+    fn ipso_steers_around_a_hazard_on_the_straight_line() {
+        let m = model(flat(), vec![hazard(50.0, 0.0, 8.0)]);
+        let problem = CrawlerProblem::new(m);
+        let straight = problem.model.reference();
+        assert!(straight.penalty > 0.0);
+        let out = Executor::new(100).run(&problem, &mut Ipso::table8(30, 2), |_| {});
+        let t = problem.terms(out.state.best_position());
+        assert_eq!(t.penalty, 0.0, "{t:?}");
+        assert!(t.min_hazard_clearance_m >= 0.0);
+        // Around an 8 m circle the detour is short: well under 20 % longer.
+        assert!(t.length_m < 120.0, "{t:?}");
+    }
+}

@@ -1,0 +1,592 @@
+//! Measured seabed: a height grid from a CSV file or an ESRI ASCII grid, with errors that name
+//! the file, the line and the offending text.
+
+use std::path::{Path, PathBuf};
+
+/// Why a height grid could not be built.
+#[derive(Debug, thiserror::Error)]
+pub enum TerrainError {
+    /// The file could not be read.
+    #[error("{}: cannot read: {source}", file.display())]
+    Io {
+        file: PathBuf,
+        source: std::io::Error,
+    },
+    /// [`HeightGrid::load`] does not know the extension.
+    #[error("{}: unknown terrain format (expected extension .asc or .csv)", file.display())]
+    UnknownFormat { file: PathBuf },
+    /// A caller-supplied parameter (cell size, origin) is unusable for this file.
+    #[error("{}: {what}", file.display())]
+    BadParameter { file: PathBuf, what: String },
+    /// [`HeightGrid::new`] was given inconsistent data.
+    #[error("invalid height grid: {0}")]
+    InvalidGrid(String),
+    /// Something wrong at a given line (1-based) of a file.
+    #[error("{}:{line}: {problem}", file.display())]
+    At {
+        file: PathBuf,
+        line: usize,
+        problem: Problem,
+    },
+}
+
+/// What is wrong at a line of a grid file; the offending text is always quoted.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum Problem {
+    #[error("expected {expected} values, found {found}")]
+    Ragged { expected: usize, found: usize },
+    #[error("`{0}` is not a number")]
+    NotANumber(String),
+    #[error("`{0}` is not a finite number")]
+    NonFinite(String),
+    #[error("header key `{0}` is missing (the header ends before this line)")]
+    MissingHeader(&'static str),
+    #[error("bad header line `{text}`: {what}")]
+    BadHeader { text: String, what: &'static str },
+    #[error("header says `nrows {expected}` but the file has {found} data rows")]
+    RowCount { expected: usize, found: usize },
+    #[error("grid of {cols} columns × {rows} rows is too small, need at least 2×2")]
+    TooSmall { cols: usize, rows: usize },
+    #[error("cell size `{0}` must be positive")]
+    NonPositiveCell(String),
+    /// `row` and `col` are 1-based, data row 1 being the first (northernmost) one of the file.
+    #[error("data row {row}, column {col} is NODATA (`{text}`); unmeasured seabed is not guessed")]
+    NoData {
+        row: usize,
+        col: usize,
+        text: String,
+    },
+}
+
+/// Error at `file:line`.
+fn at(file: &Path, line: usize, problem: Problem) -> TerrainError {
+    TerrainError::At {
+        file: file.to_path_buf(),
+        line,
+        problem,
+    }
+}
+
+/// A regular grid of seabed heights, bilinearly interpolated.
+///
+/// Node `(col, row)` stands at `origin + (col·cell_m, row·cell_m)`; row 0 is the southernmost
+/// (smallest y), col 0 the westernmost. Outside the grid the position is clamped to the edge.
+#[derive(Debug, Clone, PartialEq)]
+pub struct HeightGrid {
+    /// Position of node (0, 0), the south-west cell centre, metres.
+    pub origin: [f64; 2],
+    /// Spacing of the nodes along x and y, metres.
+    pub cell_m: f64,
+    /// Nodes per row (along x).
+    pub cols: usize,
+    /// Rows of nodes (along y).
+    pub rows: usize,
+    /// Heights row-major, south row first; private so its length always matches `cols × rows`.
+    heights: Vec<f64>,
+}
+
+/// The "not a number" error for `text` at `file:line` (an empty field is shown as `(empty)`).
+fn bad_number(file: &Path, line: usize, text: &str) -> TerrainError {
+    let text = if text.is_empty() { "(empty)" } else { text };
+    at(file, line, Problem::NotANumber(text.to_string()))
+}
+
+/// Parses one finite number, naming file and line otherwise.
+fn parse_finite(file: &Path, line: usize, text: &str) -> Result<f64, TerrainError> {
+    let value: f64 = text.parse().map_err(|_| bad_number(file, line, text))?;
+    if value.is_finite() {
+        Ok(value)
+    } else {
+        Err(at(file, line, Problem::NonFinite(text.to_string())))
+    }
+}
+
+/// Number of the last line of `text` (1 for an empty text), for "ended too early" errors.
+fn last_line(text: &str) -> usize {
+    text.lines().count().max(1)
+}
+
+/// Grid coordinate along one axis: lower node index, fraction in its cell, and whether the
+/// coordinate lies inside the grid (outside, the clamped value does not change with it).
+fn locate(coord: f64, origin: f64, cell: f64, nodes: usize) -> (usize, f64, bool) {
+    let max = nodes.saturating_sub(1).max(1) as f64;
+    let f = (coord - origin) / cell;
+    let fc = f.clamp(0.0, max);
+    let i = (fc.floor() as usize).min(nodes.saturating_sub(2));
+    (i, fc - i as f64, (0.0..=max).contains(&f))
+}
+
+impl HeightGrid {
+    /// Builds a grid from heights given row-major, south row first.
+    pub fn new(
+        origin: [f64; 2],
+        cell_m: f64,
+        cols: usize,
+        rows: usize,
+        heights: Vec<f64>,
+    ) -> Result<Self, TerrainError> {
+        let fail = |what: String| Err(TerrainError::InvalidGrid(what));
+        if cols < 2 || rows < 2 {
+            return fail(format!("{cols}×{rows} nodes, need at least 2×2"));
+        }
+        if cols.checked_mul(rows) != Some(heights.len()) {
+            return fail(format!("{cols}×{rows} nodes but {} heights", heights.len()));
+        }
+        if !(cell_m.is_finite() && cell_m > 0.0) {
+            return fail(format!("cell size {cell_m} must be positive and finite"));
+        }
+        if !origin.iter().chain(&heights).all(|v| v.is_finite()) {
+            return fail("origin and heights must be finite".to_string());
+        }
+        Ok(Self {
+            origin,
+            cell_m,
+            cols,
+            rows,
+            heights,
+        })
+    }
+
+    /// Height of node `(col, row)` (row 0 = south), if it exists.
+    pub fn node(&self, col: usize, row: usize) -> Option<f64> {
+        if col >= self.cols {
+            return None;
+        }
+        self.heights
+            .get(row.checked_mul(self.cols)?.checked_add(col)?)
+            .copied()
+    }
+
+    /// Corners of the cell containing `(x, y)` and the fractions `(tx, ty)` within it; the bool
+    /// pair says whether x and y are inside the grid.
+    fn patch(&self, x: f64, y: f64) -> ([f64; 4], f64, f64, bool, bool) {
+        let (i, tx, in_x) = locate(x, self.origin[0], self.cell_m, self.cols);
+        let (j, ty, in_y) = locate(y, self.origin[1], self.cell_m, self.rows);
+        let at = |c, r| self.node(c, r).unwrap_or(f64::NAN);
+        let z = [at(i, j), at(i + 1, j), at(i, j + 1), at(i + 1, j + 1)];
+        (z, tx, ty, in_x, in_y)
+    }
+
+    /// Bilinear height at `(x, y)`, clamped to the edge outside the grid.
+    pub fn elevation(&self, x: f64, y: f64) -> f64 {
+        let ([z00, z10, z01, z11], tx, ty, _, _) = self.patch(x, y);
+        let south = z00 + (z10 - z00) * tx;
+        let north = z01 + (z11 - z01) * tx;
+        south + (north - south) * ty
+    }
+
+    /// Derivative of the bilinear patch; 0 along an axis where the position is clamped.
+    pub fn gradient(&self, x: f64, y: f64) -> (f64, f64) {
+        let ([z00, z10, z01, z11], tx, ty, in_x, in_y) = self.patch(x, y);
+        let gx = ((1.0 - ty) * (z10 - z00) + ty * (z11 - z01)) / self.cell_m;
+        let gy = ((1.0 - tx) * (z01 - z00) + tx * (z11 - z10)) / self.cell_m;
+        (if in_x { gx } else { 0.0 }, if in_y { gy } else { 0.0 })
+    }
+
+    /// Assembles rows read north first (like an image) into a south-first grid.
+    fn from_north_rows(origin: [f64; 2], cell_m: f64, cols: usize, rows: Vec<Vec<f64>>) -> Self {
+        let n = rows.len();
+        let heights = rows.into_iter().rev().flatten().collect();
+        Self {
+            origin,
+            cell_m,
+            cols,
+            rows: n,
+            heights,
+        }
+    }
+
+    /// Parses a CSV height grid: comma-separated numbers, one row per line, the **first line is
+    /// the northernmost row** (like an image). Blank lines and `#` comments are skipped. Node
+    /// (0, 0), the south-west one, stands at `origin`; nodes are `cell_m` apart.
+    pub fn from_csv(
+        text: &str,
+        file: &Path,
+        cell_m: f64,
+        origin: [f64; 2],
+    ) -> Result<Self, TerrainError> {
+        if !(cell_m.is_finite() && cell_m > 0.0) {
+            return Err(TerrainError::BadParameter {
+                file: file.to_path_buf(),
+                what: format!("cell size {cell_m} must be positive and finite"),
+            });
+        }
+        if !(origin[0].is_finite() && origin[1].is_finite()) {
+            return Err(TerrainError::BadParameter {
+                file: file.to_path_buf(),
+                what: format!("origin {origin:?} must be finite"),
+            });
+        }
+        let mut rows: Vec<Vec<f64>> = Vec::new();
+        let mut first_line = 0;
+        for (index, raw) in text.lines().enumerate() {
+            let line = index + 1;
+            let content = raw.split('#').next().unwrap_or("").trim();
+            if content.is_empty() {
+                continue;
+            }
+            let row = content
+                .split(',')
+                .map(|field| parse_finite(file, line, field.trim()))
+                .collect::<Result<Vec<f64>, _>>()?;
+            match rows.first() {
+                None => first_line = line,
+                Some(first) if first.len() != row.len() => {
+                    let (expected, found) = (first.len(), row.len());
+                    return Err(at(file, line, Problem::Ragged { expected, found }));
+                }
+                Some(_) => {}
+            }
+            rows.push(row);
+        }
+        let cols = rows.first().map_or(0, Vec::len);
+        if cols < 2 || rows.len() < 2 {
+            let line = if rows.is_empty() {
+                last_line(text)
+            } else {
+                first_line
+            };
+            let rows = rows.len();
+            return Err(at(file, line, Problem::TooSmall { cols, rows }));
+        }
+        Ok(Self::from_north_rows(origin, cell_m, cols, rows))
+    }
+
+    /// Parses an ESRI ASCII grid: header keys `ncols`, `nrows`, `xllcorner`|`xllcenter`,
+    /// `yllcorner`|`yllcenter`, `cellsize` and optional `NODATA_value` (case-insensitive), then
+    /// `nrows` lines of `ncols` whitespace-separated values, **first line = north**.
+    ///
+    /// A `*corner` origin is the outer corner of the south-west cell, so node (0, 0) lies half a
+    /// cell inside it; a `*center` origin is node (0, 0) itself. A NODATA cell is an error: we do
+    /// not guess seabed we have not measured.
+    pub fn from_esri_ascii(text: &str, file: &Path) -> Result<Self, TerrainError> {
+        const KEYS: [&str; 8] = [
+            "ncols",
+            "nrows",
+            "xllcorner",
+            "xllcenter",
+            "yllcorner",
+            "yllcenter",
+            "cellsize",
+            "nodata_value",
+        ];
+        // (value text, line) per key in KEYS order.
+        let mut header: [Option<(&str, usize)>; 8] = [None; 8];
+        let mut lines = text.lines().enumerate().map(|(i, l)| (i + 1, l)).peekable();
+        while let Some(&(line, raw)) = lines.peek() {
+            let mut tokens = raw.split_whitespace();
+            let Some(first) = tokens.next() else {
+                lines.next();
+                continue;
+            };
+            let Some(k) = KEYS.iter().position(|key| key.eq_ignore_ascii_case(first)) else {
+                break;
+            };
+            let text = raw.trim().to_string();
+            let bad = |what| at(file, line, Problem::BadHeader { text, what });
+            let (Some(value), None) = (tokens.next(), tokens.next()) else {
+                return Err(bad("expected `key value`"));
+            };
+            if header[k].is_some() {
+                return Err(bad("key given twice"));
+            }
+            header[k] = Some((value, line));
+            lines.next();
+        }
+        let data_line = lines.peek().map_or(last_line(text), |&(line, _)| line);
+        let require = |k: usize, alt: Option<usize>| {
+            header[k]
+                .or_else(|| alt.and_then(|a| header[a]))
+                .ok_or_else(|| at(file, data_line, Problem::MissingHeader(KEYS[k])))
+        };
+        let count = |(text, line): (&str, usize)| {
+            text.parse::<usize>()
+                .map_err(|_| bad_number(file, line, text))
+        };
+        let ncols_at = require(0, None)?;
+        let nrows_at = require(1, None)?;
+        let (ncols, nrows) = (count(ncols_at)?, count(nrows_at)?);
+        for (n, line) in [(ncols, ncols_at.1), (nrows, nrows_at.1)] {
+            if n < 2 {
+                let (cols, rows) = (ncols, nrows);
+                return Err(at(file, line, Problem::TooSmall { cols, rows }));
+            }
+        }
+        for (corner, centre) in [(2, 3), (4, 5)] {
+            if let (Some(_), Some((_, line))) = (header[corner], header[centre]) {
+                let text = KEYS[centre].to_string();
+                let what = "give either the corner or the centre of an axis, not both";
+                return Err(at(file, line, Problem::BadHeader { text, what }));
+            }
+        }
+        let number = |(text, line): (&str, usize)| parse_finite(file, line, text);
+        let cell_at = require(6, None)?;
+        let cell = number(cell_at)?;
+        if cell <= 0.0 {
+            let problem = Problem::NonPositiveCell(cell_at.0.to_string());
+            return Err(at(file, cell_at.1, problem));
+        }
+        let half = |corner: bool| if corner { cell / 2.0 } else { 0.0 };
+        let origin = [
+            number(require(2, Some(3))?)? + half(header[2].is_some()),
+            number(require(4, Some(5))?)? + half(header[4].is_some()),
+        ];
+        let nodata = header[7].map(number).transpose()?;
+        let data: Vec<(usize, &str)> = lines.filter(|(_, l)| !l.trim().is_empty()).collect();
+        if data.len() != nrows {
+            let line = data.get(nrows).map_or(last_line(text), |d| d.0);
+            let (expected, found) = (nrows, data.len());
+            return Err(at(file, line, Problem::RowCount { expected, found }));
+        }
+        let mut rows: Vec<Vec<f64>> = Vec::with_capacity(nrows);
+        for (line, raw) in data {
+            let fields: Vec<&str> = raw.split_whitespace().collect();
+            if fields.len() != ncols {
+                let (expected, found) = (ncols, fields.len());
+                return Err(at(file, line, Problem::Ragged { expected, found }));
+            }
+            let mut row = Vec::with_capacity(ncols);
+            for (col, field) in fields.iter().enumerate() {
+                let value: f64 = field.parse().map_err(|_| bad_number(file, line, field))?;
+                if nodata == Some(value) {
+                    let (row, col, text) = (rows.len() + 1, col + 1, field.to_string());
+                    return Err(at(file, line, Problem::NoData { row, col, text }));
+                }
+                row.push(parse_finite(file, line, field)?);
+            }
+            rows.push(row);
+        }
+        Ok(Self::from_north_rows(origin, cell, ncols, rows))
+    }
+
+    /// Reads a grid file, choosing the parser by extension (case-insensitive): `.asc` → ESRI
+    /// ASCII; `.csv` → CSV with 1 m cells and node (0, 0) at the origin (0, 0).
+    pub fn load(path: &Path) -> Result<Self, TerrainError> {
+        let ext = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(str::to_ascii_lowercase);
+        let parse: fn(&str, &Path) -> Result<Self, TerrainError> = match ext.as_deref() {
+            Some("asc") => Self::from_esri_ascii,
+            Some("csv") => |text, file| Self::from_csv(text, file, 1.0, [0.0, 0.0]),
+            _ => {
+                return Err(TerrainError::UnknownFormat {
+                    file: path.to_path_buf(),
+                })
+            }
+        };
+        let text = std::fs::read_to_string(path).map_err(|source| TerrainError::Io {
+            file: path.to_path_buf(),
+            source,
+        })?;
+        parse(&text, path)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::Terrain;
+    use super::*;
+    use approx::assert_abs_diff_eq;
+    use proptest::prelude::*;
+
+    type TestResult = Result<(), Box<dyn std::error::Error>>;
+
+    #[test]
+    fn slope_of_ten_degree_plane_grid() -> TestResult {
+        let rise = 10.0 * 10f64.to_radians().tan();
+        let grid = HeightGrid::new([0.0, 0.0], 10.0, 2, 2, vec![0.0, rise, 0.0, rise])?;
+        let t = Terrain::Grid(grid);
+        assert_abs_diff_eq!(t.slope_deg(5.0, 5.0), 10.0, epsilon = 1e-9);
+        assert_abs_diff_eq!(t.slope_deg(1.0, 9.0), 10.0, epsilon = 1e-9);
+        assert_abs_diff_eq!(
+            t.crawler_z(5.0, 5.0, 1.5),
+            rise / 2.0 + 1.5,
+            epsilon = 1e-12
+        );
+        Ok(())
+    }
+
+    #[test]
+    fn bilinear_centre_and_clamping() -> TestResult {
+        // South row 1, 2; north row 3, 4.
+        let g = HeightGrid::new([100.0, 200.0], 2.0, 2, 2, vec![1.0, 2.0, 3.0, 4.0])?;
+        assert_abs_diff_eq!(g.elevation(101.0, 201.0), 2.5, epsilon = 1e-12);
+        assert_abs_diff_eq!(g.elevation(0.0, 0.0), 1.0, epsilon = 1e-12);
+        assert_abs_diff_eq!(g.elevation(1e9, 1e9), 4.0, epsilon = 1e-12);
+        assert_abs_diff_eq!(g.elevation(-50.0, 201.0), 2.0, epsilon = 1e-12);
+        assert_eq!(g.gradient(-50.0, 201.0).0, 0.0);
+        assert_abs_diff_eq!(g.gradient(-50.0, 201.0).1, 1.0, epsilon = 1e-12);
+        assert!(g.elevation(f64::NAN, 0.0).is_nan());
+        assert!(HeightGrid::new([0.0, 0.0], 1.0, 2, 2, vec![1.0; 3]).is_err());
+        assert!(HeightGrid::new([0.0, 0.0], 0.0, 2, 2, vec![1.0; 4]).is_err());
+        Ok(())
+    }
+
+    #[test]
+    fn csv_three_by_three_first_line_is_north() -> TestResult {
+        let text = "# depth survey\n1, 2, 3\n\n4,5,6 # middle\n7,8,9\n";
+        let g = HeightGrid::from_csv(text, Path::new("a.csv"), 1.0, [0.0, 0.0])?;
+        assert_eq!((g.cols, g.rows), (3, 3));
+        assert_eq!(g.node(0, 0), Some(7.0));
+        assert_eq!(g.node(2, 2), Some(3.0));
+        assert_abs_diff_eq!(g.elevation(0.0, 0.0), 7.0, epsilon = 1e-12);
+        assert_abs_diff_eq!(g.elevation(2.0, 2.0), 3.0, epsilon = 1e-12);
+        // Cell centre between rows 0 (7 8 9) and 1 (4 5 6), cols 1–2: mean of 8, 9, 5, 6.
+        assert_abs_diff_eq!(g.elevation(1.5, 0.5), 7.0, epsilon = 1e-12);
+        Ok(())
+    }
+
+    const ESRI: &str = "NCOLS 3\nnrows 3\nxllcorner 100\nYllCorner 200\ncellsize 10\n\
+                        NODATA_value -9999\n1 2 3\n4 5 6\n7 8 9\n";
+
+    #[test]
+    fn esri_three_by_three_corner_and_centre() -> TestResult {
+        let g = HeightGrid::from_esri_ascii(ESRI, Path::new("b.asc"))?;
+        assert_eq!((g.cols, g.rows, g.cell_m), (3, 3, 10.0));
+        assert_eq!(g.origin, [105.0, 205.0]);
+        assert_abs_diff_eq!(g.elevation(105.0, 205.0), 7.0, epsilon = 1e-12);
+        assert_abs_diff_eq!(g.elevation(125.0, 225.0), 3.0, epsilon = 1e-12);
+        let centre = ESRI.replace("xllcorner", "xllcenter");
+        let g = HeightGrid::from_esri_ascii(&centre, Path::new("b.asc"))?;
+        assert_eq!(g.origin, [100.0, 205.0]);
+        Ok(())
+    }
+
+    /// The error message of `result`, which must name `file:line` and contain `text`.
+    fn check_err(result: Result<HeightGrid, TerrainError>, file: &str, line: usize, text: &str) {
+        match result {
+            Ok(_) => panic!("expected an error at {file}:{line} about {text}"),
+            Err(e) => {
+                let msg = e.to_string();
+                assert!(msg.contains(&format!("{file}:{line}:")), "{msg}");
+                assert!(msg.contains(text), "`{text}` missing from: {msg}");
+            }
+        }
+    }
+
+    #[test]
+    fn csv_errors_name_file_line_and_text() {
+        let csv = |text: &str| HeightGrid::from_csv(text, Path::new("s.csv"), 1.0, [0.0, 0.0]);
+        check_err(
+            csv("1,2,3\n4,5\n"),
+            "s.csv",
+            2,
+            "expected 3 values, found 2",
+        );
+        check_err(csv("1,2\n# c\nx7,4\n"), "s.csv", 3, "`x7`");
+        check_err(csv("1,2\n3,inf\n"), "s.csv", 2, "`inf`");
+        check_err(csv("1,2\n3,\n"), "s.csv", 2, "(empty)");
+        check_err(csv("\n1,2,3\n"), "s.csv", 2, "3 columns × 1 rows");
+        check_err(csv("1\n2\n"), "s.csv", 1, "1 columns × 2 rows");
+        check_err(csv("# nothing\n"), "s.csv", 1, "need at least 2×2");
+        let bad_cell = HeightGrid::from_csv("1,2\n3,4\n", Path::new("s.csv"), 0.0, [0.0, 0.0]);
+        assert!(matches!(bad_cell, Err(TerrainError::BadParameter { .. })));
+    }
+
+    #[test]
+    fn esri_errors_name_file_line_and_text() {
+        let asc = |text: &str| HeightGrid::from_esri_ascii(text, Path::new("g.asc"));
+        let no_cell = ESRI.replace("cellsize 10\n", "");
+        check_err(asc(&no_cell), "g.asc", 6, "`cellsize`");
+        let no_y = ESRI.replace("YllCorner 200\n", "");
+        check_err(asc(&no_y), "g.asc", 6, "`yllcorner`");
+        check_err(
+            asc(&ESRI.replace("nrows 3", "nrows 4")),
+            "g.asc",
+            9,
+            "nrows 4",
+        );
+        check_err(asc(&format!("{ESRI}1 2 3\n")), "g.asc", 10, "nrows 3");
+        check_err(asc(&ESRI.replace("4 5 6", "4 5")), "g.asc", 8, "found 2");
+        check_err(
+            asc(&ESRI.replace("4 5 6", "4 5 6 0")),
+            "g.asc",
+            8,
+            "found 4",
+        );
+        check_err(
+            asc(&ESRI.replace("cellsize 10", "cellsize -1")),
+            "g.asc",
+            5,
+            "`-1`",
+        );
+        check_err(
+            asc(&ESRI.replace("cellsize 10", "cellsize 0")),
+            "g.asc",
+            5,
+            "`0`",
+        );
+        let nodata = asc(&ESRI.replace("6\n", "-9999\n"));
+        check_err(nodata, "g.asc", 8, "row 2, column 3 is NODATA (`-9999`)");
+        check_err(
+            asc(&ESRI.replace("NCOLS 3", "ncols three")),
+            "g.asc",
+            1,
+            "`three`",
+        );
+        check_err(asc(&ESRI.replace("8 9", "NaN 9")), "g.asc", 9, "`NaN`");
+        check_err(asc(&ESRI.replace("8 9", "8x 9")), "g.asc", 9, "`8x`");
+        check_err(
+            asc(&ESRI.replace("NCOLS 3", "ncols 1")),
+            "g.asc",
+            1,
+            "1 columns",
+        );
+        check_err(
+            asc(&ESRI.replace("nrows 3", "nrows 0")),
+            "g.asc",
+            2,
+            "0 rows",
+        );
+        check_err(
+            asc(&ESRI.replace("cellsize 10", "cellsize 10 m")),
+            "g.asc",
+            5,
+            "10 m",
+        );
+        let both = ESRI.replace("cellsize", "xllcenter 3\ncellsize");
+        check_err(asc(&both), "g.asc", 5, "xllcenter");
+    }
+
+    #[test]
+    fn load_chooses_parser_by_extension() -> TestResult {
+        let dir = std::env::temp_dir().join(format!("shoal-terrain-{}", std::process::id()));
+        std::fs::create_dir_all(&dir)?;
+        let asc = dir.join("g.ASC");
+        std::fs::write(&asc, ESRI)?;
+        assert_eq!(HeightGrid::load(&asc)?.origin, [105.0, 205.0]);
+        let csv = dir.join("g.csv");
+        std::fs::write(&csv, "1,2\n3,4\n")?;
+        let g = HeightGrid::load(&csv)?;
+        assert_eq!(
+            (g.origin, g.cell_m, g.node(0, 0)),
+            ([0.0, 0.0], 1.0, Some(3.0))
+        );
+        let missing = HeightGrid::load(&dir.join("none.csv"));
+        assert!(matches!(missing, Err(TerrainError::Io { .. })));
+        let txt = HeightGrid::load(&dir.join("g.txt"));
+        assert!(matches!(txt, Err(TerrainError::UnknownFormat { .. })));
+        std::fs::remove_dir_all(&dir)?;
+        Ok(())
+    }
+
+    proptest! {
+        #[test]
+        fn parsers_never_panic(text in ".{0,300}") {
+            let _ = HeightGrid::from_csv(&text, Path::new("p.csv"), 1.0, [0.0, 0.0]);
+            let _ = HeightGrid::from_esri_ascii(&text, Path::new("p.asc"));
+        }
+
+        #[test]
+        fn parsers_never_panic_on_near_grids(
+            text in "((ncols|nrows|xllcorner|yllcenter|cellsize|nodata_value) [-0-9.e]{1,4}\n){0,7}([-0-9 ,.#naif]{0,12}\n){0,5}"
+        ) {
+            let _ = HeightGrid::from_csv(&text, Path::new("p.csv"), 1.0, [0.0, 0.0]);
+            if let Ok(g) = HeightGrid::from_esri_ascii(&text, Path::new("p.asc")) {
+                let t = Terrain::Grid(g);
+                let _ = (t.elevation(1.0, 2.0), t.slope_deg(-1e9, 1e9));
+            }
+        }
+    }
+}
