@@ -4,6 +4,7 @@
 //!
 //! A new variant (IPSO, EPA-PSO, DE-PSO…) is one file implementing [`Solver`].
 
+pub mod cbpso;
 pub mod ipso;
 pub mod multi;
 pub mod parallel;
@@ -267,6 +268,8 @@ mod tests {
     fn classic_pso_converges_in_low_dimension_and_stalls_in_high() {
         // Table 5's ω = 0.15 is a greedy setting: fine on a 3-D bowl...
         assert_converged("pso", 3, solve(Pso::classic(50, 7), 3, 300));
+        // Seed 000's SPSO (ω = 0.5, c1 = c2 = 2) on the same bowl.
+        assert_converged("spso", 3, solve(Pso::spso(30, 7), 3, 300));
         // ...but it loses its momentum before reaching the optimum in 10-D, the premature
         // convergence seed 004 §4.2 reports for classic PSO; A-PSO on the same budget does not.
         let (pso, _) = solve(Pso::classic(50, 7), 10, 300);

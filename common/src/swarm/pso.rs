@@ -28,6 +28,20 @@ impl Pso {
         }
     }
 
+    /// SPSO, seed 000's standard PSO baseline (Table 4 / Table 8): ω = 0.5, c1 = c2 = 2.
+    pub fn spso(particles: usize, seed: u64) -> Pso {
+        Pso {
+            schedule: Schedule::Fixed(super::population::Coefficients {
+                w: 0.5,
+                c1: 2.0,
+                c2: 2.0,
+                c3: 0.0,
+            }),
+            max_velocity_fraction: 0.2,
+            ..Pso::classic(particles, seed)
+        }
+    }
+
     /// A-PSO: one population with eq. (7).
     pub fn adaptive(particles: usize, seed: u64) -> Pso {
         Pso {
