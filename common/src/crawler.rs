@@ -239,9 +239,10 @@ mod tests {
     use super::*;
     use crate::swarm::ipso::Ipso;
     use crate::swarm::{Executor, SolverState};
-    use crate::terrain::{BaseRelief, Mountain};
+    use crate::terrain::{BaseRelief, HeightGrid, Mountain};
     use approx::assert_abs_diff_eq;
 
+    /// `Z1 = sin(y)`: level along y = 0, the line the hill test drives on.
     fn level() -> BaseRelief {
         BaseRelief {
             a: 0.0,
@@ -254,10 +255,12 @@ mod tests {
         }
     }
 
+    /// Level ground: a flat height grid (eq. (2)'s `sin(y + a)` has no coefficient, so no
+    /// analytic relief is flat).
     fn flat() -> Terrain {
-        Terrain::Analytic {
-            base: level(),
-            mountains: vec![],
+        match HeightGrid::new([0.0, -50.0], 50.0, 3, 3, vec![0.0; 9]) {
+            Ok(g) => Terrain::Grid(g),
+            Err(e) => panic!("{e}"),
         }
     }
 

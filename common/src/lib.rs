@@ -9,6 +9,7 @@ pub mod distributed;
 mod fixtures;
 pub mod fleet;
 pub mod geometry;
+pub mod gridsearch;
 pub mod health;
 pub mod plan;
 pub mod scenario;
