@@ -481,3 +481,43 @@ fn missing_agents_are_named() -> TestResult {
     fleet.passed();
     Ok(())
 }
+
+/// A coordinator killed mid-plan: its agents, connected through a hub router, abandon the
+/// mission at once (the hub tells them the coordinator's liveliness token is gone) instead of
+/// waiting out their idle timeout, and keep serving. (Agents connected to the killed
+/// coordinator's own router lose their router with it and fall back on `--idle-timeout`.)
+#[test]
+fn agents_abandon_the_mission_of_a_killed_coordinator() -> TestResult {
+    let mut fleet = Fleet::new();
+    let out = fleet.dir().join("out");
+    let (hub, port) = (endpoint(free_port()), free_port());
+    let mut cmd = Command::new(coordinator());
+    without_shoal_env(&mut cmd);
+    cmd.args(["router", "--listen", hub.as_str()]);
+    let router = fleet.spawn("router", cmd);
+    fleet.wait_for_stderr(router, "router listening", deadline());
+    let c = external_coordinator(
+        &mut fleet,
+        "coordinator",
+        &out,
+        port,
+        "e2e-orphan",
+        &["--iterations", "4000", "--router", hub.as_str()],
+    );
+    let agents: Vec<Handle> = VEHICLES
+        .iter()
+        .map(|v| fleet.agent(v, &hub, &["--idle-timeout", "60"]))
+        .collect();
+    fleet.wait_for_stderr(c, "iteration ", deadline());
+    fleet.kill(c);
+    // Well before the 60 s idle timeout.
+    let soon = Instant::now() + Duration::from_secs(15);
+    for &a in &agents {
+        fleet.wait_for_stderr(a, "its coordinator left the network", soon);
+    }
+    for (v, &a) in VEHICLES.iter().zip(&agents) {
+        assert!(fleet.running(a), "the agent of {v} exited");
+    }
+    fleet.passed();
+    Ok(())
+}

@@ -214,7 +214,7 @@ fn wait_for_migrants(
             } if r == round => migrants = Some((particles, context_round)),
             CoordinatorToAgent::Migrants { .. } | CoordinatorToAgent::Assign { .. } => {}
             CoordinatorToAgent::Stop { reason, .. } => {
-                return Wait::End(format!("stopped by the coordinator: {reason}"))
+                return Wait::End(format!("stopped: {reason}"))
             }
         }
     }

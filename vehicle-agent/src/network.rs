@@ -145,6 +145,21 @@ pub fn serve(args: &AgentArgs, shutdown: &AtomicBool) -> anyhow::Result<()> {
         .callback(forward(tx))
         .wait()
         .map_err(|e| anyhow::anyhow!("cannot subscribe to {}: {e}", topics::ALL_FLEETS))?;
+    // A coordinator that leaves (exit, crash, cut link) ends its missions here at once, instead
+    // of after --idle-timeout.
+    let (gone_tx, gone_rx) = mpsc::channel::<String>();
+    let _coordinators = session
+        .liveliness()
+        .declare_subscriber(topics::ALL_COORDINATORS)
+        .callback(move |sample| {
+            if sample.kind() == zenoh::sample::SampleKind::Delete {
+                if let Some(m) = topics::mission_of_coordinator(sample.key_expr().as_str()) {
+                    let _ = gone_tx.send(m.to_string());
+                }
+            }
+        })
+        .wait()
+        .map_err(|e| anyhow::anyhow!("cannot watch the coordinators' liveliness: {e}"))?;
     // Declared last: a coordinator that sees the token can reach the subscriptions.
     let token_key = topics::liveliness(&vehicle)?;
     let token = session
@@ -171,6 +186,14 @@ pub fn serve(args: &AgentArgs, shutdown: &AtomicBool) -> anyhow::Result<()> {
             }
             Err(RecvTimeoutError::Timeout) => {}
             Err(RecvTimeoutError::Disconnected) => break,
+        }
+        while let Ok(m) = gone_rx.try_recv() {
+            if let Some(w) = workers.get(&m) {
+                let _ = w.tx.send(CoordinatorToAgent::Stop {
+                    mission: m,
+                    reason: "its coordinator left the network (liveliness token gone)".into(),
+                });
+            }
         }
         let done: Vec<String> = workers
             .iter()

@@ -85,6 +85,16 @@ pub fn coordinator_liveliness(mission: &str) -> Result<String, IdError> {
     Ok(format!("shoal-coordinator/{mission}"))
 }
 
+/// Every coordinator's liveliness token (agents watch them to abandon a mission whose
+/// coordinator is gone).
+pub const ALL_COORDINATORS: &str = "shoal-coordinator/*";
+
+/// The mission of a coordinator's liveliness token `key`, if it is one.
+pub fn mission_of_coordinator(key: &str) -> Option<&str> {
+    let id = key.strip_prefix("shoal-coordinator/")?;
+    check_id("mission", id).ok().map(|()| id)
+}
+
 /// Every agent's liveliness token.
 pub const ALL_LIVELINESS: &str = "shoal-alive/*";
 
@@ -131,6 +141,11 @@ mod tests {
         assert_eq!(vehicle_of_liveliness("shoal-alive/auv3"), Some("auv3"));
         assert_eq!(mission_of_fleet(&fleet("m-1")?), Some("m-1"));
         assert_eq!(coordinator_liveliness("m-1")?, "shoal-coordinator/m-1");
+        assert_eq!(
+            mission_of_coordinator(&coordinator_liveliness("m-1")?),
+            Some("m-1")
+        );
+        assert_eq!(mission_of_coordinator("shoal-coordinator/a/b"), None);
         assert_eq!(mission_of_fleet("shoal/a/b/fleet"), None);
         assert_eq!(vehicle_of_liveliness("shoal-alive/a/b"), None);
         assert_eq!(
