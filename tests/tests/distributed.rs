@@ -59,6 +59,15 @@ fn external_coordinator(
     c
 }
 
+/// Starts `shoal-coordinator router` on `hub` and waits until it listens.
+fn start_hub(fleet: &mut Fleet, hub: &str) {
+    let mut cmd = Command::new(coordinator());
+    without_shoal_env(&mut cmd);
+    cmd.args(["router", "--listen", hub]);
+    let router = fleet.spawn("router", cmd);
+    fleet.wait_for_stderr(router, "router listening", deadline());
+}
+
 /// `distributed.agents[]` entry of `vehicle`.
 fn agent_figures<'a>(json: &'a Value, vehicle: &str) -> &'a Value {
     let agents = key(json, "distributed.agents");
@@ -397,11 +406,7 @@ fn two_missions_share_one_router_and_its_agents() -> TestResult {
     let (out_a, out_b) = (fleet.dir().join("out-a"), fleet.dir().join("out-b"));
     let (hub, p, q) = (free_port(), free_port(), free_port());
     let hub = endpoint(hub);
-    let mut cmd = Command::new(coordinator());
-    without_shoal_env(&mut cmd);
-    cmd.args(["router", "--listen", hub.as_str()]);
-    let router = fleet.spawn("router", cmd);
-    fleet.wait_for_stderr(router, "router listening", deadline());
+    start_hub(&mut fleet, &hub);
     let a = external_coordinator(
         &mut fleet,
         "coordinator-a",
@@ -491,11 +496,7 @@ fn agents_abandon_the_mission_of_a_killed_coordinator() -> TestResult {
     let mut fleet = Fleet::new();
     let out = fleet.dir().join("out");
     let (hub, port) = (endpoint(free_port()), free_port());
-    let mut cmd = Command::new(coordinator());
-    without_shoal_env(&mut cmd);
-    cmd.args(["router", "--listen", hub.as_str()]);
-    let router = fleet.spawn("router", cmd);
-    fleet.wait_for_stderr(router, "router listening", deadline());
+    start_hub(&mut fleet, &hub);
     let c = external_coordinator(
         &mut fleet,
         "coordinator",

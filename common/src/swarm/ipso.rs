@@ -19,7 +19,8 @@
 use rand::Rng;
 
 use super::population::{Limits, Particle, Population};
-use super::{Problem, Progress, Solver, SolverState};
+use super::pso::PsoState;
+use super::{Problem, Progress, Solver};
 
 /// The IPSO solver (Table 4 / Table 8 defaults).
 #[derive(Debug, Clone)]
@@ -86,29 +87,6 @@ impl Ipso {
     }
 }
 
-/// State of an IPSO run.
-#[derive(Debug, Clone)]
-pub struct IpsoState {
-    /// The swarm (its elite is the best position evaluated).
-    pub population: Population,
-    /// Box and velocity limits.
-    pub limits: Limits,
-    /// Evaluations so far.
-    pub evaluations: u64,
-}
-
-impl SolverState for IpsoState {
-    fn best_cost(&self) -> f64 {
-        self.population.elite_cost
-    }
-    fn best_position(&self) -> &[f64] {
-        &self.population.elite_x
-    }
-    fn evaluations(&self) -> u64 {
-        self.evaluations
-    }
-}
-
 /// Natural selection (eq. (25)): the `e` particles of worst current fitness take the position,
 /// velocity and current fitness of the `e` best, in rank order; memories stay their own.
 pub fn natural_selection(particles: &mut [Particle], e: usize) {
@@ -133,22 +111,22 @@ pub fn natural_selection(particles: &mut [Particle], e: usize) {
 }
 
 impl<P: Problem> Solver<P> for Ipso {
-    type State = IpsoState;
+    type State = PsoState;
 
     fn name(&self) -> &'static str {
         "ipso"
     }
 
-    fn init(&mut self, problem: &P) -> IpsoState {
+    fn init(&mut self, problem: &P) -> PsoState {
         let population = Population::sample(problem, self.particles.max(1), self.seed);
-        IpsoState {
+        PsoState {
             evaluations: population.evaluations,
             population,
             limits: Limits::of(problem, self.max_velocity_fraction),
         }
     }
 
-    fn step(&mut self, problem: &P, mut state: IpsoState, progress: Progress) -> IpsoState {
+    fn step(&mut self, problem: &P, mut state: PsoState, progress: Progress) -> PsoState {
         let (c1, c2, c3) = self.factors(progress);
         let pop = &mut state.population;
         let m = pop.particles.len();
@@ -210,7 +188,7 @@ impl<P: Problem> Solver<P> for Ipso {
 #[cfg(test)]
 mod tests {
     use super::super::testfns::{Rastrigin, ShiftedSphere};
-    use super::super::Executor;
+    use super::super::{Executor, SolverState};
     use super::*;
     use approx::assert_abs_diff_eq;
 
