@@ -77,6 +77,14 @@ fn agent(vehicle: &str, endpoint: &str) -> Agent {
     }
 }
 
+/// One agent per vehicle of scenario 2.
+fn fleet_agents(endpoint: &str) -> Vec<Agent> {
+    ["auv1", "auv2", "auv3"]
+        .iter()
+        .map(|v| agent(v, endpoint))
+        .collect()
+}
+
 /// Runs the coordinator on a thread and waits for it at most [`LIMIT`]; `on_iteration` sees
 /// every round's iteration count.
 fn coordinate(
@@ -111,10 +119,7 @@ fn agents_over_loopback_give_the_lockstep_plan() -> TestResult {
     let s = scenario()?;
     let endpoint = free_endpoint()?;
     // Agents first: they wait for the coordinator's router.
-    let agents: Vec<Agent> = ["auv1", "auv2", "auv3"]
-        .iter()
-        .map(|v| agent(v, &endpoint))
-        .collect();
+    let agents = fleet_agents(&endpoint);
     let plan = coordinate(&s, options("loopback-same", &endpoint, 30), |_| {})??;
     finish(agents)?;
     let reference = lockstep::run(&s, None, &mut |_| {});
@@ -143,10 +148,7 @@ fn agents_over_loopback_give_the_lockstep_plan() -> TestResult {
 fn a_lost_agent_is_planned_by_the_coordinator() -> TestResult {
     let s = scenario()?;
     let endpoint = free_endpoint()?;
-    let agents: Vec<Agent> = ["auv1", "auv2", "auv3"]
-        .iter()
-        .map(|v| agent(v, &endpoint))
-        .collect();
+    let agents = fleet_agents(&endpoint);
     // auv2's agent shuts down once the coordinator reports iteration 5 (the end of round 1).
     let auv2 = Arc::clone(&agents[1].stop);
     let plan = coordinate(&s, options("loopback-lost", &endpoint, 30), move |it| {

@@ -11,7 +11,7 @@ use std::time::{Duration, Instant};
 
 use shoal_common::cost::FleetModel;
 use shoal_common::distributed::follower::{FollowerSettings, Followers};
-use shoal_common::distributed::{round_iterations, rounds, Context};
+use shoal_common::distributed::{round_iterations, rounds, Chromosome, Context};
 use shoal_common::scenario::Scenario;
 use shoal_common::swarm::Progress;
 use shoal_common::wire::agent_to_coordinator::AgentToCoordinator;
@@ -135,9 +135,7 @@ pub fn run(
                 if latest.round >= context_round && latest.round > followers.context().round {
                     followers.set_context(latest.clone());
                 }
-                for (k, c) in particles.into_iter().enumerate() {
-                    followers.immigrate(k, c.into());
-                }
+                followers.immigrate_all(particles.into_iter().map(Chromosome::from).enumerate());
             }
             Wait::End(why) => {
                 outcome = why;

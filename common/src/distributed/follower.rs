@@ -122,10 +122,7 @@ impl Followers {
     ) -> Followers {
         let mut f = Followers::new(model, vehicle, settings, context);
         f.iterations = iterations_done;
-        for (k, c) in last_elites.iter().enumerate() {
-            let k = k % f.populations.len();
-            f.immigrate(k, c.clone());
-        }
+        f.immigrate_all(last_elites.iter().cloned().enumerate());
         f
     }
 
@@ -172,34 +169,42 @@ impl Followers {
     /// An updated immigrant returns to population `k` (Fig. 5c): scored in the current context,
     /// it replaces the population's worst particle. Out-of-range genes are clamped to the box.
     pub fn immigrate(&mut self, k: usize, c: Chromosome) {
+        self.immigrate_all([(k, c)]);
+    }
+
+    /// Immigrants `(population, chromosome)` in one go: the problem in the current context is
+    /// built once for the whole batch (an exchange returns one migrant per population).
+    pub fn immigrate_all(&mut self, migrants: impl IntoIterator<Item = (usize, Chromosome)>) {
         let problem = problem_of(&self.model, self.vehicle, &self.context);
         let dim = problem.dim();
-        if c.x.len() != dim || c.v.len() != dim || self.populations.is_empty() {
-            return;
-        }
-        let x: Vec<f64> =
-            c.x.iter()
-                .zip(problem.lower().iter().zip(problem.upper()))
-                .map(|(g, (lo, hi))| {
-                    if g.is_finite() {
-                        g.clamp(*lo, *hi)
-                    } else {
-                        *lo
-                    }
-                })
-                .collect();
-        let mut p = Particle::new(&problem, x);
-        p.v =
-            c.v.iter()
-                .zip(&self.limits.vmax)
-                .map(|(v, m)| if v.is_finite() { v.clamp(-m, *m) } else { 0.0 })
-                .collect();
         let n = self.populations.len();
-        let pop = &mut self.populations[k % n];
-        let worst = pop.worst();
-        pop.particles[worst] = p;
-        pop.evaluations += 1;
-        self.evaluations += 1 + pop.refresh(&problem);
+        for (k, c) in migrants {
+            if c.x.len() != dim || c.v.len() != dim || n == 0 {
+                continue;
+            }
+            let x: Vec<f64> =
+                c.x.iter()
+                    .zip(problem.lower().iter().zip(problem.upper()))
+                    .map(|(g, (lo, hi))| {
+                        if g.is_finite() {
+                            g.clamp(*lo, *hi)
+                        } else {
+                            *lo
+                        }
+                    })
+                    .collect();
+            let mut p = Particle::new(&problem, x);
+            p.v =
+                c.v.iter()
+                    .zip(&self.limits.vmax)
+                    .map(|(v, m)| if v.is_finite() { v.clamp(-m, *m) } else { 0.0 })
+                    .collect();
+            let pop = &mut self.populations[k % n];
+            let worst = pop.worst();
+            pop.particles[worst] = p;
+            pop.evaluations += 1;
+            self.evaluations += 1 + pop.refresh(&problem);
+        }
     }
 
     /// Scores every memory in a new context (see the module notes). A context from an older

@@ -75,13 +75,7 @@ impl Leader {
 
     /// Keeps `x` (truly evaluated at `cost`) if it beats the best.
     fn offer(&mut self, x: &[f64], cost: f64) -> bool {
-        if cost < self.best_cost {
-            self.best_cost = cost;
-            self.best_x = x.to_vec();
-            true
-        } else {
-            false
-        }
+        keep_better(&mut self.best_x, &mut self.best_cost, x, cost)
     }
 
     /// One exchange (Fig. 5). `elites[i]` are vehicle `i`'s emigrants, one per follower
@@ -119,7 +113,7 @@ impl Leader {
         self.evaluations += immigrants.len() as u64;
         let mut improved = false;
         for p in &immigrants {
-            improved |= self.offer(&p.x.clone(), p.cost);
+            improved |= self.offer(&p.x, p.cost);
         }
         // o_f_gbest: assembled vehicle by vehicle from the immigrants, trusted only if truly
         // better than the best immigrant.
@@ -171,11 +165,7 @@ impl Leader {
         parallel::for_each_mut(&mut movers, self.threads, |p| p.evaluate(model));
         self.evaluations += movers.len() as u64;
         for p in self.leader.particles.iter().chain(immigrants.iter()) {
-            if p.cost < self.best_cost {
-                self.best_cost = p.cost;
-                self.best_x.clone_from(&p.x);
-                improved = true;
-            }
+            improved |= keep_better(&mut self.best_x, &mut self.best_cost, &p.x, p.cost);
         }
         for im in &immigrants {
             if im.cost < self.leader.elite_cost {
@@ -200,6 +190,18 @@ impl Leader {
             })
             .collect();
         (migrants, improved)
+    }
+}
+
+/// Replaces `(best_x, best_cost)` by `(x, cost)` when `cost` is lower; says whether it did.
+fn keep_better(best_x: &mut Vec<f64>, best_cost: &mut f64, x: &[f64], cost: f64) -> bool {
+    if cost < *best_cost {
+        *best_cost = cost;
+        best_x.clear();
+        best_x.extend_from_slice(x);
+        true
+    } else {
+        false
     }
 }
 

@@ -86,9 +86,7 @@ pub fn run(
             }
         }
         for (f, ms) in followers.iter_mut().zip(migrants) {
-            for (k, m) in ms.into_iter().enumerate() {
-                f.immigrate(k, m);
-            }
+            f.immigrate_all(ms.into_iter().enumerate());
         }
         if let Some(last) = convergence.last_mut() {
             *last = leader.best_cost();

@@ -4,7 +4,7 @@
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
-use shoal_common::distributed::{Chromosome, Context};
+use shoal_common::distributed::Context;
 use shoal_common::wire::agent_to_coordinator::AgentToCoordinator;
 
 use super::super::agents::LocalAgents;
@@ -78,11 +78,7 @@ impl Run<'_> {
                     if let Some(i) = self.index(&vehicle) {
                         let seat = &mut self.seats[i];
                         seat.joined = true;
-                        seat.elites_received += 1;
-                        seat.agent_iterations = iteration;
-                        seat.agent_evaluations = evaluations;
-                        seat.this_round =
-                            Some(particles.into_iter().map(Chromosome::from).collect());
+                        seat.take_elites(iteration, evaluations, particles);
                     }
                 }
                 Some(Event::Message(m)) => self.net.out_of_turn(&format!(

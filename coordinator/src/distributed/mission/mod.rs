@@ -72,6 +72,16 @@ struct Seat {
     gone: Option<(Instant, String)>,
 }
 
+impl Seat {
+    /// Keeps an agent's elites for the current round, with the figures they report.
+    fn take_elites(&mut self, iteration: u32, evaluations: u64, particles: Vec<WireChromosome>) {
+        self.elites_received += 1;
+        self.agent_iterations = iteration;
+        self.agent_evaluations = evaluations;
+        self.this_round = Some(particles.into_iter().map(Chromosome::from).collect());
+    }
+}
+
 /// How long a vehicle whose agent was seen to go keeps its seat: Zenoh sends declarations
 /// (the liveliness token's end) ahead of queued data, so an agent that leaves right after its
 /// last elites can be "gone" before they arrive, and an agent whose link blinked may be back.
@@ -386,10 +396,7 @@ impl Run<'_> {
                         ));
                         continue;
                     }
-                    seat.elites_received += 1;
-                    seat.agent_iterations = it;
-                    seat.agent_evaluations = evaluations;
-                    seat.this_round = Some(particles.into_iter().map(Chromosome::from).collect());
+                    seat.take_elites(it, evaluations, particles);
                 }
                 Some(Event::Message(AgentToCoordinator::Done {
                     vehicle,
@@ -434,11 +441,7 @@ impl Run<'_> {
         for (i, ms) in migrants.into_iter().enumerate() {
             let seat = &mut self.seats[i];
             match &mut seat.local {
-                Some(f) => {
-                    for (k, m) in ms.into_iter().enumerate() {
-                        f.immigrate(k, m);
-                    }
-                }
+                Some(f) => f.immigrate_all(ms.into_iter().enumerate()),
                 None => self.net.send(
                     &seat.id,
                     CoordinatorToAgent::Migrants {
