@@ -17,7 +17,8 @@
 //! each as `count + depth of the breach relative to its limit`, so the swarm feels both how many
 //! and how bad.
 
-use crate::geometry::{chord_inside_sphere, pitch, Vec3, MIN_HEADING_EXTENT};
+use crate::crawler::{CrawlerModel, CrawlerTerms};
+use crate::geometry::{chord_inside_sphere, pitch, Vec3, CONTACT_GUARD_M, MIN_HEADING_EXTENT};
 use crate::scenario::{Scenario, Vehicle};
 use crate::separation::{motion_separation, Motion};
 use crate::trajectory::{common_arrival, retime_legs, Layout, Path, Trajectory};
@@ -93,7 +94,13 @@ fn sphere_terms(points: &[Vec3], hard: &[Sphere], soft: &[Sphere]) -> SphereTerm
         .map(|s| (s, true))
         .chain(soft.iter().map(|s| (s, false)))
     {
-        let r2 = s.radius * s.radius;
+        // Hard spheres are tested with the contact guard (see `CONTACT_GUARD_M`).
+        let reach = if is_hard {
+            s.radius + CONTACT_GUARD_M
+        } else {
+            s.radius
+        };
+        let r2 = reach * reach;
         for (chunk, (lo, hi)) in boxes.iter().enumerate() {
             let gap = (lo - s.centre).sup(&(s.centre - hi)).sup(&Vec3::zeros());
             if gap.norm_squared() >= r2 {
@@ -113,7 +120,7 @@ fn sphere_terms(points: &[Vec3], hard: &[Sphere], soft: &[Sphere]) -> SphereTerm
                 let d2 = (q - k * u).norm_squared();
                 if d2 < r2 {
                     if is_hard {
-                        out.hard_penalty += 1.0 + (s.radius - d2.sqrt()) / s.radius;
+                        out.hard_penalty += 1.0 + ((s.radius - d2.sqrt()) / s.radius).max(0.0);
                         out.hard_hits += 1;
                     } else {
                         out.soft_inside += chord_inside_sphere(&a, &b, &s.centre, s.radius);
@@ -229,6 +236,9 @@ pub struct VehicleTerms {
     pub separation: f64,
     /// Hard-obstacle intrusions (leg × obstacle).
     pub hard_hits: usize,
+    /// A crawler's seed 000 eq. (10) objective (standardised, without penalties), which takes
+    /// the place of F(L) + F(D) + F(O); `None` for swimmers.
+    pub crawler: Option<f64>,
 }
 
 /// Everything the fitness computed for one fleet particle.
@@ -267,6 +277,9 @@ pub struct FleetModel {
     pub soft: Vec<Sphere>,
     /// Straight-line distance of every vehicle, metres.
     pub straight: Vec<f64>,
+    /// Per vehicle: the crawler cost model and its straight path's terms (the standardisation
+    /// scales), or `None` for a swimmer.
+    pub crawlers: Vec<Option<(CrawlerModel, CrawlerTerms)>>,
 }
 
 impl FleetModel {
@@ -289,14 +302,59 @@ impl FleetModel {
                 .iter()
                 .map(|v| (v.goal() - v.start()).norm())
                 .collect(),
+            crawlers: (0..scenario.vehicles.len())
+                .map(|i| {
+                    scenario.crawler_model(i).map(|m| {
+                        let r = m.reference();
+                        (m, r)
+                    })
+                })
+                .collect(),
             scenario: scenario.clone(),
         }
+    }
+
+    /// Vehicle `i`'s path from its chromosome: the waypoint polygon for a swimmer; for a
+    /// crawler the clamped cubic B-spline through its horizontal waypoints, sampled and draped
+    /// on the seabed (seed 000 eq. (12)–(13)), each sample leg taking the speed gene of the
+    /// control leg it belongs to.
+    pub fn decode(&self, i: usize, genes: &[f64]) -> Path {
+        let v = &self.scenario.vehicles[i];
+        let Some((crawler, _)) = &self.crawlers[i] else {
+            return Path::decode(v, genes);
+        };
+        let m = genes.len() / crate::trajectory::GENES_PER_WAYPOINT;
+        let (coords, status) = genes.split_at(3 * m);
+        let points = crawler.path_through(coords.chunks_exact(3).map(|g| [g[0], g[1]]));
+        let legs = points.len().saturating_sub(1);
+        let speeds = (0..legs)
+            .map(|k| {
+                let control_leg = k * (m + 1) / legs.max(1);
+                status
+                    .get(control_leg.min(m.saturating_sub(1)))
+                    .copied()
+                    .unwrap_or(v.speed_max_mps)
+            })
+            .collect();
+        Path { points, speeds }
     }
 
     /// Vehicle-local terms of vehicle `i` (everything but F(S) and the separation penalty).
     pub fn vehicle_terms(&self, i: usize, path: &Path, length: f64) -> VehicleTerms {
         let s = &self.scenario;
         let v = &s.vehicles[i];
+        if let Some((crawler, reference)) = &self.crawlers[i] {
+            let t = crawler.terms(&path.points);
+            return VehicleTerms {
+                length: length_term(length, self.straight[i]),
+                time: time_term(length, v, s.fleet.mission_time_s),
+                hard: t.hazard_penalty,
+                motion: turn_penalty(&path.points, v.max_turn_deg.to_radians()) + t.slope_penalty,
+                hard_hits: t.hazard_intrusions,
+                crawler: Some(crawler.objective_of(&t, reference)),
+                ..VehicleTerms::default()
+            };
+        }
         let surface = s.bounds.max[2];
         let column = s.bounds.max[2] - s.bounds.min[2];
         let spheres = sphere_terms(&path.points, &self.hard, &self.soft);
@@ -311,13 +369,19 @@ impl FleetModel {
             motion: turn_penalty(&path.points, v.max_turn_deg.to_radians())
                 + pitch_penalty(&path.points, v.max_pitch_deg.to_radians()),
             hard_hits: spheres.hard_hits,
+            crawler: None,
         }
     }
 
-    /// Vehicle `t`'s weighted share of eq. (12).
+    /// Vehicle `t`'s weighted share of eq. (12). For a crawler, seed 000's eq. (10) objective
+    /// stands in for the three path terms and takes their weights: `(λ1 + λ2 + λ3) F_c`.
     pub fn objective_of(&self, t: &VehicleTerms) -> f64 {
         let w = &self.scenario.optimizer.weights;
-        w[0] * t.length + w[1] * t.depth + w[2] * t.soft + w[3] * t.time + w[4] * t.space
+        let path = match t.crawler {
+            Some(c) => (w[0] + w[1] + w[2]) * c,
+            None => w[0] * t.length + w[1] * t.depth + w[2] * t.soft,
+        };
+        path + w[3] * t.time + w[4] * t.space
     }
 
     /// Vehicle `t`'s share of the total fitness: its eq. (12) terms plus its weighted penalties
@@ -334,7 +398,7 @@ impl FleetModel {
             .vehicles
             .iter()
             .enumerate()
-            .map(|(i, v)| Path::decode(v, &x[self.layout.chromosome(i)]))
+            .map(|(i, _)| self.decode(i, &x[self.layout.chromosome(i)]))
             .collect();
         let legs: Vec<Vec<f64>> = paths.iter().map(Path::leg_lengths).collect();
         let lengths: Vec<f64> = legs.iter().map(|l| l.iter().sum()).collect();
@@ -472,6 +536,22 @@ mod tests {
         assert_eq!(n, 1);
         assert_abs_diff_eq!(p, 1.5, epsilon = 1e-12);
         let (p, n) = hard_penalty(&[v(0., 20., 0.), v(100., 20., 0.)], &hard);
+        assert_eq!((p, n), (0.0, 0));
+    }
+
+    #[test]
+    fn hard_penalty_guards_a_leg_that_grazes_the_inflated_sphere() {
+        // The leg runs exactly on the surface (5 + 10 = 15 from the centre's line): a checker
+        // calls that clear, but the planner demands the contact guard beyond it, so it is one hit
+        // with penalty 1. A leg 1 mm further out is clear.
+        let hard = [Sphere {
+            centre: v(50., 15., 0.),
+            radius: 15.0,
+        }];
+        let (p, n) = hard_penalty(&[v(0., 0., 0.), v(100., 0., 0.)], &hard);
+        assert_eq!(n, 1);
+        assert_abs_diff_eq!(p, 1.0, epsilon = 1e-12);
+        let (p, n) = hard_penalty(&[v(0., -0.001, 0.), v(100., -0.001, 0.)], &hard);
         assert_eq!((p, n), (0.0, 0));
     }
 

@@ -19,14 +19,16 @@
 //!
 //! Standardisation: the paper z-scores each term over the swarm (`(x − μ)/σ`), which makes a
 //! particle's cost depend on the other particles and change between iterations. Shoal divides
-//! each of `f_d`, `f_u`, `f_e` by its value on the straight start→goal line draped on the same
-//! terrain (so each is dimensionless and about 1), keeps `f_s` as it is (already in [0, 1] per
-//! hazard), and weighs them with ω = (0.5, 0.2, 0.2, 0.1) as §2.3.5 assigns them (length 0.5,
+//! `f_d` and `f_e` by their values on the straight start→goal line draped on the same terrain
+//! (so each is dimensionless and about 1), and divides `f_u` by that line's *length*, not by its
+//! undulation: on a gentle summit the straight line's undulation can be a few decimetres, and a
+//! ratio to it would weigh a 1 m bump like a 100 m detour. `f_s` stays as it is (in [0, 1] per
+//! hazard). The weights are ω = (0.5, 0.2, 0.2, 0.1) as §2.3.5 assigns them (length 0.5,
 //! undulation 0.2, slip 0.2, energy 0.1).
 //!
-//! Constraints, as penalties of weight `penalty_weight`: a sample inside a hazard's circle
-//! (`1 + depth / radius` per intruding leg) and a leg steeper than `max_slope_deg`
-//! (`1 + excess / limit`).
+//! Constraints, as penalties of weight `penalty_weight`: a path entering a hazard's circle
+//! (`1 + min(depth / radius, 1)` per hazard) and a leg steeper than `max_slope_deg`
+//! (`1 + excess / limit` per leg).
 
 use crate::bspline;
 use crate::geometry::Vec3;
@@ -83,18 +85,33 @@ pub struct CrawlerTerms {
     pub min_hazard_clearance_m: f64,
     /// Steepest leg, degrees.
     pub max_slope_deg: f64,
-    /// Unweighted constraint penalty (0 when admissible).
-    pub penalty: f64,
+    /// Unweighted hazard-intrusion penalty (0 when admissible).
+    pub hazard_penalty: f64,
+    /// Unweighted slope penalty (0 when admissible).
+    pub slope_penalty: f64,
+    /// Hazards the path enters.
+    pub hazard_intrusions: usize,
+}
+
+impl CrawlerTerms {
+    /// Both penalties, unweighted.
+    pub fn penalty(&self) -> f64 {
+        self.hazard_penalty + self.slope_penalty
+    }
 }
 
 impl CrawlerModel {
     /// The smoothed path of a particle, draped on the terrain.
     pub fn path(&self, genes: &[f64]) -> Vec<Vec3> {
+        self.path_through(genes.chunks_exact(2).map(|xy| [xy[0], xy[1]]))
+    }
+
+    /// The smoothed, draped path with the horizontal control points `inner` between start and
+    /// goal (clamped cubic B-spline, eq. (12)–(13), `samples` points).
+    pub fn path_through(&self, inner: impl Iterator<Item = [f64; 2]>) -> Vec<Vec3> {
         let mut control = Vec::with_capacity(self.control_points + 2);
         control.push(Vec3::new(self.start[0], self.start[1], 0.0));
-        for xy in genes.chunks_exact(2) {
-            control.push(Vec3::new(xy[0], xy[1], 0.0));
-        }
+        control.extend(inner.map(|[x, y]| Vec3::new(x, y, 0.0)));
         control.push(Vec3::new(self.goal[0], self.goal[1], 0.0));
         bspline::sample(&control, 3, self.samples)
             .into_iter()
@@ -134,7 +151,7 @@ impl CrawlerModel {
         let undulation: f64 = path.windows(2).map(|w| (w[1].z - w[0].z).abs()).sum();
         let mut slip = 0.0;
         let mut clearance = f64::INFINITY;
-        let mut penalty = 0.0;
+        let (mut hazard_penalty, mut slope_penalty, mut intrusions) = (0.0, 0.0, 0);
         for h in &self.hazards {
             let d = path
                 .windows(2)
@@ -142,8 +159,13 @@ impl CrawlerModel {
                 .fold(f64::INFINITY, f64::min);
             clearance = clearance.min(d);
             slip += self.slip_of(d);
+            // The penalty starts at the contact guard; the reported count is the strict one
+            // every checker recomputes.
+            if d < crate::geometry::CONTACT_GUARD_M {
+                hazard_penalty += 1.0 + (-d / h.radius_m.max(1e-9)).clamp(0.0, 1.0);
+            }
             if d < 0.0 {
-                penalty += 1.0 + (-d / h.radius_m.max(1e-9)).min(1.0);
+                intrusions += 1;
             }
         }
         let mut steepest: f64 = 0.0;
@@ -152,7 +174,7 @@ impl CrawlerModel {
             let slope = (w[1].z - w[0].z).abs().atan2(horizontal).to_degrees();
             steepest = steepest.max(slope);
             if slope > self.max_slope_deg {
-                penalty += 1.0 + (slope - self.max_slope_deg) / self.max_slope_deg;
+                slope_penalty += 1.0 + (slope - self.max_slope_deg) / self.max_slope_deg;
             }
         }
         CrawlerTerms {
@@ -162,7 +184,9 @@ impl CrawlerModel {
             slip,
             min_hazard_clearance_m: clearance,
             max_slope_deg: steepest,
-            penalty,
+            hazard_penalty,
+            slope_penalty,
+            hazard_intrusions: intrusions,
         }
     }
 
@@ -181,15 +205,90 @@ impl CrawlerModel {
         self.terms(&self.path(&genes))
     }
 
-    /// Eq. (10) with the standardisation above, plus the weighted penalty.
-    pub fn cost_of(&self, t: &CrawlerTerms, reference: &CrawlerTerms) -> f64 {
+    /// Eq. (10) with the standardisation above, without the penalties.
+    pub fn objective_of(&self, t: &CrawlerTerms, reference: &CrawlerTerms) -> f64 {
         let scale = |v: f64, r: f64| if r > 1e-12 { v / r } else { v };
         let [w1, w2, w3, w4] = self.weights;
         w1 * scale(t.length_m, reference.length_m)
-            + w2 * scale(t.undulation_m, reference.undulation_m)
+            + w2 * scale(t.undulation_m, reference.length_m)
             + w3 * t.slip
             + w4 * scale(t.energy_kwh, reference.energy_kwh)
-            + self.penalty_weight * t.penalty
+    }
+
+    /// [`Self::objective_of`] plus the weighted penalties.
+    pub fn cost_of(&self, t: &CrawlerTerms, reference: &CrawlerTerms) -> f64 {
+        self.objective_of(t, reference) + self.penalty_weight * t.penalty()
+    }
+}
+
+/// What `plan.json` reports of a crawler's path (seed 000 §5.2's figures), recomputed from the
+/// planned trajectory's points.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct CrawlerFigures {
+    /// 3D length of the smoothed path on the seabed, metres (eq. (5)).
+    pub length_m: f64,
+    /// Undulation, metres (eq. (6)).
+    pub undulation_m: f64,
+    /// Energy, kWh (eq. (7), §5.1 powers and 60/40 mining/travel split).
+    pub energy_kwh: f64,
+    /// Slip cost f_s (eq. (8)–(9)), summed over hazards.
+    pub slip_cost: f64,
+    /// Smallest horizontal distance to a hazard's edge, metres (`null` without hazards;
+    /// negative inside one).
+    pub min_hazard_clearance_m: Option<f64>,
+    /// Hazards the path enters.
+    pub hazard_intrusions: usize,
+    /// Steepest leg on the seabed, degrees.
+    pub max_slope_deg: f64,
+    /// The slope limit (the vehicle's pitch limit), degrees.
+    pub slope_limit_deg: f64,
+    /// Largest distance of a sample from the seabed plus the sensor height, metres (0 when
+    /// the path follows the seabed).
+    pub off_seabed_m: f64,
+}
+
+impl CrawlerFigures {
+    /// The figures of the trajectory points `points` under `model`.
+    pub fn of(model: &CrawlerModel, points: &[Vec3]) -> CrawlerFigures {
+        let t = model.terms(points);
+        let off = points
+            .iter()
+            .map(|p| (p.z - model.terrain.elevation(p.x, p.y) - model.sensor_height_m).abs())
+            .fold(0.0, f64::max);
+        CrawlerFigures {
+            length_m: t.length_m,
+            undulation_m: t.undulation_m,
+            energy_kwh: t.energy_kwh,
+            slip_cost: t.slip,
+            min_hazard_clearance_m: t
+                .min_hazard_clearance_m
+                .is_finite()
+                .then_some(t.min_hazard_clearance_m),
+            hazard_intrusions: t.hazard_intrusions,
+            max_slope_deg: t.max_slope_deg,
+            slope_limit_deg: model.max_slope_deg,
+            off_seabed_m: off,
+        }
+    }
+
+    /// Broken crawler constraints, in plain words (the slope limit is the pitch limit, which
+    /// the plan checks for every vehicle).
+    pub fn violations(&self, id: &str) -> Vec<String> {
+        let mut out = Vec::new();
+        if self.hazard_intrusions > 0 {
+            out.push(format!(
+                "{id} enters {} hazard zone(s) of soft substrate (clearance {:.2} m)",
+                self.hazard_intrusions,
+                self.min_hazard_clearance_m.unwrap_or(0.0)
+            ));
+        }
+        if self.off_seabed_m > 1e-6 {
+            out.push(format!(
+                "{id} is a crawler but its path leaves the seabed by {:.3} m",
+                self.off_seabed_m
+            ));
+        }
+        out
     }
 }
 
@@ -252,6 +351,9 @@ mod tests {
             e: 0.0,
             f: 0.0,
             g: 0.0,
+            length_scale_m: 1.0,
+            height_scale_m: 1.0,
+            datum_m: 0.0,
         }
     }
 
@@ -312,7 +414,7 @@ mod tests {
         assert_abs_diff_eq!(r.undulation_m, 0.0, epsilon = 1e-12);
         assert_abs_diff_eq!(r.min_hazard_clearance_m, 4.0, epsilon = 1e-9);
         assert_abs_diff_eq!(r.slip, 0.75, epsilon = 1e-9);
-        assert_eq!((r.penalty, r.max_slope_deg), (0.0, 0.0));
+        assert_eq!((r.penalty(), r.max_slope_deg), (0.0, 0.0));
         assert_abs_diff_eq!(m.energy_kwh(100.0), r.energy_kwh, epsilon = 1e-12);
         // Its standardised cost: 0.5 + 0.2·0 + 0.2·0.75 + 0.1.
         assert_abs_diff_eq!(m.cost_of(&r, &r), 0.75, epsilon = 1e-9);
@@ -332,7 +434,7 @@ mod tests {
         let m = model(hill, vec![]);
         let r = m.reference();
         assert!(r.max_slope_deg > 40.0, "{}", r.max_slope_deg);
-        assert!(r.penalty > 1.0);
+        assert!(r.slope_penalty > 1.0 && r.hazard_penalty == 0.0);
         assert_abs_diff_eq!(r.undulation_m, 20.0, epsilon = 0.1);
         let p = m.path(&[25.0, 0.0, 50.0, 0.0, 75.0, 0.0]);
         assert_abs_diff_eq!(p[50].z, 10.5, epsilon = 1e-6);
@@ -343,10 +445,10 @@ mod tests {
         let m = model(flat(), vec![hazard(50.0, 0.0, 8.0)]);
         let problem = CrawlerProblem::new(m);
         let straight = problem.model.reference();
-        assert!(straight.penalty > 0.0);
+        assert!(straight.hazard_penalty > 0.0 && straight.hazard_intrusions == 1);
         let out = Executor::new(100).run(&problem, &mut Ipso::table8(30, 2), |_| {});
         let t = problem.terms(out.state.best_position());
-        assert_eq!(t.penalty, 0.0, "{t:?}");
+        assert_eq!(t.penalty(), 0.0, "{t:?}");
         assert!(t.min_hazard_clearance_m >= 0.0);
         // Around an 8 m circle the detour is short: well under 20 % longer.
         assert!(t.length_m < 120.0, "{t:?}");

@@ -90,9 +90,12 @@ impl FleetModel {
         } else {
             rng.random_range(0.02..=0.5) * span
         };
-        for p in bent_curve(a, b, m, &shape, amp)[1..=m].iter() {
+        // The chromosome's own bounds: a crawler's z genes are pinned.
+        let first = self.layout.chromosome(i).start;
+        for (j, p) in bent_curve(a, b, m, &shape, amp)[1..=m].iter().enumerate() {
             for d in 0..3 {
-                x.push(p[d].clamp(s.bounds.min[d], s.bounds.max[d]));
+                let g = first + 3 * j + d;
+                x.push(p[d].clamp(self.lower[g], self.upper[g]));
             }
         }
         x.extend((0..m).map(|_| rng.random_range(v.speed_min_mps..=v.speed_max_mps)));

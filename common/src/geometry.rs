@@ -26,6 +26,13 @@ pub fn segment_point_distance(a: &Vec3, b: &Vec3, p: &Vec3) -> f64 {
     (a + (b - a) * u - p).norm()
 }
 
+/// Extra distance, metres, the planner's penalties demand beyond a hard limit (an obstacle's
+/// inflated radius, a hazard's edge). A path the optimizer drives onto the limit itself would
+/// otherwise pass or fail on the last bit of rounding, and a checker that computes the same
+/// distance another way could see it 1e-13 m inside: with this guard whatever the planner accepts
+/// is strictly clear for every checker.
+pub const CONTACT_GUARD_M: f64 = 1e-6;
+
 /// True when segment `a→b` comes strictly closer than `radius` to `centre` anywhere along it.
 ///
 /// This is seed 003 eq. (31)–(33) restricted to the segment: the quadratic

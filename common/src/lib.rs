@@ -1,6 +1,7 @@
 //! Shoal's shared model and algorithms: scenarios, geometry, timed trajectories, the fleet
 //! fitness of seed 004 and the swarm optimizers.
 
+pub mod benchfns;
 pub mod bspline;
 pub mod cost;
 pub mod crawler;
@@ -14,6 +15,7 @@ pub mod health;
 pub mod plan;
 pub mod scenario;
 pub mod separation;
+pub mod stats;
 pub mod swarm;
 pub mod terrain;
 pub mod trajectory;

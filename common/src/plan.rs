@@ -41,6 +41,9 @@ pub struct VehiclePlan {
     pub hard_collisions: usize,
     /// Metres of path inside inflated soft obstacles.
     pub soft_exposure_m: f64,
+    /// Crawlers only: the seed 000 figures of the path on the seabed.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub crawler: Option<crate::crawler::CrawlerFigures>,
 }
 
 /// Fleet-wide figures.
@@ -76,8 +79,14 @@ pub struct Assessment {
 pub fn assess(scenario: &Scenario, trajectories: &[Trajectory]) -> Assessment {
     let mut violations = Vec::new();
     let mut vehicles = Vec::with_capacity(trajectories.len());
-    for (v, t) in scenario.vehicles.iter().zip(trajectories) {
+    for (i, (v, t)) in scenario.vehicles.iter().zip(trajectories).enumerate() {
         let pts = &t.points;
+        let crawler = scenario
+            .crawler_model(i)
+            .map(|m| crate::crawler::CrawlerFigures::of(&m, pts));
+        if let Some(c) = &crawler {
+            violations.extend(c.violations(&v.id));
+        }
         let length: f64 = pts.windows(2).map(|w| (w[1] - w[0]).norm()).sum();
         let max_turn = turns(pts).map(f64::to_degrees).fold(0.0, f64::max);
         let max_pitch = pts
@@ -160,8 +169,13 @@ pub fn assess(scenario: &Scenario, trajectories: &[Trajectory]) -> Assessment {
         if out_of_bounds {
             violations.push(format!("{} leaves the scenario bounds", v.id));
         }
-        let ends_ok = pts.first().is_some_and(|p| (p - v.start()).norm() <= TOL)
-            && pts.last().is_some_and(|p| (p - v.goal()).norm() <= TOL);
+        // A crawler's ends are on the seabed below its start and goal.
+        let gap = |p: &crate::geometry::Vec3, q: crate::geometry::Vec3| match crawler {
+            Some(_) => (p.x - q.x).hypot(p.y - q.y),
+            None => (p - q).norm(),
+        };
+        let ends_ok = pts.first().is_some_and(|p| gap(p, v.start()) <= TOL)
+            && pts.last().is_some_and(|p| gap(p, v.goal()) <= TOL);
         if !ends_ok {
             violations.push(format!("{} does not run from its start to its goal", v.id));
         }
@@ -182,6 +196,7 @@ pub fn assess(scenario: &Scenario, trajectories: &[Trajectory]) -> Assessment {
             min_clearance_m: clearance,
             hard_collisions,
             soft_exposure_m: soft_exposure,
+            crawler,
         });
     }
 
@@ -241,14 +256,6 @@ pub fn notices(
     common_arrival: f64,
 ) -> Vec<String> {
     let mut out = Vec::new();
-    for v in &scenario.vehicles {
-        if v.kind == crate::scenario::VehicleKind::Crawler {
-            out.push(format!(
-                "{} is a crawler, but seabed terrain and crawler costs are not built yet: it was planned as a free-swimming vehicle",
-                v.id
-            ));
-        }
-    }
     let mission = scenario.fleet.mission_time_s;
     for (v, t) in scenario.vehicles.iter().zip(trajectories) {
         let length: f64 = t.points.windows(2).map(|w| (w[1] - w[0]).norm()).sum();
@@ -526,10 +533,6 @@ mission_time_s = 1000.0
         assert_eq!(n.len(), 1, "{n:?}");
         assert!(n[0].starts_with("a's planned path of 1500 m"), "{}", n[0]);
         assert!(n[0].contains("would take 500 s"), "{}", n[0]);
-        // A crawler is planned as a swimmer, and the plan says so.
-        s.vehicles[1].kind = crate::scenario::VehicleKind::Crawler;
-        let n = notices(&s, &t, 500.0);
-        assert!(n[0].contains("b is a crawler"), "{}", n[0]);
         Ok(())
     }
 }

@@ -67,9 +67,14 @@ impl Layout {
         let mut lo = Vec::with_capacity(self.dim());
         let mut hi = Vec::with_capacity(self.dim());
         for v in &scenario.vehicles {
+            // A crawler's z follows the seabed: its z genes are pinned (and ignored).
+            let mut top = scenario.bounds.max;
+            if v.kind == crate::scenario::VehicleKind::Crawler {
+                top[2] = scenario.bounds.min[2];
+            }
             for _ in 0..self.waypoints {
                 lo.extend_from_slice(&scenario.bounds.min);
-                hi.extend_from_slice(&scenario.bounds.max);
+                hi.extend_from_slice(&top);
             }
             lo.extend(std::iter::repeat_n(v.speed_min_mps, self.waypoints));
             hi.extend(std::iter::repeat_n(v.speed_max_mps, self.waypoints));

@@ -17,7 +17,7 @@ use rand::rngs::StdRng;
 use crate::cost::{separation_penalty, space_term, FleetModel, VehicleTerms};
 use crate::separation::{motion_separation, Motion};
 use crate::swarm::Problem;
-use crate::trajectory::{retime_legs, Path, Trajectory};
+use crate::trajectory::{retime_legs, Trajectory};
 
 /// Vehicle `vehicle`'s chromosome against the other vehicles' fixed trajectories.
 #[derive(Debug, Clone)]
@@ -78,7 +78,7 @@ impl<'a> VehicleProblem<'a> {
     pub fn evaluate(&self, genes: &[f64]) -> VehicleEvaluation {
         let s = &self.model.scenario;
         let v = &s.vehicles[self.vehicle];
-        let path = Path::decode(v, genes);
+        let path = self.model.decode(self.vehicle, genes);
         let legs = path.leg_lengths();
         let length: f64 = legs.iter().sum();
         let mut terms = self.model.vehicle_terms(self.vehicle, &path, length);

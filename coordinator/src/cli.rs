@@ -32,6 +32,8 @@ pub enum Command {
     Router(RouterArgs),
     /// Container healthcheck: exit 0 if the health file was rewritten in the last 10 s.
     Health(HealthArgs),
+    /// Run the benchmark-function suite (seed 000 Table 3–6).
+    BenchFunctions(crate::bench_functions::BenchFunctionsArgs),
 }
 
 /// `shoal-coordinator plan`.
@@ -49,7 +51,9 @@ pub struct PlanArgs {
     /// RNG seed (overrides the scenario's).
     #[arg(long, env = "SHOAL_SEED")]
     pub seed: Option<u64>,
-    /// Optimizer: amp-pso, pso, mp-pso or a-pso (overrides the scenario's).
+    /// Optimizer: amp-pso, a-pso, mp-pso, pso (seed 004) or ipso, spso, cbpso, nspso, aco-pso
+    /// (seed 000);
+    /// overrides the scenario's.
     #[arg(long, env = "SHOAL_ALGORITHM")]
     pub algorithm: Option<Algorithm>,
     /// Iterations (overrides the scenario's).

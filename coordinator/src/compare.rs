@@ -45,6 +45,8 @@ pub struct Cell {
     pub worst_separation_m: f64,
     /// Evaluations per second over all runs.
     pub evals_per_s: f64,
+    /// Crawler figures, when the scenario has crawlers.
+    pub crawler: Option<crate::crawler_table::CrawlerStats>,
 }
 
 fn median(v: &mut [f64]) -> f64 {
@@ -100,6 +102,7 @@ pub fn cell(
             / plans.len().max(1) as f64,
         worst_separation_m: plans.iter().map(sep).fold(f64::INFINITY, f64::min),
         evals_per_s: if time > 0.0 { evals as f64 / time } else { 0.0 },
+        crawler: crate::crawler_table::CrawlerStats::of(plans),
     }
 }
 
@@ -118,7 +121,7 @@ pub fn compare(
     let mut cells = Vec::new();
     for s in scenarios {
         for &a in algorithms {
-            let multi = matches!(a, Algorithm::AmpPso | Algorithm::MpPso);
+            let multi = a.is_multi_population();
             for remote in [false, true] {
                 if remote && !(multi && distributed.is_some()) {
                     continue;
@@ -209,4 +212,7 @@ pub struct CompareArgs {
     /// Write the markdown table here too.
     #[arg(long, env = "SHOAL_OUT")]
     pub out: Option<PathBuf>,
+    /// Crawler scenarios: grid spacing of the reference shortest admissible path, metres.
+    #[arg(long, default_value_t = 0.5, env = "SHOAL_REFERENCE_CELL")]
+    pub reference_cell: f64,
 }

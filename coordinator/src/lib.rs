@@ -1,13 +1,16 @@
 //! Shoal's coordinator as a library: the binary parses its command line and calls [`run`]; tests
 //! call [`run`] (or the functions it uses) directly.
 
+pub mod bench_functions;
 pub mod cli;
 pub mod compare;
+pub mod crawler_table;
 pub mod distributed;
 pub mod generate;
 pub mod planner;
 pub mod summary;
 pub mod svg;
+pub mod svg_terrain;
 
 use std::io::IsTerminal;
 use std::path::Path;
@@ -16,7 +19,7 @@ use std::sync::Arc;
 
 use anyhow::{bail, Context};
 use shoal_common::plan::Plan;
-use shoal_common::scenario::{Algorithm, Scenario};
+use shoal_common::scenario::Scenario;
 use shoal_common::swarm::IterationReport;
 
 pub use cli::{Command, PlanArgs};
@@ -34,6 +37,7 @@ pub fn run(command: Command, shutdown: Arc<AtomicBool>) -> anyhow::Result<i32> {
     match command {
         Command::Plan(args) => plan_command(&args, shutdown),
         Command::Compare(args) => compare_command(&args, &shutdown),
+        Command::BenchFunctions(args) => bench_functions::command(&args, &shutdown),
         Command::Health(args) => {
             shoal_common::health::check(&args.file, std::time::Duration::from_secs(10))
                 .map_err(anyhow::Error::msg)?;
@@ -67,7 +71,7 @@ fn compare_command(args: &compare::CompareArgs, stop: &AtomicBool) -> anyhow::Re
     let multi = args
         .algorithms
         .iter()
-        .filter(|a| matches!(a, Algorithm::AmpPso | Algorithm::MpPso))
+        .filter(|a| a.is_multi_population())
         .count();
     let per_scenario = args.algorithms.len() + if args.distributed { multi } else { 0 };
     let total = scenarios.len() * per_scenario * args.seeds as usize;
@@ -106,7 +110,15 @@ fn compare_command(args: &compare::CompareArgs, stop: &AtomicBool) -> anyhow::Re
     if stop.load(std::sync::atomic::Ordering::Relaxed) {
         eprintln!("interrupted: the table has only the cells completed before Ctrl-C");
     }
-    let table = compare::markdown(&cells);
+    let mut table = compare::markdown(&cells);
+    if cells.iter().any(|c| c.crawler.is_some()) {
+        eprintln!(
+            "computing the reference crawler paths (grid {} m)…",
+            args.reference_cell
+        );
+        let references = crawler_table::references(&scenarios, args.reference_cell);
+        table.push_str(&crawler_table::markdown(&cells, &references));
+    }
     say(&table);
     if let Some(out) = &args.out {
         std::fs::write(out, &table).with_context(|| format!("cannot write {}", out.display()))?;

@@ -6,7 +6,11 @@ use std::sync::Arc;
 use shoal_common::cost::FleetModel;
 use shoal_common::plan::{assess, notices, Plan};
 use shoal_common::scenario::{Algorithm, Scenario};
+use shoal_common::swarm::acopso::AcoPso;
+use shoal_common::swarm::cbpso::Cbpso;
+use shoal_common::swarm::ipso::Ipso;
 use shoal_common::swarm::multi::MultiPso;
+use shoal_common::swarm::nspso::Nspso;
 use shoal_common::swarm::population::Schedule;
 use shoal_common::swarm::pso::Pso;
 use shoal_common::swarm::{Executor, IterationReport, Solver, SolverState, Termination};
@@ -76,6 +80,31 @@ pub fn plan_in_process(
         Algorithm::MpPso => run_solver(&model, multi(Schedule::TABLE5_FIXED), &executor, observe),
         Algorithm::APso => run_solver(&model, single(Schedule::Adaptive), &executor, observe),
         Algorithm::Pso => run_solver(&model, single(Schedule::TABLE5_FIXED), &executor, observe),
+        Algorithm::Ipso => run_solver(
+            &model,
+            Ipso::table8(o.particles, o.seed),
+            &executor,
+            observe,
+        ),
+        Algorithm::Spso => run_solver(&model, Pso::spso(o.particles, o.seed), &executor, observe),
+        Algorithm::Cbpso => run_solver(
+            &model,
+            Cbpso::table8(o.particles, o.seed),
+            &executor,
+            observe,
+        ),
+        Algorithm::Nspso => run_solver(
+            &model,
+            Nspso::table8(o.particles, o.seed),
+            &executor,
+            observe,
+        ),
+        Algorithm::AcoPso => run_solver(
+            &model,
+            AcoPso::table8(o.particles, o.seed),
+            &executor,
+            observe,
+        ),
     };
     to_plan(scenario, &model, run, "in-process")
 }

@@ -41,10 +41,11 @@ const FONT: &str = "sans-serif";
 
 type Fmt<'a> = &'a dyn Fn(&f64) -> String;
 type Area<'a> = DrawingArea<SVGBackend<'a>, Shift>;
-type Chart<'a, 'b> = ChartContext<'a, SVGBackend<'b>, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
+pub(crate) type Chart<'a, 'b> =
+    ChartContext<'a, SVGBackend<'b>, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
 
 /// Turns a plotters error into an `anyhow` error saying what was being drawn.
-fn fail<E: Display>(what: &'static str) -> impl FnOnce(E) -> anyhow::Error {
+pub(crate) fn fail<E: Display>(what: &'static str) -> impl FnOnce(E) -> anyhow::Error {
     move |e| anyhow::anyhow!("svg: cannot draw {what}: {e}")
 }
 
@@ -190,6 +191,9 @@ fn draw_view(
     if exag > 1.05 {
         title.push_str(&format!(", z stretched ×{exag:.1}"));
     }
+    if b == 1 && scenario.terrain().is_some() {
+        title.push_str(" on the seabed (dark = high)");
+    }
     let body = captioned(area, &title)?;
     let mut chart = ChartBuilder::on(&body)
         .margin_left(mx)
@@ -203,6 +207,9 @@ fn draw_view(
     let metres = |v: &f64| format!("{v:.0}");
     let names = ["x (m)", "y (m)", "z (m)"];
     mesh(&mut chart, [names[a], names[b]], &metres, &metres)?;
+    if b == 1 {
+        crate::svg_terrain::draw_seabed(&mut chart, scenario, (x0, x1, y0, y1))?;
+    }
 
     let inside = |(x, y): (f64, f64)| x >= x0 && x <= x1 && y >= y0 && y <= y1;
     let clamp = |(x, y): (f64, f64)| (x.clamp(x0, x1), y.clamp(y0, y1));
@@ -237,7 +244,11 @@ fn draw_view(
         let c = colour(i);
         let path: Vec<(f64, f64)> = v.trajectory.iter().map(|s| (s[1 + a], s[1 + b])).collect();
         // Markers at the scenario's start and goal; at the path's ends for an unknown vehicle.
-        let known = scenario.vehicles.iter().find(|s| s.id == v.id);
+        // A crawler's path starts on the seabed below its start: mark the path's ends.
+        let known = scenario
+            .vehicles
+            .iter()
+            .find(|s| s.id == v.id && s.kind != shoal_common::scenario::VehicleKind::Crawler);
         let start = known
             .map(|s| (s.start[a], s.start[b]))
             .or(path.first().copied());

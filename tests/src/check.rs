@@ -82,6 +82,7 @@ pub fn check_parsed(scenario: &Scenario, plan: &Plan) -> Report {
     }
 
     let mut figures = Vec::with_capacity(pairs.len());
+    let mut crawler_broken = Vec::new();
     for (v, pv) in &pairs {
         let id = &v.id;
         let traj = &pv.trajectory;
@@ -159,7 +160,7 @@ pub fn check_parsed(scenario: &Scenario, plan: &Plan) -> Report {
 
         // Contract rules that hold for every plan.
         if let (Some(first), Some(last)) = (traj.first(), traj.last()) {
-            let ds = dist(&point(first), &v.start);
+            let ds = v.end_distance(first, &v.start);
             if ds > TOL {
                 failures.push(format!(
                     "{id}: trajectory starts at {:?}, {ds} m from its start {:?}",
@@ -167,7 +168,7 @@ pub fn check_parsed(scenario: &Scenario, plan: &Plan) -> Report {
                     v.start
                 ));
             }
-            let dg = dist(&point(last), &v.goal);
+            let dg = v.end_distance(last, &v.goal);
             if dg > TOL {
                 failures.push(format!(
                     "{id}: trajectory ends at {:?}, {dg} m from its goal {:?}",
@@ -199,6 +200,11 @@ pub fn check_parsed(scenario: &Scenario, plan: &Plan) -> Report {
                     v.speed_max_mps
                 ));
             }
+        }
+        if v.is_crawler() {
+            let c = crate::crawler::check(scenario, v, traj, pv.crawler.as_ref());
+            mismatches.extend(c.mismatches);
+            crawler_broken.extend(c.broken);
         }
         figures.push(f);
     }
@@ -297,6 +303,7 @@ pub fn check_parsed(scenario: &Scenario, plan: &Plan) -> Report {
         &pairs,
         &figures,
         &fleet,
+        &crawler_broken,
     ));
 
     Report {

@@ -3,7 +3,6 @@
 //! must break (or come within the slack of breaking) at least one.
 
 use crate::figures::{FleetFigures, VehicleFigures};
-use crate::geometry::{dist, point};
 use crate::model::{Plan, PlanVehicle, Vehicle};
 use crate::{MAX_ARRIVAL_SPREAD_S, SEPARATION_TOL, TOL};
 
@@ -15,6 +14,7 @@ pub(crate) fn claim_failures(
     pairs: &[(&Vehicle, &PlanVehicle)],
     figures: &[VehicleFigures],
     fleet: &FleetFigures,
+    crawler_broken: &[String],
 ) -> Vec<String> {
     let mut failures = Vec::new();
     if plan.feasible != plan.violations.is_empty() {
@@ -24,7 +24,7 @@ pub(crate) fn claim_failures(
         ));
     }
     // Constraints broken beyond the slack (what a feasible plan must not have) ...
-    let mut broken = Vec::new();
+    let mut broken = crawler_broken.to_vec();
     // ... and constraints broken or within the slack of breaking (an infeasible plan needs one).
     let mut marginal = Vec::new();
     for ((v, pv), f) in pairs.iter().zip(figures) {
@@ -56,11 +56,11 @@ pub(crate) fn claim_failures(
         let ends_ok = pv
             .trajectory
             .first()
-            .is_some_and(|s| dist(&point(s), &v.start) <= TOL)
+            .is_some_and(|s| v.end_distance(s, &v.start) <= TOL)
             && pv
                 .trajectory
                 .last()
-                .is_some_and(|s| dist(&point(s), &v.goal) <= TOL);
+                .is_some_and(|s| v.end_distance(s, &v.goal) <= TOL);
         if !ends_ok {
             broken.push(format!("{id} does not run from start to goal"));
         }

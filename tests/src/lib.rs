@@ -23,6 +23,7 @@
 //! `feasibility` judges the plan's `feasible` verdict, and `report` holds the result.
 
 mod check;
+pub mod crawler;
 mod feasibility;
 mod figures;
 #[cfg(test)]

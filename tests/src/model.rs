@@ -18,6 +18,15 @@ pub struct Scenario {
     pub vehicles: Vec<Vehicle>,
     /// Fleet coupling.
     pub fleet: Fleet,
+    /// Seabed for crawlers.
+    #[serde(default)]
+    pub seabed: Option<crate::crawler::Seabed>,
+    /// Hazard cylinders crawlers must not enter.
+    #[serde(default)]
+    pub hazards: Vec<crate::crawler::Hazard>,
+    /// Crawler cost settings.
+    #[serde(default)]
+    pub crawler: Option<crate::crawler::CrawlerSettings>,
 }
 
 /// Axis-aligned box, metres.
@@ -59,6 +68,9 @@ pub struct Obstacle {
 pub struct Vehicle {
     /// Unique id.
     pub id: String,
+    /// `auv` or `crawler`.
+    #[serde(default)]
+    pub kind: String,
     /// Start, metres.
     pub start: [f64; 3],
     /// Goal, metres.
@@ -71,6 +83,24 @@ pub struct Vehicle {
     pub max_turn_deg: f64,
     /// Largest |pitch|, degrees.
     pub max_pitch_deg: f64,
+}
+
+impl Vehicle {
+    /// True for a seabed crawler.
+    pub fn is_crawler(&self) -> bool {
+        self.kind == "crawler"
+    }
+
+    /// Distance from trajectory sample `s` to `target` (start or goal): horizontal only for a
+    /// crawler, whose path lies on the seabed below them.
+    pub fn end_distance(&self, s: &[f64; 4], target: &[f64; 3]) -> f64 {
+        let (dx, dy, dz) = (s[1] - target[0], s[2] - target[1], s[3] - target[2]);
+        if self.is_crawler() {
+            dx.hypot(dy)
+        } else {
+            (dx * dx + dy * dy + dz * dz).sqrt()
+        }
+    }
 }
 
 /// Fleet coupling.
@@ -142,6 +172,9 @@ pub struct PlanVehicle {
     pub hard_collisions: usize,
     /// Reported metres inside inflated soft obstacles.
     pub soft_exposure_m: f64,
+    /// Crawlers: reported seabed figures.
+    #[serde(default)]
+    pub crawler: Option<crate::crawler::PlanCrawler>,
 }
 
 /// Fleet figures in `plan.json`.

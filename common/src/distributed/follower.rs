@@ -42,8 +42,8 @@ impl FollowerSettings {
             populations: o.distributed.agent_populations,
             particles: o.particles,
             schedule: match o.algorithm {
-                Algorithm::MpPso | Algorithm::Pso => Schedule::TABLE5_FIXED,
                 Algorithm::AmpPso | Algorithm::APso => Schedule::Adaptive,
+                _ => Schedule::TABLE5_FIXED,
             },
             max_velocity_fraction: o.max_velocity_fraction,
             threads: o.threads,

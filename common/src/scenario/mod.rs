@@ -11,7 +11,12 @@ use serde::{Deserialize, Serialize};
 use crate::geometry::Vec3;
 
 mod optimizer;
+mod seabed;
 pub use optimizer::{Algorithm, DistributedSettings, OptimizerSettings};
+pub use seabed::{CrawlerSettings, Seabed, SeabedGrid};
+
+use crate::crawler::CrawlerModel;
+use crate::terrain::Hazard;
 
 /// One knot in metres per second (1852 m / 3600 s), for scenario comments and tests.
 pub const KNOT_MPS: f64 = 1852.0 / 3600.0;
@@ -60,6 +65,15 @@ pub struct Scenario {
     /// Which optimizer and with what budget.
     #[serde(default)]
     pub optimizer: OptimizerSettings,
+    /// The seabed crawlers drive on (seed 000 §2.2); required when a vehicle is a crawler.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub seabed: Option<Seabed>,
+    /// Soft-substrate zones crawlers must not enter, vertical cylinders (seed 000 eq. (4)).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub hazards: Vec<Hazard>,
+    /// Settings of the crawler cost (seed 000 eq. (5)–(11)).
+    #[serde(default)]
+    pub crawler: CrawlerSettings,
 }
 
 /// Axis-aligned box of the navigation space, metres.
@@ -174,11 +188,23 @@ impl Scenario {
 
     /// Parses and validates scenario text; `file` is only used in error messages.
     pub fn parse(text: &str, file: &Path) -> Result<Scenario, ScenarioError> {
-        let scenario: Scenario = toml::from_str(text).map_err(|e| ScenarioError::Parse {
+        let mut scenario: Scenario = toml::from_str(text).map_err(|e| ScenarioError::Parse {
             file: file.to_path_buf(),
             message: e.to_string().trim_end().replace('\n', "\n  "),
         })?;
         scenario.validate(file)?;
+        if let Some(seabed) = &mut scenario.seabed {
+            let bad = |field: String, value: String, reason: &str| ScenarioError::Invalid {
+                file: file.to_path_buf(),
+                field,
+                value,
+                reason: reason.to_string(),
+            };
+            let dir = file.parent().unwrap_or(Path::new("."));
+            let b = &scenario.bounds;
+            let area = [b.min[0], b.min[1], b.max[0], b.max[1]];
+            seabed.resolve(area, dir, file, &bad)?;
+        }
         Ok(scenario)
     }
 
@@ -314,7 +340,108 @@ impl Scenario {
             ));
         }
         self.optimizer.validate(&bad)?;
+        self.validate_crawlers(&bad)?;
         Ok(())
+    }
+
+    /// The crawler parts: hazards, crawler settings, and a seabed for every crawler.
+    fn validate_crawlers(
+        &self,
+        bad: &dyn Fn(String, String, &str) -> ScenarioError,
+    ) -> Result<(), ScenarioError> {
+        for (i, h) in self.hazards.iter().enumerate() {
+            if crate::wire::topics::check_id("hazard", &h.id).is_err() {
+                return Err(bad(
+                    format!("hazards[{i}].id"),
+                    format!("{:?}", h.id),
+                    "must be 1-64 letters, digits, '-', '_' or '.'",
+                ));
+            }
+            if !h.centre.iter().all(|c| c.is_finite()) {
+                return Err(bad(
+                    format!("hazards[{i}].centre"),
+                    format!("{:?}", h.centre),
+                    "must be finite",
+                ));
+            }
+            for (name, v) in [("radius_m", h.radius_m), ("height_m", h.height_m)] {
+                if !(v.is_finite() && v > 0.0) {
+                    return Err(bad(
+                        format!("hazards[{i}].{name}"),
+                        v.to_string(),
+                        "must be a positive number of metres",
+                    ));
+                }
+            }
+        }
+        self.crawler.validate(bad)?;
+        for (i, v) in self.vehicles.iter().enumerate() {
+            if v.kind != VehicleKind::Crawler {
+                continue;
+            }
+            if self.seabed.is_none() {
+                return Err(bad(
+                    format!("vehicles[{i}].kind"),
+                    "\"crawler\"".into(),
+                    "a crawler drives on the seabed: add a [seabed] table (relief or grid)",
+                ));
+            }
+            for (name, p) in [("start", &v.start), ("goal", &v.goal)] {
+                for h in &self.hazards {
+                    let d = (p[0] - h.centre[0]).hypot(p[1] - h.centre[1]);
+                    if d < h.radius_m {
+                        return Err(bad(
+                            format!("vehicles[{i}].{name}"),
+                            format!("{p:?}"),
+                            &format!(
+                                "lies inside hazard {} (radius {:.1} m, distance {d:.1} m)",
+                                h.id, h.radius_m
+                            ),
+                        ));
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// The seabed the scenario was loaded with, if any.
+    pub fn terrain(&self) -> Option<&crate::terrain::Terrain> {
+        self.seabed.as_ref().and_then(|s| s.terrain.as_ref())
+    }
+
+    /// The crawler cost model of vehicle `i`, or `None` when it is not a crawler (or the
+    /// scenario was built without loading, so it has no terrain). Its control points are the
+    /// vehicle's M waypoints, its slope limit the vehicle's pitch limit (on the seabed, pitch
+    /// is slope), its speed the vehicle's top speed (§5.1: a constant 1 m/s).
+    pub fn crawler_model(&self, i: usize) -> Option<CrawlerModel> {
+        let v = self.vehicles.get(i)?;
+        if v.kind != VehicleKind::Crawler {
+            return None;
+        }
+        let c = &self.crawler;
+        Some(CrawlerModel {
+            terrain: self.terrain()?.clone(),
+            hazards: self.hazards.clone(),
+            start: [v.start[0], v.start[1]],
+            goal: [v.goal[0], v.goal[1]],
+            area: [
+                self.bounds.min[0],
+                self.bounds.min[1],
+                self.bounds.max[0],
+                self.bounds.max[1],
+            ],
+            control_points: self.optimizer.waypoints,
+            samples: c.samples,
+            sensor_height_m: c.sensor_height_m,
+            speed_mps: v.speed_max_mps,
+            power_kw: c.power_kw,
+            mining_share: c.mining_share,
+            safe_distance_m: c.safe_distance_m,
+            max_slope_deg: v.max_pitch_deg,
+            weights: c.weights,
+            penalty_weight: self.optimizer.penalty_weight,
+        })
     }
 
     /// Hard obstacles only.

@@ -18,6 +18,16 @@ pub enum Algorithm {
     MpPso,
     /// Single-population PSO with the adaptive coefficients of eq. (7) (Table 5).
     APso,
+    /// Improved PSO of seed 000 (eq. (19)–(26), Table 8).
+    Ipso,
+    /// Standard PSO of seed 000 Table 8 (c1 = c2 = 2, w = 0.5).
+    Spso,
+    /// Chaos-initialised PSO of seed 000 Table 8.
+    Cbpso,
+    /// Non-dominated sorting PSO of seed 000 Table 8.
+    Nspso,
+    /// Ant-colony / PSO hybrid of seed 000 Table 8.
+    AcoPso,
 }
 
 impl Algorithm {
@@ -28,15 +38,29 @@ impl Algorithm {
             Algorithm::Pso => "pso",
             Algorithm::MpPso => "mp-pso",
             Algorithm::APso => "a-pso",
+            Algorithm::Ipso => "ipso",
+            Algorithm::Spso => "spso",
+            Algorithm::Cbpso => "cbpso",
+            Algorithm::Nspso => "nspso",
+            Algorithm::AcoPso => "aco-pso",
         }
     }
-    /// Every algorithm, in the order of seed 004 Table 5.
-    pub const ALL: [Algorithm; 4] = [
+    /// Every algorithm: seed 004 Table 5's order, then seed 000 Table 8's.
+    pub const ALL: [Algorithm; 9] = [
         Algorithm::AmpPso,
         Algorithm::APso,
         Algorithm::MpPso,
         Algorithm::Pso,
+        Algorithm::Ipso,
+        Algorithm::Spso,
+        Algorithm::Cbpso,
+        Algorithm::Nspso,
+        Algorithm::AcoPso,
     ];
+    /// True for the multi-population algorithms (the ones a distributed run can split).
+    pub fn is_multi_population(self) -> bool {
+        matches!(self, Algorithm::AmpPso | Algorithm::MpPso)
+    }
 }
 
 impl std::str::FromStr for Algorithm {
@@ -46,7 +70,11 @@ impl std::str::FromStr for Algorithm {
             .into_iter()
             .find(|a| a.as_str() == s)
             .ok_or_else(|| {
-                format!("unknown algorithm `{s}` (expected amp-pso, pso, mp-pso or a-pso)")
+                let names: Vec<&str> = Algorithm::ALL.iter().map(|a| a.as_str()).collect();
+                format!(
+                    "unknown algorithm `{s}` (expected one of {})",
+                    names.join(", ")
+                )
             })
     }
 }

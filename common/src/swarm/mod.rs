@@ -4,9 +4,11 @@
 //!
 //! A new variant (IPSO, EPA-PSO, DE-PSO…) is one file implementing [`Solver`].
 
+pub mod acopso;
 pub mod cbpso;
 pub mod ipso;
 pub mod multi;
+pub mod nspso;
 pub mod parallel;
 pub mod population;
 pub mod pso;

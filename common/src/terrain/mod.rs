@@ -11,6 +11,12 @@ pub use grid::{HeightGrid, Problem, TerrainError};
 
 /// Constants `a…g` of the base relief, seed 000 eq. (2). The paper does not give values: they are
 /// data of the terrain, supplied by the scenario.
+///
+/// Eq. (2) read literally in metres (`sin(y + a)` with unit amplitude and a 6.3 m wavelength) has
+/// 45° slopes everywhere, which contradicts the gentle seamount summit of §2.1 and the paper's own
+/// result (path undulation < 1 m over 283 m, §5.2). Shoal therefore evaluates eq. (2) in scaled
+/// coordinates: `Z1(x, y) = height_scale_m · eq2(x / length_scale_m, y / length_scale_m)`. Both
+/// scales default to 1 (the literal reading).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct BaseRelief {
@@ -28,23 +34,61 @@ pub struct BaseRelief {
     pub f: f64,
     /// Radial frequency of the sine ring, rad/m.
     pub g: f64,
+    /// Horizontal unit of eq. (2), metres (default 1).
+    #[serde(default = "unit_scale")]
+    pub length_scale_m: f64,
+    /// Vertical unit of eq. (2), metres (default 1).
+    #[serde(default = "unit_scale")]
+    pub height_scale_m: f64,
+    /// Added to eq. (2) so that "the lowest point of the base plane corresponds to Z = 0"
+    /// (§2.1). Not read from files: a scenario sets it when loaded ([`BaseRelief::lowest`]).
+    #[serde(skip)]
+    pub datum_m: f64,
+}
+
+fn unit_scale() -> f64 {
+    1.0
 }
 
 impl BaseRelief {
-    /// `Z1(x, y)`, seed 000 eq. (2).
+    /// Lowest elevation over the box `[x0, y0, x1, y1]`, sampled on a grid of at most 0.5 m
+    /// (and at most 1000 × 1000 points).
+    pub fn lowest(&self, area: [f64; 4]) -> f64 {
+        let [x0, y0, x1, y1] = area;
+        let steps = |span: f64| ((span / 0.5).ceil() as usize).clamp(1, 1000);
+        let (nx, ny) = (steps(x1 - x0), steps(y1 - y0));
+        let mut low = f64::INFINITY;
+        for i in 0..=nx {
+            for j in 0..=ny {
+                let x = x0 + (x1 - x0) * i as f64 / nx as f64;
+                let y = y0 + (y1 - y0) * j as f64 / ny as f64;
+                low = low.min(self.elevation(x, y));
+            }
+        }
+        low
+    }
+
+    /// `Z1(x, y)`, seed 000 eq. (2), in the scaled coordinates above.
     pub fn elevation(&self, x: f64, y: f64) -> f64 {
+        let (x, y) = (x / self.length_scale_m, y / self.length_scale_m);
         let r = x.hypot(y);
-        (y + self.a).sin()
-            + self.b * x.sin()
-            + self.c * (self.d * r).cos()
-            + self.e * y.cos()
-            + self.f * (self.g * r).sin()
+        self.datum_m
+            + self.height_scale_m
+                * ((y + self.a).sin()
+                    + self.b * x.sin()
+                    + self.c * (self.d * r).cos()
+                    + self.e * y.cos()
+                    + self.f * (self.g * r).sin())
     }
 
     /// `∇Z1`, derived by hand from eq. (2). With `r = √(x² + y²)`, the two ring terms give
     /// `(−c·d·sin(d r) + f·g·cos(g r))·(x, y)/r`. At `r = 0` the `sin(g r)` ring is a cone tip (not
     /// differentiable); we return the symmetric value 0 for the radial part there.
+    ///
+    /// With the scales, the chain rule multiplies the unscaled gradient by `height / length`.
     pub fn gradient(&self, x: f64, y: f64) -> (f64, f64) {
+        let k = self.height_scale_m / self.length_scale_m;
+        let (x, y) = (x / self.length_scale_m, y / self.length_scale_m);
         let r = x.hypot(y);
         let radial = if r > 0.0 {
             (-self.c * self.d * (self.d * r).sin() + self.f * self.g * (self.g * r).cos()) / r
@@ -52,8 +96,8 @@ impl BaseRelief {
             0.0
         };
         (
-            self.b * x.cos() + radial * x,
-            (y + self.a).cos() - self.e * y.sin() + radial * y,
+            k * (self.b * x.cos() + radial * x),
+            k * ((y + self.a).cos() - self.e * y.sin() + radial * y),
         )
     }
 }
@@ -208,7 +252,56 @@ mod tests {
             e: 0.6,
             f: 0.4,
             g: 1.3,
+            length_scale_m: 1.0,
+            height_scale_m: 1.0,
+            datum_m: 0.0,
         }
+    }
+
+    #[test]
+    fn scaled_relief_stretches_and_lifts_eq2() {
+        let unit = relief();
+        let scaled = BaseRelief {
+            length_scale_m: 40.0,
+            height_scale_m: 0.25,
+            ..unit
+        };
+        // Z1(80, 40) scaled = 0.25 · eq2(2, 1).
+        assert_abs_diff_eq!(
+            scaled.elevation(80.0, 40.0),
+            0.25 * unit.elevation(2.0, 1.0),
+            epsilon = 1e-12
+        );
+        let h = 1e-4;
+        let (gx, gy) = scaled.gradient(30.0, -12.0);
+        let dx =
+            (scaled.elevation(30.0 + h, -12.0) - scaled.elevation(30.0 - h, -12.0)) / (2.0 * h);
+        let dy =
+            (scaled.elevation(30.0, -12.0 + h) - scaled.elevation(30.0, -12.0 - h)) / (2.0 * h);
+        assert_abs_diff_eq!(gx, dx, epsilon = 1e-7);
+        assert_abs_diff_eq!(gy, dy, epsilon = 1e-7);
+        // The datum lifts the lowest point of a box to 0: Z1 = sin(y) over y ∈ [0, 2π].
+        let wave = BaseRelief {
+            a: 0.0,
+            b: 0.0,
+            c: 0.0,
+            d: 0.0,
+            e: 0.0,
+            f: 0.0,
+            g: 0.0,
+            length_scale_m: 1.0,
+            height_scale_m: 2.0,
+            datum_m: 0.0,
+        };
+        let low = wave.lowest([0.0, 0.0, 1.0, std::f64::consts::TAU]);
+        // Sampled every ~0.48 m along y: within 2·(1 − cos(0.24)) ≈ 0.057 m of the true −2.
+        assert!((-2.0..-2.0 + 0.06).contains(&low), "{low}");
+        let lifted = BaseRelief {
+            datum_m: -low,
+            ..wave
+        };
+        // At the origin eq. (2) gives 0, lifted by −low ≈ 2.
+        assert_abs_diff_eq!(lifted.elevation(0.0, 0.0), -low, epsilon = 1e-12);
     }
 
     fn analytic() -> Terrain {

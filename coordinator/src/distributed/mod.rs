@@ -17,7 +17,7 @@ use std::time::Duration;
 
 use shoal_common::cost::FleetModel;
 use shoal_common::plan::Plan;
-use shoal_common::scenario::{Algorithm, Scenario};
+use shoal_common::scenario::Scenario;
 use shoal_common::wire::topics;
 
 use crate::planner::to_plan;
@@ -84,10 +84,7 @@ pub fn plan_distributed(
     observe: &mut dyn FnMut(&mission::Status),
 ) -> anyhow::Result<Plan> {
     topics::check_id("mission", &options.mission)?;
-    if !matches!(
-        scenario.optimizer.algorithm,
-        Algorithm::AmpPso | Algorithm::MpPso
-    ) {
+    if !scenario.optimizer.algorithm.is_multi_population() {
         anyhow::bail!(
             "distributed planning runs the multi-population algorithms (amp-pso, mp-pso); {} is a single-population algorithm: plan it with --in-process",
             scenario.optimizer.algorithm.as_str()

@@ -1,0 +1,372 @@
+//! The `[seabed]`, `[[hazards]]` and `[crawler]` tables of a scenario: the terrain crawlers drive
+//! on (seed 000 eq. (1)–(4)) and the settings of their cost (eq. (5)–(11), §5.1).
+
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+
+use super::ScenarioError;
+use crate::terrain::{BaseRelief, HeightGrid, Mountain, Terrain};
+
+/// The seabed: the analytic model of eq. (2) + (3), or a measured height grid from a file.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq, Default)]
+#[serde(deny_unknown_fields)]
+pub struct Seabed {
+    /// Base relief of eq. (2) (analytic model).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub relief: Option<BaseRelief>,
+    /// Gaussian mountains of eq. (3), added to the base relief (analytic model).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub mountains: Vec<Mountain>,
+    /// Measured bathymetry instead of the analytic model.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub grid: Option<SeabedGrid>,
+    /// The terrain built from the above when the scenario was loaded (grids are read then).
+    #[serde(skip)]
+    pub terrain: Option<Terrain>,
+}
+
+/// A height-grid file: ESRI ASCII grid (`.asc`, georeferenced by its header) or CSV (`.csv`,
+/// one row of heights per line, north row first, placed by `cell_m` and `origin`).
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct SeabedGrid {
+    /// Path of the file; a relative path is taken from the scenario file's directory (and is
+    /// stored absolute once loaded, so agents on the same file system find it too).
+    pub file: PathBuf,
+    /// CSV only: node spacing, metres (default 1).
+    #[serde(default = "one_metre")]
+    pub cell_m: f64,
+    /// CSV only: position of the south-west node, metres (default the origin).
+    #[serde(default)]
+    pub origin: [f64; 2],
+}
+
+fn one_metre() -> f64 {
+    1.0
+}
+
+/// Settings of the crawler cost; defaults are seed 000 §2.3.5 and §5.1.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields, default)]
+pub struct CrawlerSettings {
+    /// Height of the path (the vehicle's sensor frame) above the seabed, metres (§5.1: 0.5–1 m).
+    pub sensor_height_m: f64,
+    /// Points the smoothed path is sampled at (eq. (12)); every check uses these points.
+    pub samples: usize,
+    /// P1 (collection), P2 (travel), P3 (control and perception), kW (§5.1: 90, 50, 5).
+    pub power_kw: [f64; 3],
+    /// Share of the mission time spent mining (§5.1: 0.6).
+    pub mining_share: f64,
+    /// `d_safe_min`, `d_safe_max` of eq. (9): slip distance ramp from a hazard's edge, metres.
+    pub safe_distance_m: [f64; 2],
+    /// ω of eq. (10) for length, undulation, slip, energy (§2.3.5: 0.5, 0.2, 0.2, 0.1).
+    pub weights: [f64; 4],
+}
+
+impl Default for CrawlerSettings {
+    fn default() -> Self {
+        CrawlerSettings {
+            sensor_height_m: 0.5,
+            samples: 100,
+            power_kw: [90.0, 50.0, 5.0],
+            mining_share: 0.6,
+            // The paper gives no distances. 2 m is about half a crawler's width (the "Pioneer
+            // No. 1" class is ~4 m wide): closer, a track is on the soft ground's edge; from 10 m
+            // on the substrate is taken as firm.
+            safe_distance_m: [2.0, 10.0],
+            weights: [0.5, 0.2, 0.2, 0.1],
+        }
+    }
+}
+
+type Bad<'a> = &'a dyn Fn(String, String, &str) -> ScenarioError;
+
+impl Seabed {
+    /// Checks the values and builds the terrain (reading a grid file relative to `dir`).
+    /// `area` is the scenario's horizontal box (the analytic relief's lowest point in it is
+    /// lifted to z = 0, §2.1).
+    pub fn resolve(
+        &mut self,
+        area: [f64; 4],
+        dir: &Path,
+        file: &Path,
+        bad: Bad,
+    ) -> Result<(), ScenarioError> {
+        if let Some(r) = &self.relief {
+            let coefficients = [r.a, r.b, r.c, r.d, r.e, r.f, r.g];
+            for (name, v) in ["a", "b", "c", "d", "e", "f", "g"].iter().zip(coefficients) {
+                if !v.is_finite() {
+                    return Err(bad(
+                        format!("seabed.relief.{name}"),
+                        v.to_string(),
+                        "must be finite",
+                    ));
+                }
+            }
+            for (name, v) in [
+                ("length_scale_m", r.length_scale_m),
+                ("height_scale_m", r.height_scale_m),
+            ] {
+                if !(v.is_finite() && v > 0.0) {
+                    return Err(bad(
+                        format!("seabed.relief.{name}"),
+                        v.to_string(),
+                        "must be a positive number of metres",
+                    ));
+                }
+            }
+        }
+        for (i, m) in self.mountains.iter().enumerate() {
+            if !(m.centre.iter().all(|c| c.is_finite()) && m.height_m.is_finite()) {
+                return Err(bad(
+                    format!("seabed.mountains[{i}]"),
+                    format!("{:?} {}", m.centre, m.height_m),
+                    "centre and height must be finite",
+                ));
+            }
+            if !m.spread_m.iter().all(|s| s.is_finite() && *s > 0.0) {
+                return Err(bad(
+                    format!("seabed.mountains[{i}].spread_m"),
+                    format!("{:?}", m.spread_m),
+                    "must be positive numbers of metres",
+                ));
+            }
+        }
+        self.terrain = Some(match (&mut self.grid, &self.relief) {
+            (Some(_), Some(_)) => {
+                return Err(bad(
+                    "seabed.grid".into(),
+                    "(set)".into(),
+                    "give either seabed.grid or seabed.relief, not both",
+                ))
+            }
+            (Some(_), None) if !self.mountains.is_empty() => {
+                return Err(bad(
+                    "seabed.mountains".into(),
+                    format!("{} mountains", self.mountains.len()),
+                    "mountains belong to the analytic relief, not to a measured grid",
+                ))
+            }
+            (Some(g), None) => {
+                if !g.file.is_absolute() {
+                    g.file = dir.join(&g.file);
+                }
+                Terrain::Grid(load_grid(g, file, bad)?)
+            }
+            (None, Some(r)) => {
+                let mut base = BaseRelief { datum_m: 0.0, ..*r };
+                base.datum_m = -base.lowest(area);
+                Terrain::Analytic {
+                    base,
+                    mountains: self.mountains.clone(),
+                }
+            }
+            (None, None) => {
+                return Err(bad(
+                    "seabed".into(),
+                    "{}".into(),
+                    "needs a `relief` table (with optional `mountains`) or a `grid` file",
+                ))
+            }
+        });
+        Ok(())
+    }
+}
+
+/// Reads the grid file, naming the scenario and the grid file in errors.
+fn load_grid(g: &SeabedGrid, file: &Path, bad: Bad) -> Result<HeightGrid, ScenarioError> {
+    let is_csv = g
+        .file
+        .extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("csv"));
+    let loaded = if is_csv {
+        if !(g.cell_m.is_finite() && g.cell_m > 0.0) {
+            return Err(bad(
+                "seabed.grid.cell_m".into(),
+                g.cell_m.to_string(),
+                "must be a positive number of metres",
+            ));
+        }
+        std::fs::read_to_string(&g.file)
+            .map_err(|source| crate::terrain::TerrainError::Io {
+                file: g.file.clone(),
+                source,
+            })
+            .and_then(|text| HeightGrid::from_csv(&text, &g.file, g.cell_m, g.origin))
+    } else {
+        HeightGrid::load(&g.file)
+    };
+    loaded.map_err(|e| ScenarioError::Parse {
+        file: file.to_path_buf(),
+        message: format!("seabed.grid.file: {e}"),
+    })
+}
+
+impl CrawlerSettings {
+    /// Checks every value.
+    pub fn validate(&self, bad: Bad) -> Result<(), ScenarioError> {
+        let positive = |name: &str, v: f64| {
+            if v.is_finite() && v >= 0.0 {
+                Ok(())
+            } else {
+                Err(bad(
+                    format!("crawler.{name}"),
+                    v.to_string(),
+                    "must be zero or positive",
+                ))
+            }
+        };
+        positive("sensor_height_m", self.sensor_height_m)?;
+        for p in self.power_kw {
+            positive("power_kw", p)?;
+        }
+        for w in self.weights {
+            positive("weights", w)?;
+        }
+        if self.samples < 4 {
+            return Err(bad(
+                "crawler.samples".into(),
+                self.samples.to_string(),
+                "must be at least 4",
+            ));
+        }
+        if !(self.mining_share >= 0.0 && self.mining_share < 1.0) {
+            return Err(bad(
+                "crawler.mining_share".into(),
+                self.mining_share.to_string(),
+                "must be in [0, 1)",
+            ));
+        }
+        let [lo, hi] = self.safe_distance_m;
+        if !(lo.is_finite() && hi.is_finite() && lo >= 0.0 && hi > lo) {
+            return Err(bad(
+                "crawler.safe_distance_m".into(),
+                format!("{:?}", self.safe_distance_m),
+                "must be [d_safe_min, d_safe_max] with 0 <= d_safe_min < d_safe_max",
+            ));
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::{Scenario, ScenarioError};
+    use std::path::Path;
+
+    const CRAWLER: &str = r#"
+name = "c"
+[bounds]
+min = [0.0, 0.0, 0.0]
+max = [100.0, 100.0, 10.0]
+[[vehicles]]
+id = "dsmv"
+kind = "crawler"
+start = [1.0, 1.0, 0.5]
+goal = [99.0, 99.0, 0.5]
+speed_min_mps = 0.5
+speed_max_mps = 1.0
+max_turn_deg = 35.0
+max_pitch_deg = 15.0
+[fleet]
+d_min_m = 5.0
+mission_time_s = 200.0
+"#;
+
+    const RELIEF: &str = "[seabed.relief]\na = 0.0\nb = 0.5\nc = 0.0\nd = 0.0\ne = 0.0\nf = 0.0\ng = 0.0\nlength_scale_m = 20.0\nheight_scale_m = 0.5\n";
+
+    fn message(r: Result<Scenario, ScenarioError>) -> String {
+        r.err().map(|e| e.to_string()).unwrap_or_default()
+    }
+
+    #[test]
+    fn a_crawler_needs_a_seabed_and_gets_one() -> Result<(), ScenarioError> {
+        let msg = message(Scenario::parse(CRAWLER, Path::new("s/c.toml")));
+        assert!(
+            msg.contains("s/c.toml")
+                && msg.contains("vehicles[0].kind")
+                && msg.contains("[seabed]"),
+            "{msg}"
+        );
+        let s = Scenario::parse(&format!("{CRAWLER}{RELIEF}"), Path::new("s/c.toml"))?;
+        let t = s.terrain().ok_or(ScenarioError::Parse {
+            file: "t".into(),
+            message: "no terrain".into(),
+        })?;
+        // sin(y/20 + 0)·0.5 + 0.5·sin(x/20)·0.5 ranges over ±0.75 m: the lowest point in the
+        // box is lifted to 0 (§2.1), so every elevation is in [0, 1.5].
+        let mut low = f64::INFINITY;
+        for i in 0..=100 {
+            for j in 0..=100 {
+                low = low.min(t.elevation(i as f64, j as f64));
+            }
+        }
+        assert!(low.abs() < 0.01, "{low}");
+        assert!(s.crawler_model(0).is_some());
+        Ok(())
+    }
+
+    #[test]
+    fn bad_seabed_values_name_the_field() {
+        let cases = [
+            (
+                RELIEF.replace("length_scale_m = 20.0", "length_scale_m = 0.0"),
+                "seabed.relief.length_scale_m",
+            ),
+            (
+                format!("{RELIEF}[[seabed.mountains]]\ncentre = [5.0, 5.0]\nheight_m = 2.0\nspread_m = [0.0, 3.0]\n"),
+                "seabed.mountains[0].spread_m",
+            ),
+            (
+                format!("{RELIEF}[[hazards]]\nid = \"h\"\ncentre = [50.0, 50.0]\nradius_m = -1.0\nheight_m = 2.0\n"),
+                "hazards[0].radius_m",
+            ),
+            (
+                format!("{RELIEF}[[hazards]]\nid = \"h\"\ncentre = [2.0, 2.0]\nradius_m = 5.0\nheight_m = 2.0\n"),
+                "vehicles[0].start",
+            ),
+            (
+                format!("{RELIEF}[crawler]\nsafe_distance_m = [5.0, 1.0]\n"),
+                "crawler.safe_distance_m",
+            ),
+            (
+                "[seabed]\n".to_string(),
+                "`seabed`",
+            ),
+        ];
+        for (extra, field) in cases {
+            let msg = message(Scenario::parse(
+                &format!("{CRAWLER}{extra}"),
+                Path::new("s/c.toml"),
+            ));
+            assert!(
+                msg.contains("s/c.toml") && msg.contains(field),
+                "{field}: {msg}"
+            );
+        }
+    }
+
+    #[test]
+    fn a_malformed_grid_file_is_named_with_its_line() -> Result<(), Box<dyn std::error::Error>> {
+        let dir = tempfile::tempdir()?;
+        std::fs::write(dir.path().join("bad.csv"), "0,1,2\n0,x,2\n0,1,2\n")?;
+        let text = format!("{CRAWLER}[seabed.grid]\nfile = \"bad.csv\"\ncell_m = 50.0\n");
+        let msg = message(Scenario::parse(&text, &dir.path().join("c.toml")));
+        assert!(
+            msg.contains("c.toml") && msg.contains("bad.csv:2") && msg.contains("`x`"),
+            "{msg}"
+        );
+        std::fs::write(dir.path().join("good.csv"), "0,1,2\n0,1,2\n0,1,2\n")?;
+        let text = format!("{CRAWLER}[seabed.grid]\nfile = \"good.csv\"\ncell_m = 50.0\n");
+        let s = Scenario::parse(&text, &dir.path().join("c.toml"))?;
+        // Heights 0, 1, 2 along x at 50 m spacing: 0.02 m per metre.
+        let z = s.terrain().map(|t| t.elevation(25.0, 10.0));
+        assert!(z.is_some_and(|z| (z - 0.5).abs() < 1e-12), "{z:?}");
+        // The file path is stored absolute, so an agent elsewhere finds it too.
+        let g = s.seabed.as_ref().and_then(|b| b.grid.as_ref());
+        assert!(g.is_some_and(|g| g.file.is_absolute()));
+        Ok(())
+    }
+}

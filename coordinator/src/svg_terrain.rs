@@ -1,0 +1,132 @@
+//! The seabed under the top view of `plan.svg` (crawler scenarios, seed 000): a shaded map of
+//! the terrain's elevation (light = low, dark = high), 1 m contour lines drawn as cell edges
+//! where the elevation crosses a whole metre, and the hazard cylinders (eq. (4)) as hatched
+//! discs with their ids.
+
+use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
+use shoal_common::scenario::Scenario;
+use shoal_common::terrain::Terrain;
+
+use crate::svg::{fail, Chart};
+
+/// Cells per axis of the shaded map.
+const CELLS: usize = 60;
+/// Hazard colour: blue, like the paper's Fig. 8 cylinders.
+const HAZARD: RGBColor = RGBColor(40, 90, 200);
+
+/// Shade of elevation fraction `f` in [0, 1]: sand to dark brown.
+fn shade(f: f64) -> RGBColor {
+    let f = f.clamp(0.0, 1.0);
+    let mix = |lo: f64, hi: f64| (lo + (hi - lo) * f).round() as u8;
+    RGBColor(mix(245.0, 110.0), mix(238.0, 80.0), mix(220.0, 50.0))
+}
+
+/// The lowest and highest elevation on a `CELLS × CELLS` sampling of the box.
+fn elevations(t: &Terrain, (x0, x1, y0, y1): (f64, f64, f64, f64)) -> Vec<Vec<f64>> {
+    (0..=CELLS)
+        .map(|j| {
+            let y = y0 + (y1 - y0) * j as f64 / CELLS as f64;
+            (0..=CELLS)
+                .map(|i| t.elevation(x0 + (x1 - x0) * i as f64 / CELLS as f64, y))
+                .collect()
+        })
+        .collect()
+}
+
+/// Draws the seabed and hazards of `scenario` into the top view `chart` spanning the box;
+/// returns the elevation range drawn, or `None` when the scenario has no seabed.
+pub fn draw_seabed(
+    chart: &mut Chart,
+    scenario: &Scenario,
+    (x0, x1, y0, y1): (f64, f64, f64, f64),
+) -> anyhow::Result<Option<(f64, f64)>> {
+    let Some(terrain) = scenario.terrain() else {
+        return Ok(None);
+    };
+    let z = elevations(terrain, (x0, x1, y0, y1));
+    let (lo, hi) = z
+        .iter()
+        .flatten()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+            (a.min(*v), b.max(*v))
+        });
+    let span = (hi - lo).max(1e-9);
+    let (dx, dy) = ((x1 - x0) / CELLS as f64, (y1 - y0) / CELLS as f64);
+    let mut cells = Vec::with_capacity(CELLS * CELLS);
+    let mut contours = Vec::new();
+    for j in 0..CELLS {
+        for i in 0..CELLS {
+            let mean = 0.25 * (z[j][i] + z[j][i + 1] + z[j + 1][i] + z[j + 1][i + 1]);
+            let (cx, cy) = (x0 + i as f64 * dx, y0 + j as f64 * dy);
+            cells.push(Rectangle::new(
+                [(cx, cy), (cx + dx, cy + dy)],
+                shade((mean - lo) / span).filled(),
+            ));
+            // A contour crosses the cell's bottom or left edge where the floor of the
+            // elevation changes between its ends: mark that edge.
+            if z[j][i].floor() != z[j][i + 1].floor() {
+                contours.push(PathElement::new(
+                    vec![
+                        (cx + 0.5 * dx, cy - 0.2 * dy),
+                        (cx + 0.5 * dx, cy + 0.2 * dy),
+                    ],
+                    RGBColor(90, 60, 30).stroke_width(1),
+                ));
+            }
+            if z[j][i].floor() != z[j + 1][i].floor() {
+                contours.push(PathElement::new(
+                    vec![
+                        (cx - 0.2 * dx, cy + 0.5 * dy),
+                        (cx + 0.2 * dx, cy + 0.5 * dy),
+                    ],
+                    RGBColor(90, 60, 30).stroke_width(1),
+                ));
+            }
+        }
+    }
+    chart.draw_series(cells).map_err(fail("seabed"))?;
+    chart.draw_series(contours).map_err(fail("contour"))?;
+    let label = ("sans-serif", 14)
+        .into_font()
+        .color(&WHITE)
+        .pos(Pos::new(HPos::Center, VPos::Center));
+    for h in &scenario.hazards {
+        let ring: Vec<(f64, f64)> = (0..=72)
+            .map(|k| {
+                let a = std::f64::consts::TAU * k as f64 / 72.0;
+                (
+                    h.centre[0] + h.radius_m * a.cos(),
+                    h.centre[1] + h.radius_m * a.sin(),
+                )
+            })
+            .collect();
+        chart
+            .draw_series([Polygon::new(ring.clone(), HAZARD.mix(0.55).filled())])
+            .map_err(fail("hazard"))?;
+        chart
+            .draw_series([PathElement::new(ring, HAZARD.stroke_width(2))])
+            .map_err(fail("hazard edge"))?;
+        chart
+            .draw_series([Text::new(
+                h.id.clone(),
+                (h.centre[0], h.centre[1]),
+                label.clone(),
+            )])
+            .map_err(fail("hazard label"))?;
+    }
+    Ok(Some((lo, hi)))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn shade_runs_from_sand_to_brown_and_clamps() {
+        assert_eq!(shade(0.0), RGBColor(245, 238, 220));
+        assert_eq!(shade(1.0), RGBColor(110, 80, 50));
+        assert_eq!(shade(2.0), shade(1.0));
+        assert_eq!(shade(0.5), RGBColor(178, 159, 135));
+    }
+}

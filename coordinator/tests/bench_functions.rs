@@ -1,0 +1,117 @@
+//! The benchmark-function suite end to end through the library: parsed from a command line as
+//! the binary does, run on two functions with two algorithms, and rendered as tables.
+
+use std::sync::atomic::AtomicBool;
+
+use clap::Parser;
+use shoal_coordinator::bench_functions::{bench_functions, markdown, BenchFunctionsArgs};
+use shoal_coordinator::cli::{Cli, Command};
+
+fn args(extra: &[&str]) -> BenchFunctionsArgs {
+    let mut line = vec![
+        "shoal-coordinator",
+        "bench-functions",
+        "--runs",
+        "3",
+        "--functions",
+        "six-hump-camel,branin",
+        "--algorithms",
+        "ipso,spso",
+        "--iterations",
+        "150",
+        "--quiet",
+    ];
+    line.extend_from_slice(extra);
+    match Cli::try_parse_from(line) {
+        Ok(Cli {
+            command: Command::BenchFunctions(a),
+        }) => a,
+        other => panic!("bench-functions did not parse: {other:?}"),
+    }
+}
+
+#[test]
+fn ipso_finds_branin_and_the_tables_have_every_row() {
+    let a = args(&["--threads", "2"]);
+    assert_eq!(
+        (a.dim, a.particles, a.seed),
+        (30, 30, 1),
+        "Table 4 defaults"
+    );
+    let report = bench_functions(&a, &AtomicBool::new(false), &|_| {})
+        .unwrap_or_else(|e| panic!("suite failed: {e:#}"));
+    assert!(report.complete);
+    assert_eq!(report.algorithms, vec!["ipso", "spso"]);
+    // Table order, whatever the command-line order.
+    let keys: Vec<&str> = report.functions.iter().map(|f| f.key.as_str()).collect();
+    assert_eq!(keys, vec!["six-hump-camel", "branin"]);
+
+    let branin = report
+        .cell("branin", "ipso")
+        .unwrap_or_else(|| panic!("no Branin cell"));
+    assert_eq!(branin.values.len(), 3);
+    let best = shoal_common::stats::min(&branin.values);
+    assert!(
+        (best - 0.39789).abs() < 1e-3,
+        "IPSO's best on Branin: {best}"
+    );
+    let camel = report
+        .cell("six-hump-camel", "ipso")
+        .unwrap_or_else(|| panic!("no camel cell"));
+    assert!(camel.values.iter().all(|v| (v + 1.031_63).abs() < 1e-3));
+    // 30 particles evaluated at the start and after each of 150 iterations.
+    assert!(camel.evaluations.iter().all(|e| *e == 30 * 151));
+
+    let md = markdown(&report);
+    for row in [
+        "| f10 Six-Hump Camel (D = 2, f* = -1.03163) | best |",
+        "| f11 Branin (D = 2, f* = 0.397887) | best |",
+        "|  | mean |",
+        "|  | std |",
+        "| function | statistic | ipso | spso |",
+        "| function | IPSO vs spso |",
+        "| f11 Branin | 3/3 |",
+    ] {
+        assert!(md.contains(row), "missing {row:?} in\n{md}");
+    }
+    // Neither f1–f8 ran: no pooled Table 6 row.
+    assert!(!md.contains("best values of f1–f8"));
+}
+
+#[test]
+fn results_do_not_depend_on_the_thread_count() {
+    let one = bench_functions(&args(&["--threads", "1"]), &AtomicBool::new(false), &|_| {});
+    let three = bench_functions(&args(&["--threads", "3"]), &AtomicBool::new(false), &|_| {});
+    match (one, three) {
+        (Ok(a), Ok(b)) => assert_eq!(a, b),
+        (a, b) => panic!("suite failed: {a:?} {b:?}"),
+    }
+}
+
+fn error(a: &BenchFunctionsArgs) -> String {
+    match bench_functions(a, &AtomicBool::new(false), &|_| {}) {
+        Ok(_) => panic!("{a:?} should be refused"),
+        Err(e) => e.to_string(),
+    }
+}
+
+#[test]
+fn bad_names_and_settings_are_errors_not_panics() {
+    let mut a = args(&[]);
+    a.algorithms = vec!["ga".into()];
+    assert!(error(&a).contains("unknown algorithm"));
+    let mut a = args(&[]);
+    a.functions = vec!["schaffer".into()];
+    assert!(error(&a).contains("unknown function"));
+    let mut a = args(&[]);
+    a.runs = 0;
+    assert!(error(&a).contains("--runs"));
+    let mut a = args(&[]);
+    a.threads = Some(0);
+    assert!(error(&a).contains("--threads"));
+    // Stopped before it starts: an empty, incomplete report.
+    let r = bench_functions(&args(&[]), &AtomicBool::new(true), &|_| {})
+        .unwrap_or_else(|e| panic!("{e:#}"));
+    assert!(!r.complete);
+    assert!(r.cells.iter().flatten().all(|c| c.values.is_empty()));
+}

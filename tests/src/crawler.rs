@@ -1,0 +1,301 @@
+//! The checker's own view of crawlers (seed 000): a crawler's trajectory must lie on the seabed
+//! (analytic terrain: eq. (2) in scaled coordinates lifted so its lowest point in the bounds is
+//! 0, plus the Gaussian mountains of eq. (3), plus the sensor height) and stay out of every
+//! hazard cylinder (eq. (4)); its reported figures are recomputed here from the samples:
+//! length (eq. (5)), undulation Σ|Δz| (eq. (6)), energy (eq. (7) at the vehicle's top speed,
+//! with the mining share), slip (eq. (9), decreasing ramp), hazard clearance and steepest leg.
+//! Measured (grid) seabeds are not re-evaluated: only the geometric figures are checked there.
+
+use serde::Deserialize;
+
+use crate::model::{Scenario, Vehicle};
+
+/// `[seabed]` as far as the checker reads it.
+#[derive(Debug, Clone, Deserialize)]
+pub struct Seabed {
+    /// Eq. (2) constants (analytic model).
+    pub relief: Option<Relief>,
+    /// Eq. (3) mountains.
+    #[serde(default)]
+    pub mountains: Vec<Mountain>,
+}
+
+/// Eq. (2).
+#[derive(Debug, Clone, Deserialize)]
+pub struct Relief {
+    a: f64,
+    b: f64,
+    c: f64,
+    d: f64,
+    e: f64,
+    f: f64,
+    g: f64,
+    #[serde(default = "one")]
+    length_scale_m: f64,
+    #[serde(default = "one")]
+    height_scale_m: f64,
+}
+
+fn one() -> f64 {
+    1.0
+}
+
+/// Eq. (3), one term.
+#[derive(Debug, Clone, Deserialize)]
+pub struct Mountain {
+    centre: [f64; 2],
+    height_m: f64,
+    spread_m: [f64; 2],
+}
+
+/// Eq. (4).
+#[derive(Debug, Clone, Deserialize)]
+pub struct Hazard {
+    /// Name.
+    pub id: String,
+    /// Centre (x, y), metres.
+    pub centre: [f64; 2],
+    /// Radius, metres.
+    pub radius_m: f64,
+}
+
+/// `[crawler]` as far as the checker reads it (defaults: seed 000 §5.1).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(default)]
+pub struct CrawlerSettings {
+    sensor_height_m: f64,
+    power_kw: [f64; 3],
+    mining_share: f64,
+    safe_distance_m: [f64; 2],
+}
+
+impl Default for CrawlerSettings {
+    fn default() -> Self {
+        CrawlerSettings {
+            sensor_height_m: 0.5,
+            power_kw: [90.0, 50.0, 5.0],
+            mining_share: 0.6,
+            safe_distance_m: [2.0, 10.0],
+        }
+    }
+}
+
+/// The crawler block of a `plan.json` vehicle.
+#[derive(Debug, Clone, Deserialize)]
+pub struct PlanCrawler {
+    length_m: f64,
+    undulation_m: f64,
+    energy_kwh: f64,
+    slip_cost: f64,
+    min_hazard_clearance_m: Option<f64>,
+    hazard_intrusions: usize,
+    max_slope_deg: f64,
+}
+
+impl Relief {
+    fn raw(&self, x: f64, y: f64) -> f64 {
+        let (x, y) = (x / self.length_scale_m, y / self.length_scale_m);
+        let r = (x * x + y * y).sqrt();
+        self.height_scale_m
+            * ((y + self.a).sin()
+                + self.b * x.sin()
+                + self.c * (self.d * r).cos()
+                + self.e * y.cos()
+                + self.f * (self.g * r).sin())
+    }
+}
+
+/// Seabed elevation of the analytic model, or `None` for a measured seabed.
+pub struct Seafloor<'a> {
+    seabed: &'a Seabed,
+    relief: &'a Relief,
+    lift: f64,
+}
+
+impl<'a> Seafloor<'a> {
+    /// The analytic seabed of `scenario`, with the lowest point of eq. (2) in the bounds at 0
+    /// (sampled every 0.5 m, at most 1000 steps per axis, like the planner's definition).
+    pub fn of(scenario: &'a Scenario) -> Option<Seafloor<'a>> {
+        let seabed = scenario.seabed.as_ref()?;
+        let relief = seabed.relief.as_ref()?;
+        let (lo, hi) = (scenario.bounds.min, scenario.bounds.max);
+        let steps = |span: f64| ((span / 0.5).ceil() as usize).clamp(1, 1000);
+        let (nx, ny) = (steps(hi[0] - lo[0]), steps(hi[1] - lo[1]));
+        let mut low = f64::INFINITY;
+        for i in 0..=nx {
+            for j in 0..=ny {
+                let x = lo[0] + (hi[0] - lo[0]) * i as f64 / nx as f64;
+                let y = lo[1] + (hi[1] - lo[1]) * j as f64 / ny as f64;
+                low = low.min(relief.raw(x, y));
+            }
+        }
+        Some(Seafloor {
+            seabed,
+            relief,
+            lift: -low,
+        })
+    }
+
+    /// z of the seabed at (x, y).
+    pub fn z(&self, x: f64, y: f64) -> f64 {
+        let mountains: f64 = self
+            .seabed
+            .mountains
+            .iter()
+            .map(|m| {
+                let u = (x - m.centre[0]) / m.spread_m[0];
+                let v = (y - m.centre[1]) / m.spread_m[1];
+                m.height_m * (-(u * u) - v * v).exp()
+            })
+            .sum();
+        self.relief.raw(x, y) + self.lift + mountains
+    }
+}
+
+/// Horizontal distance from segment a→b to point c.
+fn segment_distance_2d(a: [f64; 2], b: [f64; 2], c: [f64; 2]) -> f64 {
+    let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
+    let len2 = dx * dx + dy * dy;
+    let t = if len2 > 0.0 {
+        (((c[0] - a[0]) * dx + (c[1] - a[1]) * dy) / len2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    (a[0] + t * dx - c[0]).hypot(a[1] + t * dy - c[1])
+}
+
+/// What the crawler checks found for one vehicle.
+#[derive(Debug, Default)]
+pub struct CrawlerFindings {
+    /// Reported figures that disagree with the recomputation.
+    pub mismatches: Vec<String>,
+    /// Broken crawler constraints (hazard entered, path off the seabed).
+    pub broken: Vec<String>,
+}
+
+/// Checks crawler `v`'s trajectory and its reported `crawler` block.
+pub fn check(
+    scenario: &Scenario,
+    v: &Vehicle,
+    traj: &[[f64; 4]],
+    reported: Option<&PlanCrawler>,
+) -> CrawlerFindings {
+    let mut out = CrawlerFindings::default();
+    let id = &v.id;
+    let settings = scenario.crawler.clone().unwrap_or_default();
+    let xy = |s: &[f64; 4]| [s[1], s[2]];
+    let length: f64 = traj
+        .windows(2)
+        .map(|w| {
+            let d = [w[1][1] - w[0][1], w[1][2] - w[0][2], w[1][3] - w[0][3]];
+            (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt()
+        })
+        .sum();
+    let undulation: f64 = traj.windows(2).map(|w| (w[1][3] - w[0][3]).abs()).sum();
+    let steepest = traj
+        .windows(2)
+        .map(|w| {
+            let h = (w[1][1] - w[0][1]).hypot(w[1][2] - w[0][2]);
+            (w[1][3] - w[0][3]).abs().atan2(h).to_degrees()
+        })
+        .fold(0.0, f64::max);
+    let hours = length / v.speed_max_mps / 3600.0;
+    let mining = hours * settings.mining_share / (1.0 - settings.mining_share);
+    let [p1, p2, p3] = settings.power_kw;
+    let energy = mining * p1 + hours * p2 + (mining + hours) * p3;
+    let [lo, hi] = settings.safe_distance_m;
+    let (mut slip, mut clearance, mut intrusions) = (0.0, None::<f64>, 0);
+    for h in &scenario.hazards {
+        let d = traj
+            .windows(2)
+            .map(|w| segment_distance_2d(xy(&w[0]), xy(&w[1]), h.centre))
+            .fold(f64::INFINITY, f64::min)
+            - h.radius_m;
+        clearance = Some(clearance.map_or(d, |c| c.min(d)));
+        slip += if d < lo {
+            1.0
+        } else if d >= hi {
+            0.0
+        } else {
+            (hi - d) / (hi - lo)
+        };
+        if d < 0.0 {
+            intrusions += 1;
+            out.broken.push(format!(
+                "{id} enters hazard {} ({d:.3} m inside its edge)",
+                h.id
+            ));
+        }
+    }
+    if let Some(floor) = Seafloor::of(scenario) {
+        let off = traj
+            .iter()
+            .map(|s| (s[3] - floor.z(s[1], s[2]) - settings.sensor_height_m).abs())
+            .fold(0.0, f64::max);
+        if off > 1e-6 {
+            out.broken.push(format!(
+                "{id} is a crawler but leaves the seabed by {off:.4} m"
+            ));
+        }
+    }
+    let Some(r) = reported else {
+        out.mismatches.push(format!(
+            "{id} is a crawler but plan.json has no crawler figures"
+        ));
+        return out;
+    };
+    let mut num = |what: &str, reported: f64, recomputed: f64| {
+        if !crate::close(reported, recomputed, crate::TOL) {
+            out.mismatches.push(format!(
+                "{id}.crawler.{what}: reported {reported} but recomputed {recomputed}"
+            ));
+        }
+    };
+    num("length_m", r.length_m, length);
+    num("undulation_m", r.undulation_m, undulation);
+    num("energy_kwh", r.energy_kwh, energy);
+    num("slip_cost", r.slip_cost, slip);
+    num("max_slope_deg", r.max_slope_deg, steepest);
+    match (r.min_hazard_clearance_m, clearance) {
+        (Some(a), Some(b)) => num("min_hazard_clearance_m", a, b),
+        (None, None) => {}
+        (a, b) => out.mismatches.push(format!(
+            "{id}.crawler.min_hazard_clearance_m: reported {a:?} but recomputed {b:?}"
+        )),
+    }
+    if r.hazard_intrusions != intrusions {
+        out.mismatches.push(format!(
+            "{id}.crawler.hazard_intrusions: reported {} but recomputed {intrusions}",
+            r.hazard_intrusions
+        ));
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn segment_distance_by_hand() {
+        assert!((segment_distance_2d([0.0, 0.0], [10.0, 0.0], [5.0, 3.0]) - 3.0).abs() < 1e-12);
+        assert!((segment_distance_2d([0.0, 0.0], [10.0, 0.0], [13.0, 4.0]) - 5.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn relief_by_hand() {
+        // At the origin with a = π/2: height · (1 + c + e).
+        let r = Relief {
+            a: std::f64::consts::FRAC_PI_2,
+            b: 0.3,
+            c: 0.5,
+            d: 1.0,
+            e: 0.25,
+            f: 0.7,
+            g: 2.0,
+            length_scale_m: 10.0,
+            height_scale_m: 2.0,
+        };
+        assert!((r.raw(0.0, 0.0) - 2.0 * 1.75).abs() < 1e-12);
+    }
+}

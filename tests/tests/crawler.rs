@@ -1,0 +1,117 @@
+//! Crawlers on the seabed end to end (seed 000 as a Shoal capability): the DSMV scenario of
+//! §5.1 planned in process by every seed 000 algorithm, and a mixed fleet of two crawlers and an
+//! AUV planned in process and by one agent process per vehicle; every plan passes the
+//! independent checker, which re-evaluates the seabed and the hazards itself.
+
+mod common;
+
+use std::time::{Duration, Instant};
+
+use common::fleet::Fleet;
+use common::{check_plan_run, key, number, plan_and_check, scenario, TestResult};
+use serde_json::Value;
+
+/// The `crawler` block of vehicle `id`.
+fn crawler<'a>(json: &'a Value, id: &str) -> &'a Value {
+    let vehicles = key(json, "vehicles");
+    match vehicles
+        .as_array()
+        .and_then(|l| l.iter().find(|v| v["id"] == id))
+    {
+        Some(v) => &v["crawler"],
+        None => panic!("no vehicle {id} in {vehicles}"),
+    }
+}
+
+#[test]
+fn every_seed000_algorithm_plans_the_dsmv_on_the_seabed() -> TestResult {
+    for algorithm in ["ipso", "spso", "cbpso", "nspso", "aco-pso"] {
+        let dir = tempfile::tempdir()?;
+        let json = plan_and_check(
+            "ipso-dsmv",
+            dir.path(),
+            &[
+                "--algorithm",
+                algorithm,
+                "--iterations",
+                "25",
+                "--seed",
+                "4",
+            ],
+        )?;
+        assert_eq!(key(&json, "algorithm"), algorithm);
+        assert_eq!(key(&json, "feasible").as_bool(), Some(true), "{algorithm}");
+        let c = crawler(&json, "dsmv");
+        assert_eq!(c["hazard_intrusions"].as_u64(), Some(0), "{algorithm}: {c}");
+        assert!(c["off_seabed_m"].as_f64().is_some_and(|d| d < 1e-9), "{c}");
+        // Longer than the 281.43 m straight line (which crosses hazard pa), not absurdly so.
+        let length = c["length_m"].as_f64().unwrap_or(f64::NAN);
+        assert!(length > 281.43 && length < 300.0, "{algorithm}: {length}");
+        assert!(c["max_slope_deg"].as_f64() <= c["slope_limit_deg"].as_f64());
+        // Energy by hand from the length: 1 m/s, 60 % mining: L/3600 · (1.5·90 + 50 + 2.5·5).
+        let energy = length / 3600.0 * (1.5 * 90.0 + 50.0 + 2.5 * 5.0);
+        assert!((c["energy_kwh"].as_f64().unwrap_or(0.0) - energy).abs() < 1e-9);
+        let svg = std::fs::read_to_string(dir.path().join("plan.svg"))?;
+        assert!(
+            svg.contains("on the seabed (dark = high)"),
+            "no seabed in the top view"
+        );
+        assert!(
+            svg.contains(">\npa\n<") || svg.contains(">pa<"),
+            "hazard pa not labelled"
+        );
+    }
+    Ok(())
+}
+
+#[test]
+fn the_checker_rejects_a_crawler_driven_through_a_hazard() -> TestResult {
+    let dir = tempfile::tempdir()?;
+    let json = plan_and_check("ipso-dsmv", dir.path(), &["--iterations", "10"])?;
+    let mut tampered = json.clone();
+    let Some(samples) = tampered["vehicles"][0]["trajectory"].as_array_mut() else {
+        panic!("no trajectory");
+    };
+    // Put the middle sample on hazard pa's centre (keeping its z).
+    let mid = samples.len() / 2;
+    samples[mid][1] = serde_json::json!(148.62);
+    samples[mid][2] = serde_json::json!(149.23);
+    let text = std::fs::read_to_string(scenario("ipso-dsmv"))?;
+    let report = shoal_tests::check(&text, &tampered.to_string())?;
+    let all = format!("{report}");
+    assert!(!report.is_clean(), "{all}");
+    assert!(all.contains("enters hazard pa"), "{all}");
+    assert!(all.contains("leaves the seabed"), "{all}");
+    assert!(all.contains("dsmv.crawler.length_m"), "{all}");
+    Ok(())
+}
+
+#[test]
+fn a_mixed_fleet_keeps_crawlers_apart_in_process_and_distributed() -> TestResult {
+    let dir = tempfile::tempdir()?;
+    let json = plan_and_check("seabed-fleet", dir.path(), &["--seed", "2"])?;
+    for id in ["crawler1", "crawler2"] {
+        let c = crawler(&json, id);
+        assert_eq!(c["hazard_intrusions"].as_u64(), Some(0), "{id}: {c}");
+        assert!(c["off_seabed_m"].as_f64().is_some_and(|d| d < 1e-9), "{c}");
+    }
+    assert!(
+        crawler(&json, "auv1").is_null(),
+        "a swimmer has no crawler block"
+    );
+    assert!(number(&json, "fleet.min_separation_m") >= 10.0);
+
+    // One agent process per vehicle plans the same scenario over Zenoh.
+    let mut fleet = Fleet::new();
+    let out = fleet.dir().join("distributed");
+    let c = fleet.coordinator("coordinator", "seabed-fleet", &out, &[]);
+    let run = fleet.wait(c, Instant::now() + Duration::from_secs(120));
+    let json = check_plan_run("seabed-fleet", &out, &run)?;
+    assert_eq!(key(&json, "mode"), "distributed");
+    for id in ["crawler1", "crawler2"] {
+        let c = crawler(&json, id);
+        assert_eq!(c["hazard_intrusions"].as_u64(), Some(0), "{id}: {c}");
+    }
+    fleet.passed();
+    Ok(())
+}
