@@ -5,7 +5,9 @@ pub mod benchfns;
 pub mod bspline;
 pub mod cost;
 pub mod crawler;
+pub mod current;
 pub mod distributed;
+pub mod energy;
 #[cfg(test)]
 mod fixtures;
 pub mod fleet;
@@ -18,6 +20,7 @@ pub mod separation;
 pub mod stats;
 pub mod swarm;
 pub mod terrain;
+pub mod tour;
 pub mod trajectory;
 pub mod vehicle_problem;
 pub mod wire;

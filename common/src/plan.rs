@@ -44,6 +44,9 @@ pub struct VehiclePlan {
     /// Crawlers only: the seed 000 figures of the path on the seabed.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub crawler: Option<crate::crawler::CrawlerFigures>,
+    /// Energy-planned AUVs only: seed 001's figures (q_path, q_e, q_r, q_a, f_f, …).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub energy: Option<crate::energy::EnergyTerms>,
 }
 
 /// Fleet-wide figures.
@@ -197,6 +200,7 @@ pub fn assess(scenario: &Scenario, trajectories: &[Trajectory]) -> Assessment {
             hard_collisions,
             soft_exposure_m: soft_exposure,
             crawler,
+            energy: None,
         });
     }
 

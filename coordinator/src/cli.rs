@@ -34,6 +34,8 @@ pub enum Command {
     Health(HealthArgs),
     /// Run the benchmark-function suite (seed 000 Table 3–6).
     BenchFunctions(crate::bench_functions::BenchFunctionsArgs),
+    /// Compare PSO (length only), M-PSO and EPA-PSO on one AUV in a current (seed 001 Table 3).
+    BenchEnergy(crate::bench_energy::BenchEnergyArgs),
 }
 
 /// `shoal-coordinator plan`.
@@ -51,8 +53,8 @@ pub struct PlanArgs {
     /// RNG seed (overrides the scenario's).
     #[arg(long, env = "SHOAL_SEED")]
     pub seed: Option<u64>,
-    /// Optimizer: amp-pso, a-pso, mp-pso, pso (seed 004) or ipso, spso, cbpso, nspso, aco-pso
-    /// (seed 000);
+    /// Optimizer: amp-pso, a-pso, mp-pso, pso (seed 004); ipso, spso, cbpso, nspso, aco-pso
+    /// (seed 000); epa-pso, pso-length, m-pso (seed 001, one AUV, with --in-process);
     /// overrides the scenario's.
     #[arg(long, env = "SHOAL_ALGORITHM")]
     pub algorithm: Option<Algorithm>,

@@ -1,11 +1,13 @@
 //! Shoal's coordinator as a library: the binary parses its command line and calls [`run`]; tests
 //! call [`run`] (or the functions it uses) directly.
 
+pub mod bench_energy;
 pub mod bench_functions;
 pub mod cli;
 pub mod compare;
 pub mod crawler_table;
 pub mod distributed;
+pub mod energy_planner;
 pub mod generate;
 pub mod planner;
 pub mod summary;
@@ -38,6 +40,7 @@ pub fn run(command: Command, shutdown: Arc<AtomicBool>) -> anyhow::Result<i32> {
         Command::Plan(args) => plan_command(&args, shutdown),
         Command::Compare(args) => compare_command(&args, &shutdown),
         Command::BenchFunctions(args) => bench_functions::command(&args, &shutdown),
+        Command::BenchEnergy(args) => bench_energy::command(&args, &shutdown),
         Command::Health(args) => {
             shoal_common::health::check(&args.file, std::time::Duration::from_secs(10))
                 .map_err(anyhow::Error::msg)?;
@@ -192,6 +195,14 @@ pub fn distributed_options(
 
 fn plan_command(args: &PlanArgs, shutdown: Arc<AtomicBool>) -> anyhow::Result<i32> {
     let scenario = load_scenario(args)?;
+    let algorithm = scenario.optimizer.algorithm;
+    if algorithm.is_energy_planner() && !args.in_process {
+        bail!(
+            "{}: {} plans one AUV inside this process (seed 001 has no fleet to distribute): add --in-process",
+            args.scenario.display(),
+            algorithm.as_str()
+        );
+    }
     let options = if args.in_process {
         None
     } else {

@@ -13,7 +13,7 @@ use shoal_common::swarm::multi::MultiPso;
 use shoal_common::swarm::nspso::Nspso;
 use shoal_common::swarm::population::Schedule;
 use shoal_common::swarm::pso::Pso;
-use shoal_common::swarm::{Executor, IterationReport, Solver, SolverState, Termination};
+use shoal_common::swarm::{Executor, IterationReport, Problem, Solver, SolverState, Termination};
 
 /// What an optimizer run leaves behind, whatever the algorithm and the mode.
 pub struct RunResult {
@@ -29,8 +29,9 @@ pub struct RunResult {
     pub runtime_s: f64,
 }
 
-fn run_solver<S: Solver<FleetModel>>(
-    model: &FleetModel,
+/// Runs `solver` on `model` under `executor`.
+pub(crate) fn run_solver<P: Problem, S: Solver<P>>(
+    model: &P,
     mut solver: S,
     executor: &Executor,
     observe: &mut dyn FnMut(&IterationReport),
@@ -105,6 +106,10 @@ pub fn plan_in_process(
             &executor,
             observe,
         ),
+        // Seed 001's planners plan one AUV on the energy cost, not the fleet fitness.
+        Algorithm::EpaPso | Algorithm::PsoLength | Algorithm::MPso => {
+            return crate::energy_planner::plan(scenario, executor.stop.clone(), observe)
+        }
     };
     to_plan(scenario, &model, run, "in-process")
 }

@@ -10,8 +10,10 @@ use serde::{Deserialize, Serialize};
 
 use crate::geometry::Vec3;
 
+mod ocean;
 mod optimizer;
 mod seabed;
+pub use ocean::{CurrentModel, Currents, EnergySettings};
 pub use optimizer::{Algorithm, DistributedSettings, OptimizerSettings};
 pub use seabed::{CrawlerSettings, Seabed, SeabedGrid};
 
@@ -74,6 +76,12 @@ pub struct Scenario {
     /// Settings of the crawler cost (seed 000 eq. (5)–(11)).
     #[serde(default)]
     pub crawler: CrawlerSettings,
+    /// The ocean current (seed 001 eq. (2)); absent: still water.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub currents: Option<Currents>,
+    /// Settings of the energy-saving planner (seed 001, Table 2).
+    #[serde(default)]
+    pub energy: EnergySettings,
 }
 
 /// Axis-aligned box of the navigation space, metres.
@@ -341,6 +349,27 @@ impl Scenario {
         }
         self.optimizer.validate(&bad)?;
         self.validate_crawlers(&bad)?;
+        self.energy.validate(self.currents.as_ref(), &bad)?;
+        let algorithm = self.optimizer.algorithm;
+        if algorithm.is_energy_planner() {
+            if self.vehicles.len() != 1 {
+                return Err(bad(
+                    "optimizer.algorithm".into(),
+                    format!("{:?}", algorithm.as_str()),
+                    &format!(
+                        "plans one AUV (seed 001); this scenario has {} vehicles",
+                        self.vehicles.len()
+                    ),
+                ));
+            }
+            if self.vehicles[0].kind != VehicleKind::Auv {
+                return Err(bad(
+                    "vehicles[0].kind".into(),
+                    format!("{:?}", self.vehicles[0].kind),
+                    &format!("{} plans AUVs, not crawlers", algorithm.as_str()),
+                ));
+            }
+        }
         Ok(())
     }
 

@@ -28,6 +28,12 @@ pub enum Algorithm {
     Nspso,
     /// Ant-colony / PSO hybrid of seed 000 Table 8.
     AcoPso,
+    /// Energy-saving PSO of seed 001 (eq. (14)–(17), Table 2), one AUV in a current.
+    EpaPso,
+    /// Seed 001's baseline: PSO minimising the path length alone.
+    PsoLength,
+    /// Seed 001's M-PSO: the same PSO on the full cost of eq. (6).
+    MPso,
 }
 
 impl Algorithm {
@@ -43,10 +49,13 @@ impl Algorithm {
             Algorithm::Cbpso => "cbpso",
             Algorithm::Nspso => "nspso",
             Algorithm::AcoPso => "aco-pso",
+            Algorithm::EpaPso => "epa-pso",
+            Algorithm::PsoLength => "pso-length",
+            Algorithm::MPso => "m-pso",
         }
     }
-    /// Every algorithm: seed 004 Table 5's order, then seed 000 Table 8's.
-    pub const ALL: [Algorithm; 9] = [
+    /// Every algorithm: seed 004 Table 5's order, then seed 000 Table 8's, then seed 001's.
+    pub const ALL: [Algorithm; 12] = [
         Algorithm::AmpPso,
         Algorithm::APso,
         Algorithm::MpPso,
@@ -56,7 +65,18 @@ impl Algorithm {
         Algorithm::Cbpso,
         Algorithm::Nspso,
         Algorithm::AcoPso,
+        Algorithm::EpaPso,
+        Algorithm::PsoLength,
+        Algorithm::MPso,
     ];
+    /// True for seed 001's single-AUV energy planners, which plan on the energy cost rather
+    /// than the fleet fitness.
+    pub fn is_energy_planner(self) -> bool {
+        matches!(
+            self,
+            Algorithm::EpaPso | Algorithm::PsoLength | Algorithm::MPso
+        )
+    }
     /// True for the multi-population algorithms (the ones a distributed run can split).
     pub fn is_multi_population(self) -> bool {
         matches!(self, Algorithm::AmpPso | Algorithm::MpPso)

@@ -162,11 +162,12 @@ impl Seabed {
                     mountains: self.mountains.clone(),
                 }
             }
+            (None, None) if !self.mountains.is_empty() => Terrain::Hills(self.mountains.clone()),
             (None, None) => {
                 return Err(bad(
                     "seabed".into(),
                     "{}".into(),
-                    "needs a `relief` table (with optional `mountains`) or a `grid` file",
+                    "needs a `relief` table (with optional `mountains`), `mountains` alone (hills on a flat floor, seed 001 eq. (1)) or a `grid` file",
                 ))
             }
         });

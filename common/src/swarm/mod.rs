@@ -6,7 +6,11 @@
 
 pub mod acopso;
 pub mod cbpso;
+pub mod epapso;
+pub mod depso;
 pub mod ipso;
+pub mod lcpso;
+pub mod ldiwpso;
 pub mod multi;
 pub mod nspso;
 pub mod parallel;
@@ -60,6 +64,13 @@ pub trait Problem: Sync {
             *p = c;
         }
         c
+    }
+    /// True when `x` meets every hard constraint of the problem. Solvers that keep a set of
+    /// feasible solutions (EPA-PSO, seed 001 §3.2.2) ask it; the default calls everything
+    /// feasible, which is right for unconstrained problems.
+    fn feasible(&self, x: &[f64]) -> bool {
+        let _ = x;
+        true
     }
     /// An initial position. Default: uniform in the box (seed 004 §3.1, `g ~ U`).
     fn sample(&self, rng: &mut StdRng) -> Vec<f64> {

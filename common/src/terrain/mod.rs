@@ -167,6 +167,8 @@ pub enum Terrain {
         /// Mountains summed into `Z2`, eq. (3).
         mountains: Vec<Mountain>,
     },
+    /// Seed 001 eq. (1): Gaussian hills on a flat floor at z = 0, no base relief.
+    Hills(Vec<Mountain>),
     /// Measured bathymetry, bilinearly interpolated.
     Grid(HeightGrid),
 }
@@ -178,6 +180,7 @@ impl Terrain {
             Terrain::Analytic { base, mountains } => {
                 base.elevation(x, y) + mountains.iter().map(|m| m.elevation(x, y)).sum::<f64>()
             }
+            Terrain::Hills(hills) => hills.iter().map(|m| m.elevation(x, y)).sum(),
             Terrain::Grid(grid) => grid.elevation(x, y),
         }
     }
@@ -191,6 +194,10 @@ impl Terrain {
                     (gx + mx, gy + my)
                 })
             }
+            Terrain::Hills(hills) => hills.iter().fold((0.0, 0.0), |(gx, gy), m| {
+                let (mx, my) = m.gradient(x, y);
+                (gx + mx, gy + my)
+            }),
             Terrain::Grid(grid) => grid.gradient(x, y),
         }
     }

@@ -1,0 +1,166 @@
+//! The `[currents]` and `[energy]` tables: the water an AUV flies through and the constants of
+//! seed 001's energy-saving planner.
+
+use std::sync::Arc;
+
+use serde::{Deserialize, Serialize};
+
+use super::ScenarioError;
+use crate::current::{CurrentField, DepthDecayCurrent};
+use crate::energy::Weights;
+
+/// Which current model a scenario uses.
+#[derive(Debug, Clone, Copy, Serialize, Deserialize, PartialEq, Eq, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum CurrentModel {
+    /// Seed 001 eq. (2): horizontal, strongest at the surface, zero at the map's greatest depth.
+    #[default]
+    DepthDecay,
+}
+
+/// `[currents]`: the current field.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct Currents {
+    /// The model (only `depth-decay` so far; a forecast grid would be a second variant).
+    #[serde(default)]
+    pub model: CurrentModel,
+    /// `(u, v)` at the surface, m/s (seed 001 eq. (2): −1.0 each).
+    pub surface_velocity_mps: [f64; 2],
+}
+
+impl Currents {
+    /// The field over a scenario box whose top is the surface and whose floor is ζ_bd.
+    pub fn field(&self, bounds_min_z: f64, bounds_max_z: f64) -> Arc<dyn CurrentField> {
+        match self.model {
+            CurrentModel::DepthDecay => Arc::new(DepthDecayCurrent {
+                surface_mps: self.surface_velocity_mps,
+                surface_z: bounds_max_z,
+                max_depth_m: bounds_max_z - bounds_min_z,
+            }),
+        }
+    }
+}
+
+/// `[energy]`: seed 001's planner constants (Table 2 by default).
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields, default)]
+pub struct EnergySettings {
+    /// R_AUV, the smallest turning radius, metres (Table 2: 8 m).
+    pub min_turn_radius_m: f64,
+    /// Free control points of the B-spline between start and goal (the particle's genes are
+    /// their x, y, z).
+    pub control_points: usize,
+    /// n_p, points the path is sampled into (Table 2: 500).
+    pub path_points: usize,
+    /// K_pinit, K_einit, K_rinit, K_ainit (Table 2: 0.25 each).
+    pub weights_init: [f64; 4],
+    /// K_urp, K_ure, K_urr, K_ura (Table 2: 0.01 each).
+    pub weights_range: [f64; 4],
+    /// μ of eq. (8), (12), (13) (not in the paper).
+    pub mu: f64,
+    /// Height kept above the seabed, metres (not in the paper).
+    pub terrain_clearance_m: f64,
+    /// Constant speed over ground |V_h|, m/s; default: the vehicle's top speed.
+    pub ground_speed_mps: Option<f64>,
+}
+
+impl Default for EnergySettings {
+    fn default() -> Self {
+        let w = Weights::default();
+        EnergySettings {
+            min_turn_radius_m: 8.0,
+            control_points: 10,
+            path_points: 500,
+            weights_init: w.init,
+            weights_range: w.range,
+            mu: w.mu,
+            terrain_clearance_m: 2.0,
+            ground_speed_mps: None,
+        }
+    }
+}
+
+impl EnergySettings {
+    /// The weight constants.
+    pub fn weights(&self) -> Weights {
+        Weights {
+            init: self.weights_init,
+            range: self.weights_range,
+            mu: self.mu,
+        }
+    }
+
+    /// Checks every value; `bad` builds the error naming the field.
+    pub fn validate(
+        &self,
+        currents: Option<&Currents>,
+        bad: &dyn Fn(String, String, &str) -> ScenarioError,
+    ) -> Result<(), ScenarioError> {
+        let positive = [
+            ("energy.min_turn_radius_m", self.min_turn_radius_m),
+            ("energy.mu", self.mu),
+        ];
+        for (field, v) in positive {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(bad(
+                    field.into(),
+                    v.to_string(),
+                    "must be a positive number",
+                ));
+            }
+        }
+        if !(self.terrain_clearance_m.is_finite() && self.terrain_clearance_m >= 0.0) {
+            return Err(bad(
+                "energy.terrain_clearance_m".into(),
+                self.terrain_clearance_m.to_string(),
+                "must be a non-negative number of metres",
+            ));
+        }
+        if let Some(v) = self.ground_speed_mps {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(bad(
+                    "energy.ground_speed_mps".into(),
+                    v.to_string(),
+                    "must be a positive speed in m/s",
+                ));
+            }
+        }
+        if !(1..=64).contains(&self.control_points) {
+            return Err(bad(
+                "energy.control_points".into(),
+                self.control_points.to_string(),
+                "must be between 1 and 64",
+            ));
+        }
+        if !(3..=100_000).contains(&self.path_points) {
+            return Err(bad(
+                "energy.path_points".into(),
+                self.path_points.to_string(),
+                "must be between 3 and 100000",
+            ));
+        }
+        for (name, values) in [
+            ("energy.weights_init", self.weights_init),
+            ("energy.weights_range", self.weights_range),
+        ] {
+            if !values.iter().all(|v| v.is_finite() && *v >= 0.0) {
+                return Err(bad(
+                    name.into(),
+                    format!("{values:?}"),
+                    "must be four non-negative numbers",
+                ));
+            }
+        }
+        if let Some(c) = currents {
+            if !c.surface_velocity_mps.iter().all(|v| v.is_finite()) {
+                return Err(bad(
+                    "currents.surface_velocity_mps".into(),
+                    format!("{:?}", c.surface_velocity_mps),
+                    "must be finite m/s",
+                ));
+            }
+        }
+        Ok(())
+    }
+}

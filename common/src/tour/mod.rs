@@ -1,0 +1,393 @@
+//! Cage-inspection tours, seed 003 (Hu et al. 2023): an AUV leaves a base, visits two inspection
+//! points on opposite sides of every spherical net cage and returns, on the shortest path that
+//! never touches a cage.
+//!
+//! Two layers, as in the seed:
+//! 1. the visiting order, by the swap-operator PSO (§III-B, Table 3) on straight-line distances
+//!    ([`SwapPso`]);
+//! 2. every leg between consecutive visits, by a continuous swarm (DE-PSO, LDIW-PSO or LCPSO,
+//!    Table 5) over the leg's intermediate waypoints with the cages as spherical obstacles
+//!    ([`LegProblem`], §IV-C).
+//!
+//! [`plan_tour`] puts them together and reports the seed's Table 6 measures (path growth over
+//! the straight tour and its rate). [`split_points`] shares the points among several AUVs.
+
+mod cages;
+mod leg;
+mod order;
+mod split;
+
+pub use cages::{
+    cage_group_a, cage_group_b, inspection_points, paper_base, paper_bounds, Cage, FirstPoint,
+    InspectionPoint, MONITOR_STANDOFF_M,
+};
+pub use leg::{
+    feasible, intersections, path_length, safety_spheres, segment_hits, LegProblem, Sphere,
+    CHORD_WEIGHT, HIT_PENALTY_M,
+};
+pub use order::{distance_matrix, open_order_length, swap_sequence, tour_length, two_opt, SwapPso};
+pub use split::{short_tour, split_points};
+
+use crate::geometry::Vec3;
+use crate::swarm::depso::DePso;
+use crate::swarm::lcpso::Lcpso;
+use crate::swarm::ldiwpso::LdiwPso;
+use crate::swarm::multi::stream_seed;
+use crate::swarm::{Executor, SolverState};
+
+/// Clearance the leg planner keeps from a cage's surface, metres. The seed treats the AUV as a
+/// point and the cage sphere itself as the obstacle; 1 m of margin stays well inside the 5 m
+/// standoff of the inspection points ([`MONITOR_STANDOFF_M`]), so those remain reachable.
+pub const LEG_CLEARANCE_M: f64 = 1.0;
+
+/// The swarm that plans the legs (the three algorithms of seed 003 Table 6).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum LegAlgorithm {
+    /// DE-PSO, §IV-A, eq. (14)–(20).
+    DePso,
+    /// LDIW-PSO, eq. (3).
+    LdiwPso,
+    /// LCPSO, eq. (4)–(10).
+    Lcpso,
+}
+
+impl LegAlgorithm {
+    /// The solver's name ("de-pso", "ldiw-pso", "lcpso").
+    pub fn name(&self) -> &'static str {
+        match self {
+            LegAlgorithm::DePso => "de-pso",
+            LegAlgorithm::LdiwPso => "ldiw-pso",
+            LegAlgorithm::Lcpso => "lcpso",
+        }
+    }
+}
+
+/// Budgets and geometry of one leg's optimisation.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LegSettings {
+    /// Swarm size M (Table 5: 60).
+    pub particles: usize,
+    /// Iterations (Table 5: 400).
+    pub iterations: usize,
+    /// Intermediate waypoints n (Table 5's `path_num = 30` segments: 29).
+    pub waypoints: usize,
+    /// Margin added to every cage radius, metres ([`LEG_CLEARANCE_M`]).
+    pub clearance_m: f64,
+}
+
+impl LegSettings {
+    /// Seed 003 Table 5.
+    pub fn table5() -> LegSettings {
+        LegSettings {
+            particles: 60,
+            iterations: 400,
+            waypoints: 29,
+            clearance_m: LEG_CLEARANCE_M,
+        }
+    }
+}
+
+/// Settings of [`plan_tour`].
+#[derive(Debug, Clone)]
+pub struct TourSettings {
+    /// The ordering swarm; its `seed` is replaced by one derived from the plan's seed.
+    pub order: SwapPso,
+    /// The leg swarms.
+    pub leg: LegSettings,
+}
+
+impl TourSettings {
+    /// Seed 003's settings: Table 3 for the order, Table 5 for the legs.
+    pub fn paper() -> TourSettings {
+        TourSettings {
+            order: SwapPso::table3(0),
+            leg: LegSettings::table5(),
+        }
+    }
+}
+
+/// A planned inspection tour with the measures of seed 003 Table 6.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TourPlan {
+    /// Visiting order: indices into the inspection points (the base is implicit at both ends).
+    pub order: Vec<usize>,
+    /// The full polyline: base, every leg's waypoints and inspection points, base.
+    pub path: Vec<Vec3>,
+    /// Length of each leg (base → first point, …, last point → base), metres.
+    pub leg_lengths: Vec<f64>,
+    /// Length of `path`, metres.
+    pub tour_length_m: f64,
+    /// Length of the same visiting order with straight legs, metres.
+    pub straight_tour_length_m: f64,
+    /// `tour_length_m − straight_tour_length_m` ("path growth length", Table 6), metres.
+    pub growth_m: f64,
+    /// `growth_m / straight_tour_length_m` ("path growth rate"; 0 for a zero-length tour).
+    pub growth_rate: f64,
+    /// Segment–cage intersections along `path`, against the cages inflated by the clearance,
+    /// with the contact guard (0 for a safe tour).
+    pub cage_intersections: usize,
+}
+
+/// Plans one leg with `algorithm`; returns its polyline (both end points included).
+///
+/// A straight leg that is already clear is kept as it is: nothing is shorter, so no swarm is run.
+/// Otherwise the swarm's best path is returned, or the straight one if the swarm did worse by the
+/// leg's cost (possible only when both collide).
+pub fn plan_leg(
+    problem: &LegProblem,
+    algorithm: LegAlgorithm,
+    settings: &LegSettings,
+    seed: u64,
+) -> Vec<Vec3> {
+    let straight = vec![problem.start, problem.end];
+    if problem.waypoints == 0 || problem.feasible(&straight) {
+        return straight;
+    }
+    let ex = Executor::new(settings.iterations);
+    let m = settings.particles;
+    let best = match algorithm {
+        LegAlgorithm::DePso => ex
+            .run(problem, &mut DePso::table5(m, seed), |_| {})
+            .state
+            .best_position()
+            .to_vec(),
+        LegAlgorithm::LdiwPso => ex
+            .run(problem, &mut LdiwPso::table5(m, seed), |_| {})
+            .state
+            .best_position()
+            .to_vec(),
+        LegAlgorithm::Lcpso => ex
+            .run(problem, &mut Lcpso::table5(m, seed), |_| {})
+            .state
+            .best_position()
+            .to_vec(),
+    };
+    let path = problem.path(&best);
+    if problem.path_cost(&path) <= problem.path_cost(&straight) {
+        path
+    } else {
+        straight
+    }
+}
+
+/// Plans a closed inspection tour from `base` through every point of `points` (seed 003 §V).
+///
+/// The order comes from the swap-operator PSO on straight-line distances (seeded with
+/// `stream_seed(seed, 0)`); leg `k` is planned by [`plan_leg`] with `stream_seed(seed, k + 1)`,
+/// so a plan is reproducible from `seed` alone. Nothing here panics on odd input: an inverted box
+/// is put in order, and a point inside a cage simply leaves `cage_intersections` above zero.
+pub fn plan_tour(
+    base: Vec3,
+    points: &[InspectionPoint],
+    cages: &[Cage],
+    bounds: (Vec3, Vec3),
+    algorithm: LegAlgorithm,
+    settings: &TourSettings,
+    seed: u64,
+) -> TourPlan {
+    let nodes: Vec<Vec3> = std::iter::once(base)
+        .chain(points.iter().map(|p| p.position))
+        .collect();
+    let dist = distance_matrix(&nodes);
+    let orderer = SwapPso {
+        seed: stream_seed(seed, 0),
+        ..settings.order.clone()
+    };
+    let tour = orderer.order(&dist);
+    let order: Vec<usize> = tour
+        .iter()
+        .skip(1)
+        .take(points.len())
+        .map(|&k| k - 1)
+        .collect();
+    let spheres = safety_spheres(cages, settings.leg.clearance_m);
+    let mut path = vec![base];
+    let mut leg_lengths = Vec::with_capacity(points.len() + 1);
+    for (k, w) in tour.windows(2).enumerate() {
+        let problem = LegProblem::new(
+            nodes[w[0]],
+            nodes[w[1]],
+            spheres.clone(),
+            bounds,
+            settings.leg.waypoints,
+        );
+        let leg = plan_leg(
+            &problem,
+            algorithm,
+            &settings.leg,
+            stream_seed(seed, k as u64 + 1),
+        );
+        leg_lengths.push(path_length(&leg));
+        path.extend(leg.into_iter().skip(1));
+    }
+    let tour_length_m: f64 = leg_lengths.iter().sum();
+    let straight_tour_length_m = tour_length(&dist, &tour);
+    let growth_m = tour_length_m - straight_tour_length_m;
+    TourPlan {
+        order,
+        cage_intersections: intersections(&path, &spheres),
+        path,
+        leg_lengths,
+        tour_length_m,
+        straight_tour_length_m,
+        growth_m,
+        growth_rate: if straight_tour_length_m > 0.0 {
+            growth_m / straight_tour_length_m
+        } else {
+            0.0
+        },
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use approx::assert_abs_diff_eq;
+
+    fn small() -> TourSettings {
+        TourSettings {
+            order: SwapPso {
+                particles: 50,
+                iterations: 300,
+                ..SwapPso::table3(0)
+            },
+            leg: LegSettings {
+                particles: 30,
+                iterations: 150,
+                waypoints: 9,
+                clearance_m: LEG_CLEARANCE_M,
+            },
+        }
+    }
+
+    fn group_a_plan(algorithm: LegAlgorithm, seed: u64) -> (Vec<InspectionPoint>, TourPlan) {
+        let cages = cage_group_a();
+        let base = paper_base();
+        let pts = inspection_points(&cages, MONITOR_STANDOFF_M, FirstPoint::Toward(base));
+        let plan = plan_tour(
+            base,
+            &pts,
+            &cages,
+            paper_bounds(),
+            algorithm,
+            &small(),
+            seed,
+        );
+        (pts, plan)
+    }
+
+    #[test]
+    fn de_pso_tour_of_group_a_is_safe_and_complete() {
+        let (pts, plan) = group_a_plan(LegAlgorithm::DePso, 1);
+        assert_eq!(plan.cage_intersections, 0, "{plan:?}");
+        // Every point exactly once, in order along the path.
+        let mut seen = plan.order.clone();
+        seen.sort_unstable();
+        assert_eq!(seen, (0..pts.len()).collect::<Vec<_>>());
+        let mut cursor = 0;
+        for &i in &plan.order {
+            let at = plan.path[cursor..]
+                .iter()
+                .position(|p| *p == pts[i].position)
+                .map(|k| k + cursor);
+            assert!(at.is_some(), "point {i} missing after {cursor}");
+            cursor = at.unwrap_or(cursor) + 1;
+        }
+        assert_eq!(plan.path.first(), Some(&paper_base()));
+        assert_eq!(plan.path.last(), Some(&paper_base()));
+        // Table 6's measures are consistent.
+        assert_eq!(plan.leg_lengths.len(), pts.len() + 1);
+        assert_abs_diff_eq!(plan.tour_length_m, path_length(&plan.path), epsilon = 1e-6);
+        assert!(plan.growth_m >= 0.0, "{}", plan.growth_m);
+        assert_abs_diff_eq!(
+            plan.growth_m,
+            plan.tour_length_m - plan.straight_tour_length_m,
+            epsilon = 1e-9
+        );
+        assert_abs_diff_eq!(
+            plan.growth_rate,
+            plan.growth_m / plan.straight_tour_length_m,
+            epsilon = 1e-12
+        );
+        // The straight tour collides (the two points of a cage face each other through it), so
+        // avoiding the cages must cost something.
+        let straight: Vec<Vec3> = std::iter::once(paper_base())
+            .chain(plan.order.iter().map(|&i| pts[i].position))
+            .chain(std::iter::once(paper_base()))
+            .collect();
+        assert!(intersections(&straight, &safety_spheres(&cage_group_a(), 1.0)) > 0);
+        assert!(plan.growth_m > 1.0, "{}", plan.growth_m);
+    }
+
+    /// Seed 003 §V-B at full Table 3 / Table 5 budgets on both groups (slow in a debug build:
+    /// `cargo test -p shoal-common --lib tour::tests::paper_budgets -- --ignored --nocapture`).
+    #[test]
+    #[ignore = "full Table 5 budgets; run on demand"]
+    fn paper_budgets_give_safe_de_pso_tours_on_both_groups() {
+        for (group, cages) in [("A", cage_group_a()), ("B", cage_group_b())] {
+            let base = paper_base();
+            let pts = inspection_points(&cages, MONITOR_STANDOFF_M, FirstPoint::Toward(base));
+            for alg in [
+                LegAlgorithm::LdiwPso,
+                LegAlgorithm::Lcpso,
+                LegAlgorithm::DePso,
+            ] {
+                let plan = plan_tour(
+                    base,
+                    &pts,
+                    &cages,
+                    paper_bounds(),
+                    alg,
+                    &TourSettings::paper(),
+                    1,
+                );
+                println!(
+                    "group {group} {:>8}: straight {:.1} m, tour {:.1} m, growth {:.1} m ({:.2} %), \
+                     intersections {}",
+                    alg.name(),
+                    plan.straight_tour_length_m,
+                    plan.tour_length_m,
+                    plan.growth_m,
+                    100.0 * plan.growth_rate,
+                    plan.cage_intersections
+                );
+                if alg == LegAlgorithm::DePso {
+                    assert_eq!(plan.cage_intersections, 0, "group {group}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn plans_are_reproducible_from_the_seed() {
+        let (_, a) = group_a_plan(LegAlgorithm::DePso, 3);
+        let (_, b) = group_a_plan(LegAlgorithm::DePso, 3);
+        assert_eq!(a, b);
+    }
+
+    #[test]
+    fn every_algorithm_plans_a_complete_tour() {
+        for alg in [LegAlgorithm::LdiwPso, LegAlgorithm::Lcpso] {
+            let (pts, plan) = group_a_plan(alg, 2);
+            assert_eq!(plan.order.len(), pts.len(), "{}", alg.name());
+            assert!(plan.growth_m >= 0.0, "{}: {}", alg.name(), plan.growth_m);
+            assert_abs_diff_eq!(plan.tour_length_m, path_length(&plan.path), epsilon = 1e-6);
+        }
+    }
+
+    #[test]
+    fn a_clear_straight_leg_is_kept() {
+        let s = safety_spheres(&[Cage::new("X", 50.0, 50.0, 0.0, 10.0)], 1.0);
+        let p = LegProblem::new(
+            Vec3::zeros(),
+            Vec3::new(100.0, 0.0, 0.0),
+            s,
+            paper_bounds(),
+            5,
+        );
+        let leg = plan_leg(&p, LegAlgorithm::DePso, &small().leg, 0);
+        assert_eq!(leg, vec![p.start, p.end]);
+        assert_eq!(LegAlgorithm::Lcpso.name(), "lcpso");
+    }
+}
