@@ -6,8 +6,8 @@
 
 pub mod acopso;
 pub mod cbpso;
-pub mod epapso;
 pub mod depso;
+pub mod epapso;
 pub mod ipso;
 pub mod lcpso;
 pub mod ldiwpso;
