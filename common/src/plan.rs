@@ -47,6 +47,9 @@ pub struct VehiclePlan {
     /// Energy-planned AUVs only: seed 001's figures (q_path, q_e, q_r, q_a, f_f, …).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub energy: Option<crate::energy::EnergyTerms>,
+    /// Inspection tours only: seed 003's figures (visiting order, tour length, path growth).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tour: Option<crate::tour::TourFigures>,
 }
 
 /// Fleet-wide figures.
@@ -201,6 +204,7 @@ pub fn assess(scenario: &Scenario, trajectories: &[Trajectory]) -> Assessment {
             soft_exposure_m: soft_exposure,
             crawler,
             energy: None,
+            tour: None,
         });
     }
 

@@ -3,13 +3,13 @@
 //! paper's numbers beside ours.
 
 use std::path::PathBuf;
-use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
-use std::sync::Mutex;
+use std::sync::atomic::AtomicBool;
 
 use anyhow::Context;
 use shoal_common::energy::EnergyTerms;
 use shoal_common::scenario::{Algorithm, Scenario};
 
+use crate::bench_pool::run_jobs;
 use crate::energy_planner;
 
 /// `shoal-coordinator bench-energy`.
@@ -97,47 +97,27 @@ pub fn bench(
             }
         }
     }
-    let next = AtomicUsize::new(0);
-    let done = AtomicUsize::new(0);
-    let out = Mutex::new(Vec::new());
-    std::thread::scope(|s| {
-        for _ in 0..args.threads.max(1) {
-            s.spawn(|| loop {
-                if stop.load(Ordering::Relaxed) {
-                    break;
-                }
-                let k = next.fetch_add(1, Ordering::Relaxed);
-                let Some(&(iterations, algorithm, seed)) = jobs.get(k) else {
-                    break;
-                };
-                let mut sc = scenario.clone();
-                sc.optimizer.algorithm = algorithm;
-                sc.optimizer.iterations = iterations;
-                sc.optimizer.seed = seed;
-                let plan = energy_planner::plan(&sc, None, &mut |_| {});
-                let terms = plan
-                    .vehicles
-                    .first()
-                    .and_then(|v| v.energy)
-                    .unwrap_or_default();
-                let run = Run {
-                    iterations,
-                    algorithm,
-                    seed,
-                    fitness: plan.fitness,
-                    terms,
-                    feasible: plan.feasible,
-                    runtime_s: plan.runtime_s,
-                };
-                let n = done.fetch_add(1, Ordering::Relaxed) + 1;
-                progress(&run, n, jobs.len());
-                if let Ok(mut o) = out.lock() {
-                    o.push(run);
-                }
-            });
+    let work = |&(iterations, algorithm, seed): &(usize, Algorithm, u64)| {
+        let mut sc = scenario.clone();
+        sc.optimizer.algorithm = algorithm;
+        sc.optimizer.iterations = iterations;
+        sc.optimizer.seed = seed;
+        let plan = energy_planner::plan(&sc, None, &mut |_| {});
+        Run {
+            iterations,
+            algorithm,
+            seed,
+            fitness: plan.fitness,
+            terms: plan
+                .vehicles
+                .first()
+                .and_then(|v| v.energy)
+                .unwrap_or_default(),
+            feasible: plan.feasible,
+            runtime_s: plan.runtime_s,
         }
-    });
-    let mut runs = out.into_inner().unwrap_or_else(|e| e.into_inner());
+    };
+    let mut runs = run_jobs(&jobs, args.threads, stop, &work, progress);
     runs.sort_by_key(|r| {
         (
             r.iterations,

@@ -36,6 +36,8 @@ pub enum Command {
     BenchFunctions(crate::bench_functions::BenchFunctionsArgs),
     /// Compare PSO (length only), M-PSO and EPA-PSO on one AUV in a current (seed 001 Table 3).
     BenchEnergy(crate::bench_energy::BenchEnergyArgs),
+    /// Compare LDIW-PSO, LCPSO and DE-PSO on cage-inspection tours (seed 003 Table 6).
+    BenchCages(crate::bench_cages::BenchCagesArgs),
 }
 
 /// `shoal-coordinator plan`.
@@ -54,7 +56,8 @@ pub struct PlanArgs {
     #[arg(long, env = "SHOAL_SEED")]
     pub seed: Option<u64>,
     /// Optimizer: amp-pso, a-pso, mp-pso, pso (seed 004); ipso, spso, cbpso, nspso, aco-pso
-    /// (seed 000); epa-pso, pso-length, m-pso (seed 001, one AUV, with --in-process);
+    /// (seed 000); epa-pso, pso-length, m-pso (seed 001, one AUV, with --in-process); de-pso,
+    /// ldiw-pso, lcpso (seed 003 inspection tours, with --in-process);
     /// overrides the scenario's.
     #[arg(long, env = "SHOAL_ALGORITHM")]
     pub algorithm: Option<Algorithm>,

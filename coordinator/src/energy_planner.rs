@@ -152,7 +152,7 @@ pub fn to_plan(scenario: &Scenario, problem: &EnergyProblem, run: RunResult) -> 
 
 /// A plan that names why nothing could be planned (the scenario validation rules this out; kept
 /// so that a library caller with a hand-built scenario gets words, not a panic).
-fn unplannable(scenario: &Scenario, why: String) -> Plan {
+pub(crate) fn unplannable(scenario: &Scenario, why: String) -> Plan {
     let o = &scenario.optimizer;
     Plan {
         scenario: scenario.name.clone(),

@@ -1,8 +1,10 @@
 //! Shoal's coordinator as a library: the binary parses its command line and calls [`run`]; tests
 //! call [`run`] (or the functions it uses) directly.
 
+pub mod bench_cages;
 pub mod bench_energy;
 pub mod bench_functions;
+pub mod bench_pool;
 pub mod cli;
 pub mod compare;
 pub mod crawler_table;
@@ -12,7 +14,9 @@ pub mod generate;
 pub mod planner;
 pub mod summary;
 pub mod svg;
+pub mod svg_current;
 pub mod svg_terrain;
+pub mod tour_planner;
 
 use std::io::IsTerminal;
 use std::path::Path;
@@ -41,6 +45,7 @@ pub fn run(command: Command, shutdown: Arc<AtomicBool>) -> anyhow::Result<i32> {
         Command::Compare(args) => compare_command(&args, &shutdown),
         Command::BenchFunctions(args) => bench_functions::command(&args, &shutdown),
         Command::BenchEnergy(args) => bench_energy::command(&args, &shutdown),
+        Command::BenchCages(args) => bench_cages::command(&args, &shutdown),
         Command::Health(args) => {
             shoal_common::health::check(&args.file, std::time::Duration::from_secs(10))
                 .map_err(anyhow::Error::msg)?;
@@ -199,6 +204,13 @@ fn plan_command(args: &PlanArgs, shutdown: Arc<AtomicBool>) -> anyhow::Result<i3
     if algorithm.is_energy_planner() && !args.in_process {
         bail!(
             "{}: {} plans one AUV inside this process (seed 001 has no fleet to distribute): add --in-process",
+            args.scenario.display(),
+            algorithm.as_str()
+        );
+    }
+    if algorithm.is_tour_planner() && !args.in_process {
+        bail!(
+            "{}: {} plans inspection tours inside this process (one thread per AUV; agents do not plan tours yet): add --in-process",
             args.scenario.display(),
             algorithm.as_str()
         );

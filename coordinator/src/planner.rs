@@ -110,6 +110,10 @@ pub fn plan_in_process(
         Algorithm::EpaPso | Algorithm::PsoLength | Algorithm::MPso => {
             return crate::energy_planner::plan(scenario, executor.stop.clone(), observe)
         }
+        // Seed 003's planners plan inspection tours, leg by leg.
+        Algorithm::DePso | Algorithm::LdiwPso | Algorithm::Lcpso => {
+            return crate::tour_planner::plan(scenario, executor.stop.clone(), observe)
+        }
     };
     to_plan(scenario, &model, run, "in-process")
 }

@@ -194,6 +194,9 @@ fn draw_view(
     if b == 1 && scenario.terrain().is_some() {
         title.push_str(" on the seabed (dark = high)");
     }
+    if let Some(c) = crate::svg_current::caption(scenario, b == 1) {
+        title.push_str(&c);
+    }
     let body = captioned(area, &title)?;
     let mut chart = ChartBuilder::on(&body)
         .margin_left(mx)
@@ -210,6 +213,7 @@ fn draw_view(
     if b == 1 {
         crate::svg_terrain::draw_seabed(&mut chart, scenario, (x0, x1, y0, y1))?;
     }
+    crate::svg_current::draw_current(&mut chart, scenario, (a, b), (x0, x1, y0, y1))?;
 
     let inside = |(x, y): (f64, f64)| x >= x0 && x <= x1 && y >= y0 && y <= y1;
     let clamp = |(x, y): (f64, f64)| (x.clamp(x0, x1), y.clamp(y0, y1));

@@ -206,7 +206,25 @@ pub fn check_parsed(scenario: &Scenario, plan: &Plan) -> Report {
             mismatches.extend(c.mismatches);
             crawler_broken.extend(c.broken);
         }
+        if let Some(e) = &pv.energy {
+            let c = crate::mobility::check_energy(scenario, v, traj, e);
+            mismatches.extend(c.mismatches);
+            crawler_broken.extend(c.broken);
+        }
+        if let Some(t) = &pv.tour {
+            let c = crate::mobility::check_tour(v, traj, t);
+            mismatches.extend(c.mismatches);
+            crawler_broken.extend(c.broken);
+        }
         figures.push(f);
+    }
+    let tours: Vec<(&str, &crate::mobility::PlanTour)> = plan
+        .vehicles
+        .iter()
+        .filter_map(|v| v.tour.as_ref().map(|t| (v.id.as_str(), t)))
+        .collect();
+    if !tours.is_empty() {
+        crawler_broken.extend(crate::mobility::check_coverage(scenario, &tours));
     }
 
     // Fleet.

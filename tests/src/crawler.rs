@@ -48,6 +48,20 @@ pub struct Mountain {
     spread_m: [f64; 2],
 }
 
+impl Seabed {
+    /// The sum of the Gaussian hills alone (seed 001 eq. (1), a seabed without `relief`).
+    pub fn hills_elevation(&self, x: f64, y: f64) -> f64 {
+        self.mountains
+            .iter()
+            .map(|m| {
+                let u = (x - m.centre[0]) / m.spread_m[0];
+                let v = (y - m.centre[1]) / m.spread_m[1];
+                m.height_m * (-(u * u) - v * v).exp()
+            })
+            .sum()
+    }
+}
+
 /// Eq. (4).
 #[derive(Debug, Clone, Deserialize)]
 pub struct Hazard {

@@ -29,6 +29,7 @@ mod figures;
 #[cfg(test)]
 mod fixtures;
 pub mod geometry;
+pub mod mobility;
 mod model;
 mod report;
 

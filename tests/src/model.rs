@@ -27,6 +27,12 @@ pub struct Scenario {
     /// Crawler cost settings.
     #[serde(default)]
     pub crawler: Option<crate::crawler::CrawlerSettings>,
+    /// Energy planner settings (seed 001).
+    #[serde(default)]
+    pub energy: Option<crate::mobility::EnergySection>,
+    /// Inspection tours (seed 003).
+    #[serde(default)]
+    pub inspection: Option<crate::mobility::InspectionSection>,
 }
 
 /// Axis-aligned box, metres.
@@ -175,6 +181,12 @@ pub struct PlanVehicle {
     /// Crawlers: reported seabed figures.
     #[serde(default)]
     pub crawler: Option<crate::crawler::PlanCrawler>,
+    /// Energy-planned AUVs: reported seed 001 figures.
+    #[serde(default)]
+    pub energy: Option<crate::mobility::PlanEnergy>,
+    /// Inspection tours: reported seed 003 figures.
+    #[serde(default)]
+    pub tour: Option<crate::mobility::PlanTour>,
 }
 
 /// Fleet figures in `plan.json`.

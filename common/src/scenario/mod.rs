@@ -10,9 +10,11 @@ use serde::{Deserialize, Serialize};
 
 use crate::geometry::Vec3;
 
+mod inspection;
 mod ocean;
 mod optimizer;
 mod seabed;
+pub use inspection::{FirstPointMode, InspectionSettings};
 pub use ocean::{CurrentModel, Currents, EnergySettings};
 pub use optimizer::{Algorithm, DistributedSettings, OptimizerSettings};
 pub use seabed::{CrawlerSettings, Seabed, SeabedGrid};
@@ -82,6 +84,9 @@ pub struct Scenario {
     /// Settings of the energy-saving planner (seed 001, Table 2).
     #[serde(default)]
     pub energy: EnergySettings,
+    /// Cage-inspection tours (seed 003); required by the tour planners.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub inspection: Option<InspectionSettings>,
 }
 
 /// Axis-aligned box of the navigation space, metres.
@@ -351,6 +356,16 @@ impl Scenario {
         self.validate_crawlers(&bad)?;
         self.energy.validate(self.currents.as_ref(), &bad)?;
         let algorithm = self.optimizer.algorithm;
+        if let Some(inspection) = &self.inspection {
+            inspection.validate(self, &bad)?;
+        }
+        if algorithm.is_tour_planner() && self.inspection.is_none() {
+            return Err(bad(
+                "optimizer.algorithm".into(),
+                format!("{:?}", algorithm.as_str()),
+                "plans inspection tours (seed 003): add an [inspection] table",
+            ));
+        }
         if algorithm.is_energy_planner() {
             if self.vehicles.len() != 1 {
                 return Err(bad(

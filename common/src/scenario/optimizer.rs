@@ -34,6 +34,12 @@ pub enum Algorithm {
     PsoLength,
     /// Seed 001's M-PSO: the same PSO on the full cost of eq. (6).
     MPso,
+    /// Seed 003's DE-PSO cage-inspection tours (eq. (14)–(20), Table 5).
+    DePso,
+    /// Seed 003's LDIW-PSO baseline (eq. (3)).
+    LdiwPso,
+    /// Seed 003's LCPSO baseline (eq. (4)–(10)).
+    Lcpso,
 }
 
 impl Algorithm {
@@ -52,10 +58,13 @@ impl Algorithm {
             Algorithm::EpaPso => "epa-pso",
             Algorithm::PsoLength => "pso-length",
             Algorithm::MPso => "m-pso",
+            Algorithm::DePso => "de-pso",
+            Algorithm::LdiwPso => "ldiw-pso",
+            Algorithm::Lcpso => "lcpso",
         }
     }
-    /// Every algorithm: seed 004 Table 5's order, then seed 000 Table 8's, then seed 001's.
-    pub const ALL: [Algorithm; 12] = [
+    /// Every algorithm: seed 004 Table 5's order, then seed 000 Table 8's, seed 001's, seed 003's.
+    pub const ALL: [Algorithm; 15] = [
         Algorithm::AmpPso,
         Algorithm::APso,
         Algorithm::MpPso,
@@ -68,6 +77,9 @@ impl Algorithm {
         Algorithm::EpaPso,
         Algorithm::PsoLength,
         Algorithm::MPso,
+        Algorithm::DePso,
+        Algorithm::LdiwPso,
+        Algorithm::Lcpso,
     ];
     /// True for seed 001's single-AUV energy planners, which plan on the energy cost rather
     /// than the fleet fitness.
@@ -75,6 +87,13 @@ impl Algorithm {
         matches!(
             self,
             Algorithm::EpaPso | Algorithm::PsoLength | Algorithm::MPso
+        )
+    }
+    /// True for seed 003's inspection-tour planners (the leg swarm is the algorithm).
+    pub fn is_tour_planner(self) -> bool {
+        matches!(
+            self,
+            Algorithm::DePso | Algorithm::LdiwPso | Algorithm::Lcpso
         )
     }
     /// True for the multi-population algorithms (the ones a distributed run can split).

@@ -13,6 +13,7 @@
 //! the straight tour and its rate). [`split_points`] shares the points among several AUVs.
 
 mod cages;
+mod figures;
 mod leg;
 mod order;
 mod split;
@@ -21,6 +22,7 @@ pub use cages::{
     cage_group_a, cage_group_b, inspection_points, paper_base, paper_bounds, Cage, FirstPoint,
     InspectionPoint, MONITOR_STANDOFF_M,
 };
+pub use figures::TourFigures;
 pub use leg::{
     feasible, intersections, path_length, safety_spheres, segment_hits, LegProblem, Sphere,
     CHORD_WEIGHT, HIT_PENALTY_M,

@@ -1,0 +1,199 @@
+//! AUVs in currents (seed 001, EPA-PSO) and cage-inspection tours (seed 003, DE-PSO) end to end:
+//! the real binary plans the shipped scenarios and every plan passes the independent checker,
+//! which recomputes the turning radius, pitch and seabed clearance of an energy plan and the
+//! inspection points of a tour from the trajectories.
+
+mod common;
+
+use common::{key, plan, plan_and_check, scenario, TestResult};
+use serde_json::Value;
+
+fn vehicle<'a>(json: &'a Value, k: usize) -> &'a Value {
+    &key(json, "vehicles")[k]
+}
+
+fn num(v: &Value, field: &str) -> f64 {
+    match v[field].as_f64() {
+        Some(x) => x,
+        None => panic!("{field} is not a number in {v}"),
+    }
+}
+
+#[test]
+fn epa_pso_saves_energy_and_keeps_the_mobility_limits() -> TestResult {
+    let short = ["--iterations", "40", "--seed", "2"];
+    let dir = tempfile::tempdir()?;
+    let epa = plan_and_check("epa-pso", dir.path(), &short)?;
+    assert_eq!(key(&epa, "feasible").as_bool(), Some(true));
+    let e = &vehicle(&epa, 0)["energy"];
+    // Turning radius and pitch limits kept on every point (seed 001 eq. (5)).
+    assert_eq!((num(e, "q_r"), num(e, "q_a")), (0.0, 0.0), "{e}");
+    assert!(num(e, "min_turn_radius_m") >= 8.0);
+    assert!(num(e, "max_pitch_deg") <= 20.0 && num(e, "min_pitch_deg") >= -20.0);
+    // A 72 m climb at ≤ 20° needs at least 72 / sin 20° = 210.5 m of path.
+    assert!(num(e, "q_path") > 210.5, "{e}");
+    // eq. (18) from the reported terms.
+    let f_f = (num(e, "q_path") + num(e, "q_e") + num(e, "q_r") + num(e, "q_a")) / 4.0;
+    assert!((num(e, "f_f") - f_f).abs() < 1e-6 * f_f);
+    let svg = std::fs::read_to_string(dir.path().join("plan.svg"))?;
+    assert!(svg.contains("current"), "no current-field view in the SVG");
+
+    // The length-only baseline flies the straight line: short, too steep, far more energy.
+    let dir = tempfile::tempdir()?;
+    let pso = plan_and_check(
+        "epa-pso",
+        dir.path(),
+        &[
+            "--algorithm",
+            "pso-length",
+            "--iterations",
+            "40",
+            "--seed",
+            "2",
+        ],
+    )?;
+    assert_eq!(key(&pso, "feasible").as_bool(), Some(false));
+    let p = &vehicle(&pso, 0)["energy"];
+    assert!(num(p, "q_a") > 0.0 && num(p, "q_path") < 95.0, "{p}");
+    assert!(
+        num(e, "q_e") < 0.4 * num(p, "q_e"),
+        "EPA-PSO q_e {} vs PSO {}",
+        num(e, "q_e"),
+        num(p, "q_e")
+    );
+    Ok(())
+}
+
+#[test]
+fn energy_planners_refuse_a_distributed_run_and_fleets() -> TestResult {
+    let dir = tempfile::tempdir()?;
+    // Without --in-process the coordinator would wait for agents: it refuses at once instead.
+    let mut cmd = std::process::Command::new(common::coordinator());
+    common::without_shoal_env(&mut cmd);
+    let out = cmd
+        .arg("plan")
+        .arg(scenario("epa-pso"))
+        .arg("--out")
+        .arg(dir.path())
+        .output()?;
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("add --in-process"), "{stderr}");
+    // A fleet scenario cannot take a single-AUV planner.
+    let r = plan(
+        &scenario("amp-pso-1"),
+        dir.path(),
+        &["--algorithm", "epa-pso"],
+    );
+    assert_ne!(r.code(), Some(0));
+    assert!(
+        r.stderr.contains("optimizer.algorithm") && r.stderr.contains("plans one AUV"),
+        "{r}"
+    );
+    Ok(())
+}
+
+#[test]
+fn de_pso_tours_inspect_every_cage_without_touching_one() -> TestResult {
+    for group in ["cages-a", "cages-b"] {
+        let dir = tempfile::tempdir()?;
+        let json = plan_and_check(
+            group,
+            dir.path(),
+            &["--iterations", "80", "--particles", "30", "--seed", "3"],
+        )?;
+        assert_eq!(key(&json, "feasible").as_bool(), Some(true), "{group}");
+        let t = &vehicle(&json, 0)["tour"];
+        let order = t["order"].as_array().map(Vec::len).unwrap_or(0);
+        assert_eq!(order, 10, "{group}: {t}");
+        assert_eq!(t["cage_intersections"].as_u64(), Some(0));
+        let growth = num(t, "growth_m");
+        assert!(growth >= 0.0 && num(t, "growth_rate") < 0.5, "{group}: {t}");
+        assert!((num(t, "tour_length_m") - num(t, "straight_tour_length_m") - growth).abs() < 1e-6);
+    }
+    Ok(())
+}
+
+#[test]
+fn a_fleet_shares_the_inspection_points_and_keeps_apart() -> TestResult {
+    let dir = tempfile::tempdir()?;
+    let json = plan_and_check(
+        "cages-fleet",
+        dir.path(),
+        &[
+            "--iterations",
+            "60",
+            "--particles",
+            "30",
+            "--algorithm",
+            "ldiw-pso",
+        ],
+    )?;
+    assert_eq!(key(&json, "feasible").as_bool(), Some(true));
+    let mut labels: Vec<String> = Vec::new();
+    let mut lengths = Vec::new();
+    for k in 0..2 {
+        let t = &vehicle(&json, k)["tour"];
+        lengths.push(num(t, "tour_length_m"));
+        for l in t["order"].as_array().into_iter().flatten() {
+            labels.push(l.as_str().unwrap_or("").to_string());
+        }
+    }
+    labels.sort();
+    let expected: Vec<String> = (1..=5)
+        .flat_map(|c| [format!("A{c}.1"), format!("A{c}.2")])
+        .collect();
+    assert_eq!(labels, expected);
+    // Balanced: neither tour is more than 1.5 times the other.
+    assert!(
+        lengths[0] < 1.5 * lengths[1] && lengths[1] < 1.5 * lengths[0],
+        "{lengths:?}"
+    );
+    let fleet = key(&json, "fleet");
+    assert!(fleet["min_separation_m"]
+        .as_f64()
+        .is_some_and(|d| d >= 20.0));
+    assert!(fleet["arrival_spread_s"].as_f64().is_some_and(|s| s <= 1.0));
+    Ok(())
+}
+
+#[test]
+fn the_checker_catches_tampered_energy_and_tour_plans() -> TestResult {
+    // An honest plan is clean; the same plan claiming a wider turn, or a tour whose named point
+    // is not on its trajectory, is not.
+    let dir = tempfile::tempdir()?;
+    let json = plan_and_check("epa-pso", dir.path(), &["--iterations", "10"])?;
+    let toml = std::fs::read_to_string(scenario("epa-pso"))?;
+    let mut lied = json.clone();
+    lied["vehicles"][0]["energy"]["min_turn_radius_m"] = Value::from(1000.0);
+    let report = shoal_tests::check(&toml, &lied.to_string())?;
+    assert!(
+        report
+            .mismatches
+            .iter()
+            .any(|m| m.contains("min_turn_radius_m")),
+        "{:?}",
+        report.mismatches
+    );
+
+    let dir = tempfile::tempdir()?;
+    let json = plan_and_check(
+        "cages-a",
+        dir.path(),
+        &["--iterations", "20", "--particles", "20"],
+    )?;
+    let toml = std::fs::read_to_string(scenario("cages-a"))?;
+    let mut moved = json.clone();
+    moved["vehicles"][0]["tour"]["points"][3] = serde_json::json!([1.0, 2.0, 3.0]);
+    let report = shoal_tests::check(&toml, &moved.to_string())?;
+    assert!(!report.is_clean());
+    assert!(
+        report
+            .failures
+            .iter()
+            .chain(&report.mismatches)
+            .any(|f| f.contains("does not pass inspection point")),
+        "{report:?}"
+    );
+    Ok(())
+}
