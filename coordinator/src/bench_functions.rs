@@ -16,7 +16,11 @@ use anyhow::{bail, Context};
 use shoal_common::benchfns::{self, Benchmark};
 use shoal_common::swarm::acopso::AcoPso;
 use shoal_common::swarm::cbpso::Cbpso;
+use shoal_common::swarm::depso::DePso;
+use shoal_common::swarm::epapso::EpaPso;
 use shoal_common::swarm::ipso::Ipso;
+use shoal_common::swarm::lcpso::Lcpso;
+use shoal_common::swarm::ldiwpso::LdiwPso;
 use shoal_common::swarm::multi::MultiPso;
 use shoal_common::swarm::nspso::Nspso;
 use shoal_common::swarm::pso::Pso;
@@ -32,6 +36,7 @@ pub struct BenchFunctionsArgs {
     #[arg(long, env = "SHOAL_RUNS", default_value_t = 50)]
     pub runs: usize,
     /// Algorithms, comma-separated (default: all): ipso, spso, cbpso, nspso, aco-pso, pso,
+    /// epa-pso, ldiw-pso, lcpso, de-pso,
     /// a-pso, mp-pso, amp-pso.
     #[arg(long, env = "SHOAL_ALGORITHMS", value_delimiter = ',')]
     pub algorithms: Vec<String>,
@@ -92,7 +97,8 @@ pub struct Algorithm {
     pub run: fn(&dyn Benchmark, RunSettings, u64) -> RunResult,
 }
 
-/// Every optimizer Shoal has, in table order (seed 000's five, then seed 004's four). A new
+/// Every optimizer Shoal has, in table order (seed 000's five, seed 004's four, seed 001's
+/// EPA-PSO, seed 003's three). A new
 /// solver is one line here.
 pub fn solvers() -> Vec<Algorithm> {
     let a = |name, about, run| Algorithm { name, about, run };
@@ -141,6 +147,26 @@ pub fn solvers() -> Vec<Algorithm> {
             "amp-pso",
             "seed 004 AMP-PSO: eq. (7)–(8), M split as below",
             |f, s, seed| run(f, s.iterations, split(MultiPso::amp(seed), s.particles)),
+        ),
+        a(
+            "epa-pso",
+            "seed 001 EPA-PSO, Table 2: velocity jump, eq. (16) schedule, eq. (17) restarts",
+            |f, s, seed| run(f, s.iterations, EpaPso::table2(s.particles, seed)),
+        ),
+        a(
+            "ldiw-pso",
+            "seed 003 LDIW-PSO, Table 5: ω 0.9 → 0.4, c1 = 2, c2 = 1.5",
+            |f, s, seed| run(f, s.iterations, LdiwPso::table5(s.particles, seed)),
+        ),
+        a(
+            "lcpso",
+            "seed 003 LCPSO, Table 5: logistic-chaos inertia (eq. 4–10)",
+            |f, s, seed| run(f, s.iterations, Lcpso::table5(s.particles, seed)),
+        ),
+        a(
+            "de-pso",
+            "seed 003 DE-PSO, Table 5: PSO move + DE/best/1/bin (F = 0.8, CR = 0.6); 2 evaluations per particle per iteration",
+            |f, s, seed| run(f, s.iterations, DePso::table5(s.particles, seed)),
         ),
     ]
 }
