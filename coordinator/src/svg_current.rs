@@ -23,12 +23,9 @@ pub fn caption(scenario: &Scenario, top: bool) -> Option<String> {
         .velocity(&Vec3::new(b.min[0], b.min[1], b.max[2]))
         .norm();
     Some(if top {
-        format!(
-            ", current at z = {:.0} m (arrows; {surface:.2} m/s at the surface)",
-            sample_z(scenario)
-        )
+        format!(", current at z = {:.0} m", sample_z(scenario))
     } else {
-        format!(", current (arrows; {surface:.2} m/s at the surface)")
+        format!(", current ({surface:.2} m/s at the surface)")
     })
 }
 

@@ -1,6 +1,7 @@
 //! The seabed under the top view of `plan.svg` (crawler scenarios, seed 000): a shaded map of
-//! the terrain's elevation (light = low, dark = high), 1 m contour lines drawn as cell edges
-//! where the elevation crosses a whole metre, and the hazard cylinders (eq. (4)) as hatched
+//! the terrain's elevation (light = low, dark = high), contour ticks on cell edges where the
+//! elevation crosses a multiple of the contour interval (1 m on a gentle seabed, see
+//! [`contour_step`]), and the hazard cylinders (eq. (4)) as hatched
 //! discs with their ids.
 
 use plotters::prelude::*;
@@ -52,6 +53,8 @@ pub fn draw_seabed(
             (a.min(*v), b.max(*v))
         });
     let span = (hi - lo).max(1e-9);
+    let step = contour_step(span);
+    let level = |v: f64| (v / step).floor();
     let (dx, dy) = ((x1 - x0) / CELLS as f64, (y1 - y0) / CELLS as f64);
     let mut cells = Vec::with_capacity(CELLS * CELLS);
     let mut contours = Vec::new();
@@ -65,7 +68,7 @@ pub fn draw_seabed(
             ));
             // A contour crosses the cell's bottom or left edge where the floor of the
             // elevation changes between its ends: mark that edge.
-            if z[j][i].floor() != z[j][i + 1].floor() {
+            if level(z[j][i]) != level(z[j][i + 1]) {
                 contours.push(PathElement::new(
                     vec![
                         (cx + 0.5 * dx, cy - 0.2 * dy),
@@ -74,7 +77,7 @@ pub fn draw_seabed(
                     RGBColor(90, 60, 30).stroke_width(1),
                 ));
             }
-            if z[j][i].floor() != z[j + 1][i].floor() {
+            if level(z[j][i]) != level(z[j + 1][i]) {
                 contours.push(PathElement::new(
                     vec![
                         (cx - 0.2 * dx, cy + 0.5 * dy),
@@ -118,9 +121,33 @@ pub fn draw_seabed(
     Ok(Some((lo, hi)))
 }
 
+/// Contour interval for an elevation span: 1 m, or the smallest 1-2-5 step that keeps about a
+/// dozen contours (a 55 m hill at 1 m would hatch the whole map).
+pub fn contour_step(span: f64) -> f64 {
+    let target = span / 12.0;
+    let mut step = 1.0;
+    for k in 0..12 {
+        for m in [1.0, 2.0, 5.0] {
+            step = m * 10f64.powi(k);
+            if step >= target {
+                return step;
+            }
+        }
+    }
+    step
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn contour_step_keeps_about_a_dozen_contours() {
+        assert_eq!(contour_step(6.0), 1.0);
+        assert_eq!(contour_step(20.0), 2.0);
+        assert_eq!(contour_step(55.0), 5.0);
+        assert_eq!(contour_step(130.0), 20.0);
+    }
 
     #[test]
     fn shade_runs_from_sand_to_brown_and_clamps() {

@@ -8,7 +8,7 @@ mod common;
 use common::{key, plan, plan_and_check, scenario, TestResult};
 use serde_json::Value;
 
-fn vehicle<'a>(json: &'a Value, k: usize) -> &'a Value {
+fn vehicle(json: &Value, k: usize) -> &Value {
     &key(json, "vehicles")[k]
 }
 
