@@ -288,3 +288,44 @@ pub fn plan(
         distributed: None,
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn at(cage: usize, x: f64, y: f64) -> InspectionPoint {
+        InspectionPoint {
+            cage,
+            position: Vec3::new(x, y, 0.0),
+        }
+    }
+
+    #[test]
+    fn shares_go_to_the_nearer_base_and_cover_every_point_once() {
+        // Two clusters, one by each base: each vehicle gets the cluster at its own base whatever
+        // order the split returns them in.
+        let points = [
+            at(0, 10.0, 0.0),
+            at(0, 12.0, 2.0),
+            at(1, 990.0, 0.0),
+            at(1, 988.0, 2.0),
+        ];
+        let bases = [Vec3::new(1000.0, 0.0, 0.0), Vec3::new(0.0, 0.0, 0.0)];
+        let s = shares(&points, &bases);
+        assert_eq!(s.len(), 2);
+        let mut first = s[0].clone();
+        first.sort();
+        let mut second = s[1].clone();
+        second.sort();
+        assert_eq!((first, second), (vec![2, 3], vec![0, 1]));
+        // One vehicle takes everything.
+        assert_eq!(shares(&points, &bases[..1]), vec![vec![0, 1, 2, 3]]);
+    }
+
+    #[test]
+    fn only_tour_algorithms_have_a_leg_swarm() {
+        assert_eq!(leg_algorithm(Algorithm::DePso), Some(LegAlgorithm::DePso));
+        assert_eq!(leg_algorithm(Algorithm::Lcpso), Some(LegAlgorithm::Lcpso));
+        assert_eq!(leg_algorithm(Algorithm::AmpPso), None);
+    }
+}
