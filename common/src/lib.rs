@@ -4,8 +4,10 @@
 pub mod benchfns;
 pub mod bspline;
 pub mod cost;
+pub mod coverage;
 pub mod crawler;
 pub mod current;
+pub mod current_grid;
 pub mod distributed;
 pub mod energy;
 #[cfg(test)]

@@ -46,28 +46,67 @@ fn shipped_scenarios_load() {
 
 #[test]
 fn bad_energy_and_current_values_name_the_field() {
-    let e = refused("epa-pso", "min_turn_radius_m = 8.0", "min_turn_radius_m = -1.0");
-    assert!(e.contains("epa-pso.toml") && e.contains("energy.min_turn_radius_m") && e.contains("-1"), "{e}");
+    let e = refused(
+        "epa-pso",
+        "min_turn_radius_m = 8.0",
+        "min_turn_radius_m = -1.0",
+    );
+    assert!(
+        e.contains("epa-pso.toml") && e.contains("energy.min_turn_radius_m") && e.contains("-1"),
+        "{e}"
+    );
     let e = refused("epa-pso", "path_points = 500", "path_points = 1");
     assert!(e.contains("energy.path_points") && e.contains("= 1"), "{e}");
-    let e = refused("epa-pso", "surface_velocity_mps = [-1.0, -1.0]", "surface_velocity_mps = [nan, -1.0]");
+    let e = refused(
+        "epa-pso",
+        "surface_velocity_mps = [-1.0, -1.0]",
+        "surface_velocity_mps = [nan, -1.0]",
+    );
     assert!(e.contains("currents.surface_velocity_mps"), "{e}");
     let e = refused("epa-pso", "mu = 0.5", "mu = 0.5\nspeed = 3");
     assert!(e.contains("speed"), "{e}");
     // A fleet cannot take a single-AUV planner.
-    let e = refused("cages-fleet", "algorithm = \"de-pso\"", "algorithm = \"epa-pso\"");
-    assert!(e.contains("optimizer.algorithm") && e.contains("2 vehicles"), "{e}");
+    let e = refused(
+        "cages-fleet",
+        "algorithm = \"de-pso\"",
+        "algorithm = \"epa-pso\"",
+    );
+    assert!(
+        e.contains("optimizer.algorithm") && e.contains("2 vehicles"),
+        "{e}"
+    );
 }
 
 #[test]
 fn bad_inspection_values_name_the_field() {
     let e = refused("cages-a", "standoff_m = 5.0", "standoff_m = 0.5");
-    assert!(e.contains("inspection.standoff_m") && e.contains("0.5") && e.contains("inflation_m"), "{e}");
-    let e = refused("cages-a", "standoff_m = 5.0", "standoff_m = 5.0\ncages = [\"Z9\"]");
+    assert!(
+        e.contains("inspection.standoff_m") && e.contains("0.5") && e.contains("inflation_m"),
+        "{e}"
+    );
+    let e = refused(
+        "cages-a",
+        "standoff_m = 5.0",
+        "standoff_m = 5.0\ncages = [\"Z9\"]",
+    );
     assert!(e.contains("inspection.cages[0]") && e.contains("Z9"), "{e}");
-    let e = refused("cages-a", "goal = [0.0, 0.0, 0.0]", "goal = [10.0, 0.0, 0.0]");
-    assert!(e.contains("vehicles[0].goal") && e.contains("returns to its base"), "{e}");
+    let e = refused(
+        "cages-a",
+        "goal = [0.0, 0.0, 0.0]",
+        "goal = [10.0, 0.0, 0.0]",
+    );
+    assert!(
+        e.contains("vehicles[0].goal") && e.contains("returns to its base"),
+        "{e}"
+    );
     // A tour algorithm needs the [inspection] table.
-    let e = refused("epa-pso", "algorithm = \"epa-pso\"", "algorithm = \"de-pso\"");
-    assert!(e.contains("optimizer.algorithm") && e.contains("[inspection]"), "{e}");
+    let e = refused(
+        "epa-pso",
+        "algorithm = \"epa-pso\"",
+        "algorithm = \"de-pso\"",
+    );
+    assert!(
+        e.contains("optimizer.algorithm") && e.contains("[inspection]"),
+        "{e}"
+    );
 }

@@ -1,7 +1,7 @@
 //! The current field in `plan.svg` (seed 001 eq. (2)): arrows on a grid over the top and side
 //! views, pointing where the water flows and as long as it is fast. The top view samples the
-//! field at the mean depth of the vehicles' starts and goals (the field is horizontal and varies
-//! with depth only in the analytic model, which the side view shows).
+//! field at the mean depth of the vehicles' starts and goals, the side view on the box's middle
+//! y (the analytic model varies with depth only; a gridded field anywhere).
 
 use plotters::prelude::*;
 use shoal_common::geometry::Vec3;

@@ -218,6 +218,15 @@ impl Scenario {
             let area = [b.min[0], b.min[1], b.max[0], b.max[1]];
             seabed.resolve(area, dir, file, &bad)?;
         }
+        if let Some(currents) = &mut scenario.currents {
+            let bad = |field: String, value: String, reason: &str| ScenarioError::Invalid {
+                file: file.to_path_buf(),
+                field,
+                value,
+                reason: reason.to_string(),
+            };
+            currents.resolve(file.parent().unwrap_or(Path::new(".")), file, &bad)?;
+        }
         Ok(scenario)
     }
 

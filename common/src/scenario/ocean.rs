@@ -1,13 +1,17 @@
 //! The `[currents]` and `[energy]` tables: the water an AUV flies through and the constants of
 //! seed 001's energy-saving planner.
 
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use serde::{Deserialize, Serialize};
 
 use super::ScenarioError;
-use crate::current::{CurrentField, DepthDecayCurrent};
+use crate::current::{CurrentField, DepthDecayCurrent, StillWater};
+use crate::current_grid::GridCurrent;
 use crate::energy::Weights;
+
+type Bad<'a> = &'a dyn Fn(String, String, &str) -> ScenarioError;
 
 /// Which current model a scenario uses.
 #[derive(Debug, Clone, Copy, Serialize, Deserialize, PartialEq, Eq, Default)]
@@ -16,29 +20,145 @@ pub enum CurrentModel {
     /// Seed 001 eq. (2): horizontal, strongest at the surface, zero at the map's greatest depth.
     #[default]
     DepthDecay,
+    /// A gridded field (a forecast or a survey) read from `file`, interpolated trilinearly and
+    /// clamped to the grid's box outside it; the format is in [`crate::current_grid`].
+    Grid,
 }
 
 /// `[currents]`: the current field.
+///
+/// ```toml
+/// [currents]
+/// model = "depth-decay"                # seed 001 eq. (2)
+/// surface_velocity_mps = [-1.0, -1.0]
+/// ```
+///
+/// or
+///
+/// ```toml
+/// [currents]
+/// model = "grid"
+/// file = "currents.csv"                # x,y,z,u,v,w; relative to the scenario file
+/// ```
 #[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct Currents {
-    /// The model (only `depth-decay` so far; a forecast grid would be a second variant).
+    /// The model (default `depth-decay`).
     #[serde(default)]
     pub model: CurrentModel,
-    /// `(u, v)` at the surface, m/s (seed 001 eq. (2): −1.0 each).
-    pub surface_velocity_mps: [f64; 2],
+    /// `depth-decay` only (and required there): `(u, v)` at the surface, m/s (seed 001 eq. (2):
+    /// −1.0 each).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub surface_velocity_mps: Option<[f64; 2]>,
+    /// `grid` only (and required there): the CSV file of the field. A relative path is taken
+    /// from the scenario file's directory, and is stored absolute once loaded, so agents on the
+    /// same file system find it too.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub file: Option<PathBuf>,
+    /// The grid read from `file` when the scenario was loaded ([`Currents::resolve`]); equal
+    /// grids compare equal.
+    #[serde(skip)]
+    pub grid: Option<Arc<GridCurrent>>,
 }
 
 impl Currents {
-    /// The field over a scenario box whose top is the surface and whose floor is ζ_bd.
+    /// The field over a scenario box whose top is the surface and whose floor is ζ_bd (the
+    /// bounds are only used by `depth-decay`; a grid carries its own positions).
+    ///
+    /// A `grid` that was never loaded (a scenario deserialised without [`Currents::resolve`])
+    /// gives still water, with a warning; [`super::Scenario::load`] and
+    /// [`super::Scenario::parse`] always load it.
     pub fn field(&self, bounds_min_z: f64, bounds_max_z: f64) -> Arc<dyn CurrentField> {
         match self.model {
             CurrentModel::DepthDecay => Arc::new(DepthDecayCurrent {
-                surface_mps: self.surface_velocity_mps,
+                surface_mps: self.surface_velocity_mps.unwrap_or([0.0, 0.0]),
                 surface_z: bounds_max_z,
                 max_depth_m: bounds_max_z - bounds_min_z,
             }),
+            CurrentModel::Grid => match &self.grid {
+                Some(grid) => grid.clone(),
+                None => {
+                    tracing::warn!(
+                        "the current grid {:?} was not loaded: planning in still water",
+                        self.file
+                    );
+                    Arc::new(StillWater)
+                }
+            },
         }
+    }
+
+    /// Checks that the keys fit the model and the values are usable.
+    pub fn validate(&self, bad: Bad) -> Result<(), ScenarioError> {
+        let missing = || "(missing)".to_string();
+        match self.model {
+            CurrentModel::DepthDecay => {
+                if let Some(file) = &self.file {
+                    return Err(bad(
+                        "currents.file".into(),
+                        format!("{:?}", file.display().to_string()),
+                        "belongs to model = \"grid\"; the depth-decay model takes surface_velocity_mps",
+                    ));
+                }
+                let Some(surface) = self.surface_velocity_mps else {
+                    return Err(bad(
+                        "currents.surface_velocity_mps".into(),
+                        missing(),
+                        "model = \"depth-decay\" needs the surface current [u, v] in m/s",
+                    ));
+                };
+                if !surface.iter().all(|v| v.is_finite()) {
+                    return Err(bad(
+                        "currents.surface_velocity_mps".into(),
+                        format!("{surface:?}"),
+                        "must be finite m/s",
+                    ));
+                }
+            }
+            CurrentModel::Grid => {
+                if let Some(surface) = self.surface_velocity_mps {
+                    return Err(bad(
+                        "currents.surface_velocity_mps".into(),
+                        format!("{surface:?}"),
+                        "belongs to model = \"depth-decay\"; a grid gives the velocity at its nodes",
+                    ));
+                }
+                if self.file.is_none() {
+                    return Err(bad(
+                        "currents.file".into(),
+                        missing(),
+                        "model = \"grid\" needs the CSV file of the field (header x,y,z,u,v,w)",
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Loads the grid of a `grid` model: a relative `file` is made absolute against `dir` (the
+    /// scenario file's directory) and read; its errors are reported against field
+    /// `currents.file` of the scenario `file`. Does nothing for `depth-decay`.
+    /// (`_file` is named by `bad` already; it is kept for symmetry with `Seabed::resolve`.)
+    pub fn resolve(&mut self, dir: &Path, _file: &Path, bad: Bad) -> Result<(), ScenarioError> {
+        self.grid = None;
+        if self.model != CurrentModel::Grid {
+            return Ok(());
+        }
+        let Some(path) = &mut self.file else {
+            return Err(bad(
+                "currents.file".into(),
+                "(missing)".into(),
+                "model = \"grid\" needs the CSV file of the field (header x,y,z,u,v,w)",
+            ));
+        };
+        let written = format!("{:?}", path.display().to_string());
+        if !path.is_absolute() {
+            *path = dir.join(&*path);
+        }
+        let grid = GridCurrent::load(path)
+            .map_err(|e| bad("currents.file".into(), written, &e.to_string()))?;
+        self.grid = Some(Arc::new(grid));
+        Ok(())
     }
 }
 
@@ -153,13 +273,7 @@ impl EnergySettings {
             }
         }
         if let Some(c) = currents {
-            if !c.surface_velocity_mps.iter().all(|v| v.is_finite()) {
-                return Err(bad(
-                    "currents.surface_velocity_mps".into(),
-                    format!("{:?}", c.surface_velocity_mps),
-                    "must be finite m/s",
-                ));
-            }
+            c.validate(bad)?;
         }
         Ok(())
     }

@@ -1,0 +1,29 @@
+//! Coverage path planning for deep-sea mining crawlers (seed 002): the first slice, the 2.5D
+//! terrain map of §2.1.
+//!
+//! Seed 002 plans in three layers: (1) perception and pre-processing, which turns the 3D seabed
+//! into 2.5D kinematic constraints; (2) a Boustrophedon state machine (Straight / Detour / U-turn)
+//! with virtual boundaries and analytic arc smoothing, rows `2·R_min` apart; (3) closed-loop
+//! tracking (terrain-adaptive EKF and variable-weight MPC) under terrain disturbances. This module
+//! holds layer 1:
+//!
+//! - [`spec`]: the seeded synthetic seabed (Perlin undulation + Gaussian seamounts and trenches,
+//!   §2.1 and §3) and the crawler's [`TraversalLimits`] (critical slope, width);
+//! - [`perlin`]: Ken Perlin's improved gradient noise with a seeded permutation;
+//! - [`edt`]: the exact Euclidean distance transform used for the disc dilation and clearances;
+//! - [`terrain25`]: [`TerrainMap25`], slope → impassable → no-go, with clearance queries and the
+//!   undulation kept separately for the tracking layer.
+//!
+//! Frame: x east, y north, z up, metres, as in [`crate::terrain`].
+
+pub mod edt;
+pub mod perlin;
+pub mod spec;
+pub mod terrain25;
+
+pub use perlin::{FractalNoise, Perlin};
+pub use spec::{
+    GaussianPeak, GaussianPit, RandomGaussians, SyntheticSeabed, TerrainSpec, TraversalLimits,
+    UndulationSpec,
+};
+pub use terrain25::{slope_field_deg, Terrain25Error, TerrainMap25, MAX_CELLS};

@@ -1,0 +1,792 @@
+//! A gridded ocean current read from a file (a forecast or a measured field), interpolated
+//! trilinearly; errors name the file, the line and the offending text.
+//!
+//! # File format
+//!
+//! CSV, one line per grid node, with the header `x,y,z,u,v,w`:
+//!
+//! ```text
+//! # Tidal current over the survey box; x east, y north, z up (metres), u v w in m/s.
+//! x,y,z,u,v,w
+//! 0,0,-50,0.10,-0.20,0.0
+//! 100,0,-50,0.12,-0.21,0.0
+//! 0,100,-50,0.09,-0.18,0.0
+//! 100,100,-50,0.11,-0.19,0.0
+//! 0,0,0,0.30,-0.50,0.0
+//! 100,0,0,0.32,-0.52,0.0
+//! 0,100,0,0.28,-0.47,0.0
+//! 100,100,0,0.31,-0.49,0.0
+//! ```
+//!
+//! - `x`, `y`, `z`: position of the node in the scenario's frame, metres (x east, y north, z up,
+//!   the same frame as `[bounds]`); `u`, `v`, `w`: the water velocity there, m/s, east, north and
+//!   up.
+//! - The header is matched case-insensitively, spaces around the names are allowed. Blank lines
+//!   and `#` comments (whole lines or the end of a line) are skipped; a leading UTF-8 byte-order
+//!   mark is ignored.
+//! - The nodes form a regular lattice: the distinct x values (and likewise y and z) must be evenly
+//!   spaced (every step within 1e-6 of the mean step, relatively), and every combination of an x,
+//!   a y and a z value must have exactly one line. The lines may come in any order.
+//! - An axis may have a single value: the field is then constant along it (a single z plane is
+//!   a depth-independent current, a single x and y a vertical profile, a single node a uniform
+//!   current).
+//! - Every value must be a finite number.
+//!
+//! Inside the lattice the velocity is interpolated trilinearly. **Outside it the position is
+//! clamped to the nearest point of the lattice's box**, so the current beyond a face is the current
+//! on that face (no extrapolation, and no still water either). A non-finite position gives NaN.
+
+use std::fmt;
+use std::path::{Path, PathBuf};
+
+use crate::current::CurrentField;
+use crate::geometry::Vec3;
+
+/// The header a current grid file must start with.
+pub const HEADER: &str = "x,y,z,u,v,w";
+
+/// Column names, in file order.
+const COLUMNS: [&str; 6] = ["x", "y", "z", "u", "v", "w"];
+
+/// Relative tolerance on the spacing of the lattice along each axis.
+pub const SPACING_TOLERANCE: f64 = 1e-6;
+
+/// Why a current grid could not be read. Every variant but [`CurrentGridError::Io`] names the
+/// file and a 1-based line.
+#[derive(Debug, thiserror::Error)]
+pub enum CurrentGridError {
+    /// The file could not be read.
+    #[error("{}: cannot read: {source}", file.display())]
+    Io {
+        file: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    /// The first line that is not blank or a comment is not `x,y,z,u,v,w` (`found` is empty when
+    /// the file has no such line).
+    #[error("{}:{line}: expected the header `{HEADER}`, found {}", file.display(), quoted(found))]
+    Header {
+        file: PathBuf,
+        line: usize,
+        found: String,
+    },
+    /// A data line without exactly six values.
+    #[error("{}:{line}: expected 6 values ({HEADER}), found {found} in `{text}`", file.display())]
+    FieldCount {
+        file: PathBuf,
+        line: usize,
+        found: usize,
+        text: String,
+    },
+    /// A value that does not parse as a number.
+    #[error("{}:{line}: column `{column}`: {} is not a number", file.display(), quoted(text))]
+    NotANumber {
+        file: PathBuf,
+        line: usize,
+        column: &'static str,
+        text: String,
+    },
+    /// A number that is infinite or NaN.
+    #[error("{}:{line}: column `{column}`: `{text}` is not a finite number", file.display())]
+    NonFinite {
+        file: PathBuf,
+        line: usize,
+        column: &'static str,
+        text: String,
+    },
+    /// A header and no data line: the grid needs at least one node (`line` is the last line).
+    #[error("{}:{line}: no data lines after the header: the grid needs at least one node", file.display())]
+    NoNodes { file: PathBuf, line: usize },
+    /// The distinct values of one coordinate are not evenly spaced; `value` is the one blamed
+    /// (the value on fewest lines, a likely typo, else the end of the first uneven step) and
+    /// `line` the first line where it appears.
+    #[error(
+        "{}:{line}: {axis} = {value} breaks the even spacing of the {axis} values ({values}): \
+         steps range from {min_step} to {max_step}, they must agree within {SPACING_TOLERANCE:e} \
+         relative",
+        file.display()
+    )]
+    Spacing {
+        file: PathBuf,
+        line: usize,
+        axis: &'static str,
+        value: f64,
+        /// The distinct values around `value`, for the message.
+        values: String,
+        min_step: f64,
+        max_step: f64,
+    },
+    /// Two lines for the same node; `line` is the later one.
+    #[error(
+        "{}:{line}: node x = {}, y = {}, z = {} is given twice (first at line {first_line})",
+        file.display(), node[0], node[1], node[2]
+    )]
+    Duplicate {
+        file: PathBuf,
+        line: usize,
+        node: [f64; 3],
+        first_line: usize,
+    },
+    /// A combination of the x, y and z values with no line; `line` is the last line of the file.
+    #[error(
+        "{}:{line}: no line for node x = {}, y = {}, z = {} of the {} × {} × {} lattice spanned \
+         by the x, y and z values ({rows} data lines for {} nodes)",
+        file.display(), node[0], node[1], node[2], lattice[0], lattice[1], lattice[2],
+        node_count(lattice)
+    )]
+    Missing {
+        file: PathBuf,
+        line: usize,
+        node: [f64; 3],
+        /// Distinct values along x, y and z.
+        lattice: [usize; 3],
+        /// Data lines in the file.
+        rows: usize,
+    },
+}
+
+/// `text` in backticks, or a word when it is empty.
+fn quoted(text: &str) -> String {
+    if text.is_empty() {
+        "nothing (empty)".to_string()
+    } else {
+        format!("`{text}`")
+    }
+}
+
+/// `nx·ny·nz` for messages, without overflowing.
+fn node_count(lattice: &[usize; 3]) -> String {
+    lattice
+        .iter()
+        .try_fold(1u128, |n, &k| n.checked_mul(k as u128))
+        .map_or_else(|| "too many".to_string(), |n| n.to_string())
+}
+
+/// One axis of the lattice: `count` values `first + i·step`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Axis {
+    /// Smallest value, metres.
+    pub first: f64,
+    /// Spacing, metres (0 when the axis has a single value).
+    pub step: f64,
+    /// Number of distinct values (≥ 1).
+    pub count: usize,
+}
+
+impl Axis {
+    /// Largest value, metres.
+    pub fn last(&self) -> f64 {
+        self.first + self.step * self.count.saturating_sub(1) as f64
+    }
+
+    /// Lower and upper node index around `coord` and the fraction between them, clamped to the
+    /// axis; a single-valued axis always gives node 0.
+    fn locate(&self, coord: f64) -> (usize, usize, f64) {
+        if self.count < 2 {
+            return (0, 0, 0.0);
+        }
+        let max = (self.count - 1) as f64;
+        let f = ((coord - self.first) / self.step).clamp(0.0, max);
+        // NaN casts to 0; the NaN fraction then makes the result NaN.
+        let i = (f.floor() as usize).min(self.count - 2);
+        (i, i + 1, f - i as f64)
+    }
+}
+
+/// A current field given on a regular 3-D lattice, trilinearly interpolated and clamped to the
+/// lattice's box outside it (see the [module documentation](self) for the file format).
+#[derive(Clone, PartialEq)]
+pub struct GridCurrent {
+    /// The file it was read from (for messages).
+    file: PathBuf,
+    /// x, y and z axes.
+    axes: [Axis; 3],
+    /// Velocity of node `(i, j, k)` at `i + nx·(j + ny·k)`; always `nx·ny·nz` long.
+    values: Vec<Vec3>,
+}
+
+impl fmt::Debug for GridCurrent {
+    /// A summary: the node values of a forecast would swamp a scenario's debug output.
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("GridCurrent")
+            .field("file", &self.file)
+            .field("axes", &self.axes)
+            .field("nodes", &self.values.len())
+            .finish()
+    }
+}
+
+/// One data line: its number, position and velocity.
+struct Row {
+    line: usize,
+    xyz: [f64; 3],
+    uvw: [f64; 3],
+}
+
+/// Index of `v` in the sorted distinct values `values` (`-0.0` matches `0.0`).
+fn index_of(values: &[f64], v: f64) -> Option<usize> {
+    let i = values.partition_point(|w| *w < v);
+    (values.get(i) == Some(&v)).then_some(i)
+}
+
+impl GridCurrent {
+    /// Reads a current grid file (see the [module documentation](self) for the format).
+    pub fn load(path: &Path) -> Result<GridCurrent, CurrentGridError> {
+        let text = std::fs::read_to_string(path).map_err(|source| CurrentGridError::Io {
+            file: path.to_path_buf(),
+            source,
+        })?;
+        GridCurrent::from_csv(&text, path)
+    }
+
+    /// Parses the text of a current grid file; `file` names it in errors.
+    pub fn from_csv(text: &str, file: &Path) -> Result<GridCurrent, CurrentGridError> {
+        let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+        let rows = parse_rows(text, file)?;
+        let last_line = text.lines().count().max(1);
+        if rows.is_empty() {
+            return Err(CurrentGridError::NoNodes {
+                file: file.to_path_buf(),
+                line: last_line,
+            });
+        }
+        // Distinct sorted values per axis, then their spacing.
+        let mut distinct: [Vec<f64>; 3] = Default::default();
+        for (a, values) in distinct.iter_mut().enumerate() {
+            values.extend(rows.iter().map(|r| r.xyz[a]));
+            values.sort_by(f64::total_cmp);
+            values.dedup();
+        }
+        let mut axes = [Axis {
+            first: 0.0,
+            step: 0.0,
+            count: 1,
+        }; 3];
+        for (a, (axis, values)) in axes.iter_mut().zip(&distinct).enumerate() {
+            *axis = check_spacing(values, a, &rows, file)?;
+        }
+        // Node index of every line; sorting them puts duplicates side by side and shows gaps.
+        let mut keys: Vec<([usize; 3], usize, usize)> = Vec::with_capacity(rows.len());
+        for (r, row) in rows.iter().enumerate() {
+            let mut key = [0; 3];
+            // z, y, x: the order the values are stored in.
+            for (slot, a) in [2, 1, 0].into_iter().enumerate() {
+                // Every value is in `distinct`, so this never falls back.
+                key[slot] = index_of(&distinct[a], row.xyz[a]).unwrap_or(0);
+            }
+            keys.push((key, row.line, r));
+        }
+        keys.sort_unstable();
+        let lattice = [axes[0].count, axes[1].count, axes[2].count];
+        let node_at = |key: [usize; 3]| {
+            let coord = |a: usize, i: usize| distinct[a].get(i).copied().unwrap_or(f64::NAN);
+            [coord(0, key[2]), coord(1, key[1]), coord(2, key[0])]
+        };
+        let mut duplicate: Option<(usize, usize, [usize; 3])> = None;
+        let mut missing: Option<[usize; 3]> = None;
+        let mut expected = Some([0usize; 3]);
+        let mut run_start_line = 0;
+        for (k, &(key, line, _)) in keys.iter().enumerate() {
+            if k > 0 && keys.get(k - 1).map(|p| p.0) == Some(key) {
+                if duplicate.is_none_or(|(l, _, _)| line < l) {
+                    duplicate = Some((line, run_start_line, key));
+                }
+                continue;
+            }
+            run_start_line = line;
+            if missing.is_none() && expected != Some(key) {
+                missing = expected;
+            }
+            expected = next_key(key, lattice);
+        }
+        if let Some((line, first_line, key)) = duplicate {
+            return Err(CurrentGridError::Duplicate {
+                file: file.to_path_buf(),
+                line,
+                node: node_at(key),
+                first_line,
+            });
+        }
+        if let Some(key) = missing.or(expected) {
+            return Err(CurrentGridError::Missing {
+                file: file.to_path_buf(),
+                line: last_line,
+                node: node_at(key),
+                lattice,
+                rows: rows.len(),
+            });
+        }
+        // No duplicate and no gap: the lines are exactly the nodes, in storage order.
+        let values = keys
+            .iter()
+            .filter_map(|&(_, _, r)| rows.get(r))
+            .map(|row| Vec3::from(row.uvw))
+            .collect();
+        Ok(GridCurrent {
+            file: file.to_path_buf(),
+            axes,
+            values,
+        })
+    }
+
+    /// The file the grid was read from.
+    pub fn file(&self) -> &Path {
+        &self.file
+    }
+
+    /// The x, y and z axes of the lattice.
+    pub fn axes(&self) -> &[Axis; 3] {
+        &self.axes
+    }
+
+    /// Smallest and largest corner of the lattice's box, metres.
+    pub fn extent(&self) -> ([f64; 3], [f64; 3]) {
+        let [x, y, z] = self.axes;
+        ([x.first, y.first, z.first], [x.last(), y.last(), z.last()])
+    }
+
+    /// Velocity at node `(i, j, k)` (the i-th x value, j-th y value, k-th z value), if it exists.
+    pub fn node(&self, i: usize, j: usize, k: usize) -> Option<Vec3> {
+        let [x, y, _] = self.axes;
+        if i >= x.count || j >= y.count {
+            return None;
+        }
+        let index = k.checked_mul(y.count)?.checked_add(j)?;
+        let index = index.checked_mul(x.count)?.checked_add(i)?;
+        self.values.get(index).copied()
+    }
+}
+
+impl CurrentField for GridCurrent {
+    /// Trilinear interpolation between the eight nodes around `p`; outside the lattice, the
+    /// value at the nearest point of its box.
+    fn velocity(&self, p: &Vec3) -> Vec3 {
+        let (i0, i1, tx) = self.axes[0].locate(p.x);
+        let (j0, j1, ty) = self.axes[1].locate(p.y);
+        let (k0, k1, tz) = self.axes[2].locate(p.z);
+        let at = |i, j, k| self.node(i, j, k).unwrap_or_else(|| Vec3::repeat(f64::NAN));
+        // This form cannot overflow between two finite values.
+        let lerp = |a: Vec3, b: Vec3, t: f64| a * (1.0 - t) + b * t;
+        let plane = |k| {
+            let south = lerp(at(i0, j0, k), at(i1, j0, k), tx);
+            let north = lerp(at(i0, j1, k), at(i1, j1, k), tx);
+            lerp(south, north, ty)
+        };
+        lerp(plane(k0), plane(k1), tz)
+    }
+}
+
+/// Reads the header and the data lines.
+fn parse_rows(text: &str, file: &Path) -> Result<Vec<Row>, CurrentGridError> {
+    let mut header_seen = false;
+    let mut rows = Vec::new();
+    for (index, raw) in text.lines().enumerate() {
+        let line = index + 1;
+        let content = raw.split('#').next().unwrap_or("").trim();
+        if content.is_empty() {
+            continue;
+        }
+        let fields: Vec<&str> = content.split(',').map(str::trim).collect();
+        if !header_seen {
+            let is_header = fields.len() == COLUMNS.len()
+                && fields
+                    .iter()
+                    .zip(COLUMNS)
+                    .all(|(f, c)| f.eq_ignore_ascii_case(c));
+            if !is_header {
+                return Err(CurrentGridError::Header {
+                    file: file.to_path_buf(),
+                    line,
+                    found: content.to_string(),
+                });
+            }
+            header_seen = true;
+            continue;
+        }
+        if fields.len() != COLUMNS.len() {
+            return Err(CurrentGridError::FieldCount {
+                file: file.to_path_buf(),
+                line,
+                found: fields.len(),
+                text: content.to_string(),
+            });
+        }
+        let mut values = [0.0; 6];
+        for ((slot, field), column) in values.iter_mut().zip(&fields).zip(COLUMNS) {
+            let text = field.to_string();
+            let v: f64 = field.parse().map_err(|_| CurrentGridError::NotANumber {
+                file: file.to_path_buf(),
+                line,
+                column,
+                text: text.clone(),
+            })?;
+            if !v.is_finite() {
+                return Err(CurrentGridError::NonFinite {
+                    file: file.to_path_buf(),
+                    line,
+                    column,
+                    text,
+                });
+            }
+            *slot = v;
+        }
+        let [x, y, z, u, v, w] = values;
+        rows.push(Row {
+            line,
+            xyz: [x, y, z],
+            uvw: [u, v, w],
+        });
+    }
+    if !header_seen {
+        return Err(CurrentGridError::Header {
+            file: file.to_path_buf(),
+            line: text.lines().count().max(1),
+            found: String::new(),
+        });
+    }
+    Ok(rows)
+}
+
+/// The axis of the sorted distinct `values` of coordinate `a`, or the error blaming one value.
+fn check_spacing(
+    values: &[f64],
+    a: usize,
+    rows: &[Row],
+    file: &Path,
+) -> Result<Axis, CurrentGridError> {
+    let (Some(&first), Some(&last)) = (values.first(), values.last()) else {
+        // Not reached: there is at least one row.
+        return Ok(Axis {
+            first: 0.0,
+            step: 0.0,
+            count: 1,
+        });
+    };
+    let count = values.len();
+    if count == 1 {
+        return Ok(Axis {
+            first,
+            step: 0.0,
+            count,
+        });
+    }
+    let step = (last - first) / (count - 1) as f64;
+    let steps: Vec<f64> = values.windows(2).map(|w| w[1] - w[0]).collect();
+    // `step` is finite and positive where this is used, and a step between finite values is
+    // never NaN.
+    let uneven = |s: &f64| (s - step).abs() > SPACING_TOLERANCE * step;
+    let first_bad = if step.is_finite() && step > 0.0 {
+        steps.iter().position(uneven)
+    } else {
+        // A span too wide for f64: blame the last value.
+        Some(count - 2)
+    };
+    let Some(first_bad) = first_bad else {
+        return Ok(Axis { first, step, count });
+    };
+    // Lines per value: a typo makes a value that appears on fewer lines than the others.
+    let mut lines_with = vec![0usize; count];
+    for r in rows {
+        if let Some(c) = index_of(values, r.xyz[a]).and_then(|i| lines_with.get_mut(i)) {
+            *c += 1;
+        }
+    }
+    let fewest = lines_with.iter().copied().min().unwrap_or(0);
+    let most = lines_with.iter().copied().max().unwrap_or(0);
+    let blamed = if fewest < most {
+        lines_with.iter().position(|&c| c == fewest).unwrap_or(0)
+    } else {
+        first_bad + 1
+    };
+    let value = values.get(blamed).copied().unwrap_or(last);
+    let line = rows
+        .iter()
+        .find(|r| r.xyz[a] == value)
+        .map_or(0, |r| r.line);
+    let from = blamed.saturating_sub(3);
+    let to = (blamed + 4).min(count);
+    let mut shown: Vec<String> = values
+        .get(from..to)
+        .unwrap_or_default()
+        .iter()
+        .map(|v| v.to_string())
+        .collect();
+    if from > 0 {
+        shown.insert(0, "…".into());
+    }
+    if to < count {
+        shown.push("…".into());
+    }
+    let min_step = steps.iter().copied().fold(f64::INFINITY, f64::min);
+    let max_step = steps.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    Err(CurrentGridError::Spacing {
+        file: file.to_path_buf(),
+        line,
+        axis: COLUMNS.get(a).copied().unwrap_or("?"),
+        value,
+        values: shown.join(", "),
+        min_step,
+        max_step,
+    })
+}
+
+/// The node after `key` (`[k, j, i]`, i fastest) in storage order, or `None` past the last one.
+fn next_key(key: [usize; 3], lattice: [usize; 3]) -> Option<[usize; 3]> {
+    let [k, j, i] = key;
+    if i + 1 < lattice[0] {
+        Some([k, j, i + 1])
+    } else if j + 1 < lattice[1] {
+        Some([k, j + 1, 0])
+    } else if k + 1 < lattice[2] {
+        Some([k + 1, 0, 0])
+    } else {
+        None
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use approx::assert_abs_diff_eq;
+    use proptest::prelude::*;
+
+    type TestResult = Result<(), Box<dyn std::error::Error>>;
+
+    /// x ∈ {0, 10, 20}, y ∈ {0, 20}, z ∈ {−10, 0}, with node indices (i, j, k):
+    /// u = i + 2j + 4k, v = i·j·k, w = −0.1·i. Trilinear interpolation reproduces these exactly
+    /// with i = x/10, j = y/20, k = (z + 10)/10, since each is linear in every index separately.
+    /// The lines are written z-major, backwards, to show the order does not matter.
+    fn sample_csv() -> String {
+        let mut text = String::from("# sample\nX, Y, Z, U, V, W\n\n");
+        for i in (0..3).rev() {
+            for j in (0..2).rev() {
+                for k in (0..2).rev() {
+                    let (x, y, z) = (10 * i, 20 * j, 10 * k - 10);
+                    let (u, v, w) = (i + 2 * j + 4 * k, i * j * k, -0.1 * i as f64);
+                    text += &format!("{x},{y},{z},{u},{v},{w} # node\n");
+                }
+            }
+        }
+        text
+    }
+
+    fn sample() -> Result<GridCurrent, CurrentGridError> {
+        GridCurrent::from_csv(&sample_csv(), Path::new("c.csv"))
+    }
+
+    #[test]
+    fn trilinear_at_a_node_a_cell_centre_and_an_edge() -> TestResult {
+        let g = sample()?;
+        assert_eq!(
+            g.axes()[0],
+            Axis {
+                first: 0.0,
+                step: 10.0,
+                count: 3
+            }
+        );
+        assert_eq!(g.extent(), ([0.0, 0.0, -10.0], [20.0, 20.0, 0.0]));
+        // Node (i, j, k) = (1, 1, 1): u = 1 + 2 + 4, v = 1, w = −0.1.
+        let n = g.velocity(&Vec3::new(10.0, 20.0, 0.0));
+        assert_abs_diff_eq!(n, Vec3::new(7.0, 1.0, -0.1), epsilon = 1e-12);
+        assert_eq!(g.node(1, 1, 1), Some(n));
+        // Centre of the second cell along x, (i, j, k) = (1.5, 0.5, 0.5): u = 1.5 + 1 + 2,
+        // v = 1.5·0.5·0.5 (the mean of the corners 0, 0, 0, 0, 0, 1, 0, 2 over 8 = 3/8 too),
+        // w = −0.15.
+        let c = g.velocity(&Vec3::new(15.0, 10.0, -5.0));
+        assert_abs_diff_eq!(c, Vec3::new(4.5, 0.375, -0.15), epsilon = 1e-12);
+        // On the edge from node (2, 0, 1) to node (2, 1, 1), a quarter of the way: u = 2 + 0.5
+        // + 4, v = 2·0.25·1, w = −0.2.
+        let e = g.velocity(&Vec3::new(20.0, 5.0, 0.0));
+        assert_abs_diff_eq!(e, Vec3::new(6.5, 0.5, -0.2), epsilon = 1e-12);
+        // On the edge along x from node (0, 1, 0) to (1, 1, 0): u = 0.3 + 2, v = 0.
+        let e = g.velocity(&Vec3::new(3.0, 20.0, -10.0));
+        assert_abs_diff_eq!(e, Vec3::new(2.3, 0.0, -0.03), epsilon = 1e-12);
+        Ok(())
+    }
+
+    #[test]
+    fn outside_the_lattice_the_nearest_face_is_used() -> TestResult {
+        let g = sample()?;
+        // West of the box: the value on the x = 0 face at (y, z) = (10, −5).
+        let west = g.velocity(&Vec3::new(-100.0, 10.0, -5.0));
+        assert_abs_diff_eq!(west, g.velocity(&Vec3::new(0.0, 10.0, -5.0)));
+        assert_abs_diff_eq!(west, Vec3::new(3.0, 0.0, 0.0), epsilon = 1e-12);
+        // Beyond the top north-east corner: node (2, 1, 1).
+        let corner = g.velocity(&Vec3::new(1e9, 1e9, f64::INFINITY));
+        assert_abs_diff_eq!(corner, Vec3::new(8.0, 2.0, -0.2), epsilon = 1e-12);
+        // Below the bottom only z is clamped: (i, j, k) = (0.5, 0.5, 0).
+        let below = g.velocity(&Vec3::new(5.0, 10.0, -1e6));
+        assert_abs_diff_eq!(below, Vec3::new(1.5, 0.0, -0.05), epsilon = 1e-12);
+        assert!(g.velocity(&Vec3::new(f64::NAN, 0.0, 0.0)).x.is_nan());
+        Ok(())
+    }
+
+    #[test]
+    fn a_single_value_makes_the_axis_constant() -> TestResult {
+        let text = "x,y,z,u,v,w\n0,0,-5,1,0,0\n10,0,-5,3,0,0\n0,10,-5,1,2,0\n10,10,-5,3,2,0\n";
+        let g = GridCurrent::from_csv(text, Path::new("layer.csv"))?;
+        assert_eq!(
+            g.axes()[2],
+            Axis {
+                first: -5.0,
+                step: 0.0,
+                count: 1
+            }
+        );
+        for z in [-100.0, -5.0, 0.0, 7.0] {
+            let v = g.velocity(&Vec3::new(5.0, 5.0, z));
+            assert_abs_diff_eq!(v, Vec3::new(2.0, 1.0, 0.0), epsilon = 1e-12);
+        }
+        let one = GridCurrent::from_csv("x,y,z,u,v,w\n1,2,3,0.5,-0.5,0\n", Path::new("u.csv"))?;
+        let v = one.velocity(&Vec3::new(-7.0, 1e3, 0.0));
+        assert_abs_diff_eq!(v, Vec3::new(0.5, -0.5, 0.0));
+        Ok(())
+    }
+
+    /// The error message of `text`, which must fail naming `c.csv:line:` and containing `what`.
+    fn check_err(text: &str, line: usize, what: &str) -> CurrentGridError {
+        match GridCurrent::from_csv(text, Path::new("c.csv")) {
+            Ok(_) => panic!("accepted, expected an error at line {line} about {what}"),
+            Err(e) => {
+                let msg = e.to_string();
+                assert!(
+                    msg.contains(&format!("c.csv:{line}:")),
+                    "line {line}: {msg}"
+                );
+                assert!(msg.contains(what), "`{what}` missing from: {msg}");
+                e
+            }
+        }
+    }
+
+    const SMALL: &str = "x,y,z,u,v,w\n0,0,0,1,1,0\n10,0,0,1,1,0\n0,10,0,1,1,0\n10,10,0,1,1,0\n";
+
+    #[test]
+    fn errors_name_the_file_the_line_and_the_value() {
+        assert!(GridCurrent::from_csv(SMALL, Path::new("c.csv")).is_ok());
+        let e = check_err("# forecast\nx,y,z,u,v\n", 2, "found `x,y,z,u,v`");
+        assert!(matches!(e, CurrentGridError::Header { .. }));
+        check_err("x;y;z;u;v;w\n0;0;0;1;1;0\n", 1, "`x;y;z;u;v;w`");
+        let e = check_err("# only a comment\n\n", 2, "found nothing");
+        assert!(matches!(e, CurrentGridError::Header { .. }));
+        let e = check_err(&SMALL.replace("10,0,0,1,1,0", "10,0,0,1,1"), 3, "found 5");
+        assert!(matches!(e, CurrentGridError::FieldCount { .. }));
+        let e = check_err(
+            &SMALL.replace("0,10,0,1,1,0", "0,10,0,1,x1,0"),
+            4,
+            "`v`: `x1`",
+        );
+        assert!(matches!(e, CurrentGridError::NotANumber { .. }));
+        check_err(
+            &SMALL.replace("0,10,0,1,1,0", "0,10,,1,1,0"),
+            4,
+            "`z`: nothing",
+        );
+        let e = check_err(
+            &SMALL.replace("10,10,0,1,1,0", "10,10,0,inf,1,0"),
+            5,
+            "`inf`",
+        );
+        assert!(matches!(e, CurrentGridError::NonFinite { .. }));
+        check_err(
+            &SMALL.replace("0,0,0,1,1,0", "NaN,0,0,1,1,0"),
+            2,
+            "`x`: `NaN`",
+        );
+        let e = check_err("x,y,z,u,v,w\n# none\n", 2, "at least one node");
+        assert!(matches!(e, CurrentGridError::NoNodes { .. }));
+    }
+
+    #[test]
+    fn duplicate_missing_and_uneven_nodes_are_named() {
+        // Line 5 repeats the node of line 3 (a typo for y = 10).
+        let e = check_err(
+            &SMALL.replace("10,10,0,1,1,0", "10,0,0,2,2,0"),
+            5,
+            "node x = 10, y = 0, z = 0 is given twice (first at line 3)",
+        );
+        assert!(matches!(e, CurrentGridError::Duplicate { .. }));
+        // No line for (10, 10, 0): reported at the last line.
+        let text = SMALL.replace("10,10,0,1,1,0\n", "# end\n");
+        let e = check_err(&text, 5, "no line for node x = 10, y = 10, z = 0");
+        assert!(e.to_string().contains("2 × 2 × 1 lattice"), "{e}");
+        assert!(e.to_string().contains("(3 data lines for 4 nodes)"), "{e}");
+        // A missing node in the middle of the storage order.
+        let text = "x,y,z,u,v,w\n0,0,0,1,1,0\n10,0,0,1,1,0\n10,10,0,1,1,0\n\
+                    0,0,1,1,1,0\n10,0,1,1,1,0\n0,10,1,1,1,0\n10,10,1,1,1,0\n";
+        check_err(text, 8, "no line for node x = 0, y = 10, z = 0");
+        // x = 15 on line 6 is a typo for 20: it is on one line where the others are on two.
+        let text = "x,y,z,u,v,w\n0,0,0,0,0,0\n10,0,0,0,0,0\n20,0,0,0,0,0\n\
+                    0,5,0,0,0,0\n15,5,0,0,0,0\n10,5,0,0,0,0\n";
+        let e = check_err(text, 6, "x = 15 breaks the even spacing of the x values");
+        assert!(e.to_string().contains("(0, 10, 15, 20)"), "{e}");
+        assert!(e.to_string().contains("from 5 to 10"), "{e}");
+        // A lattice uneven on every line: the end of the first uneven step is blamed.
+        let text = "x,y,z,u,v,w\n0,0,0,0,0,0\n0,0,1,0,0,0\n0,0,3,0,0,0\n";
+        let e = check_err(text, 3, "z = 1 breaks");
+        assert!(matches!(e, CurrentGridError::Spacing { axis: "z", .. }));
+        // Steps within 1e-6 relative pass, a 1e-5 wobble does not.
+        let ok = "x,y,z,u,v,w\n0,0,0,0,0,0\n1.0000001,0,0,0,0,0\n2,0,0,0,0,0\n";
+        assert!(GridCurrent::from_csv(ok, Path::new("c.csv")).is_ok());
+        check_err(&ok.replace("1.0000001", "1.00001"), 3, "x = 1.00001");
+        // A span too wide for f64 is refused, not interpolated into NaN.
+        let wide = "x,y,z,u,v,w\n-1e308,0,0,0,0,0\n0,0,0,0,0,0\n1e308,0,0,0,0,0\n";
+        check_err(wide, 4, "breaks the even spacing");
+    }
+
+    #[test]
+    fn load_reads_a_file_and_names_an_unreadable_one() -> TestResult {
+        let dir = tempfile::tempdir()?;
+        let path = dir.path().join("c.csv");
+        std::fs::write(&path, format!("\u{feff}{}", sample_csv()))?;
+        let g = GridCurrent::load(&path)?;
+        assert_eq!(g.file(), path);
+        assert!(format!("{g:?}").contains("nodes: 12"));
+        let missing = dir.path().join("none.csv");
+        match GridCurrent::load(&missing) {
+            Err(e @ CurrentGridError::Io { .. }) => {
+                assert!(e.to_string().contains("none.csv: cannot read"), "{e}")
+            }
+            other => panic!("{other:?}"),
+        }
+        Ok(())
+    }
+
+    proptest! {
+        #[test]
+        fn parsing_never_panics(text in ".{0,300}") {
+            let _ = GridCurrent::from_csv(&text, Path::new("p.csv"));
+        }
+
+        #[test]
+        fn near_grids_never_panic(
+            body in "([-0-9.e,#nai]{0,16}\n){0,12}",
+            p in proptest::array::uniform3(-1e3f64..1e3),
+        ) {
+            let text = format!("x,y,z,u,v,w\n{body}");
+            if let Ok(g) = GridCurrent::from_csv(&text, Path::new("p.csv")) {
+                let v = g.velocity(&Vec3::from(p));
+                prop_assert!(v.iter().all(|c| c.is_finite()));
+            }
+        }
+
+        #[test]
+        fn interpolation_stays_within_the_node_values(
+            values in proptest::collection::vec(-2.0f64..2.0, 12),
+            p in proptest::array::uniform3(-50f64..50.0),
+        ) {
+            let mut text = String::from("x,y,z,u,v,w\n");
+            for (n, u) in values.iter().enumerate() {
+                let (i, j, k) = (n % 3, (n / 3) % 2, n / 6);
+                text += &format!("{},{},{},{u},0,0\n", 10 * i, 7 * j, 5 * k);
+            }
+            let g = GridCurrent::from_csv(&text, Path::new("p.csv"))
+                .map_err(|e| TestCaseError::fail(e.to_string()))?;
+            let u = g.velocity(&Vec3::from(p)).x;
+            let lo = values.iter().copied().fold(f64::INFINITY, f64::min);
+            let hi = values.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+            prop_assert!(u >= lo - 1e-12 && u <= hi + 1e-12, "{u} not in [{lo}, {hi}]");
+        }
+    }
+}
