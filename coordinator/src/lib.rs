@@ -208,13 +208,6 @@ fn plan_command(args: &PlanArgs, shutdown: Arc<AtomicBool>) -> anyhow::Result<i3
             algorithm.as_str()
         );
     }
-    if algorithm.is_tour_planner() && !args.in_process {
-        bail!(
-            "{}: {} plans inspection tours inside this process (one thread per AUV; agents do not plan tours yet): add --in-process",
-            args.scenario.display(),
-            algorithm.as_str()
-        );
-    }
     let options = if args.in_process {
         None
     } else {

@@ -14,6 +14,7 @@ use shoal_common::distributed::follower::{FollowerSettings, Followers};
 use shoal_common::distributed::{round_iterations, rounds, Chromosome, Context};
 use shoal_common::scenario::Scenario;
 use shoal_common::swarm::Progress;
+use shoal_common::tour::FleetTours;
 use shoal_common::wire::agent_to_coordinator::AgentToCoordinator;
 use shoal_common::wire::coordinator_to_agent::CoordinatorToAgent;
 use shoal_common::wire::{WireChromosome, WireContext};
@@ -90,6 +91,9 @@ pub fn run(
     stop: &AtomicBool,
     idle: Duration,
 ) -> MissionReport {
+    if a.scenario.optimizer.algorithm.is_tour_planner() {
+        return run_tour(&a, send, dropped);
+    }
     let o = a.scenario.optimizer.clone();
     let model = Arc::new(FleetModel::new(&a.scenario));
     let ids: Vec<String> = a.scenario.vehicles.iter().map(|v| v.id.clone()).collect();
@@ -157,6 +161,41 @@ pub fn run(
         dropped: dropped.load(Ordering::Relaxed),
     });
     report
+}
+
+/// A tour mission (seed 003): this vehicle's share of the inspection points follows from the
+/// scenario alone ([`FleetTours`]), so the agent plans its tour at once, sends it, and is done.
+fn run_tour(
+    a: &Assignment,
+    send: &dyn Fn(AgentToCoordinator),
+    dropped: &AtomicU32,
+) -> MissionReport {
+    let iterations = a.scenario.optimizer.iterations as u32;
+    let outcome = match FleetTours::new(&a.scenario) {
+        Ok(job) => {
+            let tour = job.plan_vehicle(a.index);
+            send(AgentToCoordinator::tour(&a.mission, &a.vehicle, &tour));
+            format!(
+                "tour of {} points planned: {:.1} m",
+                tour.order.len(),
+                tour.tour_length_m
+            )
+        }
+        Err(why) => why,
+    };
+    send(AgentToCoordinator::Done {
+        mission: a.mission.clone(),
+        vehicle: a.vehicle.clone(),
+        iterations,
+        elites_sent: 0,
+        evaluations: 0,
+        dropped: dropped.load(Ordering::Relaxed),
+    });
+    MissionReport {
+        iterations,
+        elites_sent: 0,
+        outcome,
+    }
 }
 
 /// Waits for round `round`'s migrants and the context they need, keeping the newest context in

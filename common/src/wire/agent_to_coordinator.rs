@@ -3,6 +3,8 @@
 use serde::{Deserialize, Serialize};
 
 use super::WireChromosome;
+use crate::geometry::Vec3;
+use crate::tour::TourPlan;
 
 /// Agent → coordinator. Variants are only ever added at the end: their index is on the wire.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -45,15 +47,47 @@ pub enum AgentToCoordinator {
         /// The vehicle.
         vehicle: String,
     },
+    /// Tour missions (seed 003): the inspection tour the agent planned for its share of the
+    /// points. Sent once, before `Done`.
+    Tour {
+        /// Mission id.
+        mission: String,
+        /// The vehicle.
+        vehicle: String,
+        /// Visiting order: indices into the vehicle's share of the inspection points.
+        order: Vec<u32>,
+        /// The flown polyline, base to base, metres.
+        path: Vec<[f64; 3]>,
+        /// Leg lengths, metres.
+        leg_lengths: Vec<f64>,
+        /// Length of the same order with straight legs, metres.
+        straight_m: f64,
+        /// Segment–cage intersections of `path`.
+        intersections: u32,
+    },
 }
 
 impl AgentToCoordinator {
+    /// The `Tour` message of a planned tour.
+    pub fn tour(mission: &str, vehicle: &str, t: &TourPlan) -> AgentToCoordinator {
+        AgentToCoordinator::Tour {
+            mission: mission.to_string(),
+            vehicle: vehicle.to_string(),
+            order: t.order.iter().map(|&k| k as u32).collect(),
+            path: t.path.iter().map(|p| [p.x, p.y, p.z]).collect(),
+            leg_lengths: t.leg_lengths.clone(),
+            straight_m: t.straight_tour_length_m,
+            intersections: t.cage_intersections as u32,
+        }
+    }
+
     /// The mission the message belongs to.
     pub fn mission(&self) -> &str {
         match self {
             AgentToCoordinator::Elites { mission, .. }
             | AgentToCoordinator::Done { mission, .. }
-            | AgentToCoordinator::Joined { mission, .. } => mission,
+            | AgentToCoordinator::Joined { mission, .. }
+            | AgentToCoordinator::Tour { mission, .. } => mission,
         }
     }
 
@@ -62,7 +96,84 @@ impl AgentToCoordinator {
         match self {
             AgentToCoordinator::Elites { vehicle, .. }
             | AgentToCoordinator::Done { vehicle, .. }
-            | AgentToCoordinator::Joined { vehicle, .. } => vehicle,
+            | AgentToCoordinator::Joined { vehicle, .. }
+            | AgentToCoordinator::Tour { vehicle, .. } => vehicle,
         }
+    }
+}
+
+/// The tour a `Tour` message carries, checked: every number finite, a path of at least one
+/// point, and no visit index beyond `share_len`. The length is the legs' sum (as the planner
+/// adds it up), the growth is recomputed from it.
+pub fn tour_from_wire(
+    order: &[u32],
+    path: &[[f64; 3]],
+    leg_lengths: &[f64],
+    straight_m: f64,
+    intersections: u32,
+    share_len: usize,
+) -> Result<TourPlan, String> {
+    let finite = path.iter().flatten().all(|v| v.is_finite())
+        && leg_lengths.iter().all(|v| v.is_finite())
+        && straight_m.is_finite();
+    if !finite || path.is_empty() {
+        return Err("a tour with an empty path or a non-finite number".into());
+    }
+    if let Some(k) = order.iter().find(|&&k| k as usize >= share_len) {
+        return Err(format!(
+            "a tour visiting point {k} of a share of {share_len} points"
+        ));
+    }
+    let path: Vec<Vec3> = path.iter().map(|p| Vec3::new(p[0], p[1], p[2])).collect();
+    let tour_length_m: f64 = leg_lengths.iter().sum();
+    let growth_m = tour_length_m - straight_m;
+    Ok(TourPlan {
+        order: order.iter().map(|&k| k as usize).collect(),
+        path,
+        leg_lengths: leg_lengths.to_vec(),
+        tour_length_m,
+        straight_tour_length_m: straight_m,
+        growth_m,
+        growth_rate: if straight_m > 0.0 {
+            growth_m / straight_m
+        } else {
+            0.0
+        },
+        cage_intersections: intersections as usize,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_tour_survives_the_wire_and_bad_ones_do_not() {
+        let t = TourPlan {
+            order: vec![1, 0],
+            path: vec![Vec3::zeros(), Vec3::new(3.0, 4.0, 0.0), Vec3::zeros()],
+            leg_lengths: vec![5.0, 5.0],
+            tour_length_m: 10.0,
+            straight_tour_length_m: 8.0,
+            growth_m: 2.0,
+            growth_rate: 0.25,
+            cage_intersections: 0,
+        };
+        let AgentToCoordinator::Tour {
+            order,
+            path,
+            leg_lengths,
+            straight_m,
+            intersections,
+            ..
+        } = AgentToCoordinator::tour("m", "auv1", &t)
+        else {
+            panic!("not a tour");
+        };
+        let back = tour_from_wire(&order, &path, &leg_lengths, straight_m, intersections, 2);
+        assert_eq!(back, Ok(t));
+        assert!(tour_from_wire(&order, &path, &leg_lengths, straight_m, 0, 1).is_err());
+        assert!(tour_from_wire(&order, &[[f64::NAN, 0.0, 0.0]], &[], 0.0, 0, 2).is_err());
+        assert!(tour_from_wire(&[], &[], &[], 0.0, 0, 0).is_err());
     }
 }

@@ -84,12 +84,19 @@ pub fn plan_distributed(
     observe: &mut dyn FnMut(&mission::Status),
 ) -> anyhow::Result<Plan> {
     topics::check_id("mission", &options.mission)?;
-    if !scenario.optimizer.algorithm.is_multi_population() {
+    let algorithm = scenario.optimizer.algorithm;
+    if !algorithm.is_multi_population() && !algorithm.is_tour_planner() {
         anyhow::bail!(
-            "distributed planning runs the multi-population algorithms (amp-pso, mp-pso); {} is a single-population algorithm: plan it with --in-process",
-            scenario.optimizer.algorithm.as_str()
+            "distributed planning runs the multi-population algorithms (amp-pso, mp-pso) and the inspection tours (de-pso, ldiw-pso, lcpso); {} is a single-population algorithm: plan it with --in-process",
+            algorithm.as_str()
         );
     }
+    // Tour missions: the job is a function of the scenario (every agent derives the same one);
+    // a scenario without one is refused before the network opens.
+    if algorithm.is_tour_planner() {
+        shoal_common::tour::FleetTours::new(scenario).map_err(anyhow::Error::msg)?;
+    }
+    let started = std::time::Instant::now();
     let ids: Vec<String> = scenario.vehicles.iter().map(|v| v.id.clone()).collect();
     let mut net =
         network::Network::open(&options.listen, &options.routers, &options.mission, &ids)?;
@@ -128,6 +135,31 @@ pub fn plan_distributed(
         join: options.join_timeout,
         round: options.round_timeout,
     };
+    if algorithm.is_tour_planner() {
+        let outcome = mission::run_tour_mission(
+            scenario,
+            &mut net,
+            &options.mission,
+            timing,
+            local.as_mut(),
+            stop,
+            observe,
+        );
+        drop(local);
+        net.close();
+        drop(health);
+        let (job, tours, figures) = outcome?;
+        let mut plan =
+            crate::tour_planner::assemble(scenario, &job, &tours, "distributed", started);
+        for d in &figures.degraded {
+            plan.notices.push(format!(
+                "{}'s tour was planned by the coordinator: {}",
+                d.vehicle, d.reason
+            ));
+        }
+        plan.distributed = Some(figures);
+        return Ok(plan);
+    }
     let outcome = mission::run(
         scenario,
         &mut net,

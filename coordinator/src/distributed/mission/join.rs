@@ -81,6 +81,19 @@ impl Run<'_> {
                         seat.take_elites(iteration, evaluations, particles);
                     }
                 }
+                // A tour mission's agent can finish its tour before the others join.
+                Some(Event::Message(m @ AgentToCoordinator::Tour { .. })) => {
+                    match self.tours.take() {
+                        Some(job) => {
+                            self.take_tour(&job, m);
+                            self.tours = Some(job);
+                        }
+                        None => self.net.out_of_turn(&format!(
+                            "a tour from {} in an exchange mission",
+                            m.vehicle()
+                        )),
+                    }
+                }
                 Some(Event::Message(m)) => self.net.out_of_turn(&format!(
                     "{} sent a message out of turn while the fleet was joining",
                     m.vehicle()

@@ -19,11 +19,13 @@ use shoal_common::distributed::{round_iterations, rounds, Chromosome, Context};
 use shoal_common::plan::{AgentFigures, DegradedVehicle, DistributedFigures};
 use shoal_common::scenario::Scenario;
 use shoal_common::swarm::{Progress, Termination};
+use shoal_common::tour::{FleetTours, TourPlan};
 use shoal_common::wire::agent_to_coordinator::AgentToCoordinator;
 use shoal_common::wire::coordinator_to_agent::CoordinatorToAgent;
 use shoal_common::wire::{WireChromosome, WireContext};
 
 mod join;
+mod tours;
 
 use super::agents::LocalAgents;
 use super::network::{Event, Network};
@@ -70,6 +72,8 @@ struct Seat {
     done: Option<(u32, u64, u32)>,
     /// When and why its agent was seen to go (token gone, process exited).
     gone: Option<(Instant, String)>,
+    /// Tour missions: the vehicle's inspection tour, from its agent or planned here.
+    tour: Option<TourPlan>,
 }
 
 impl Seat {
@@ -95,6 +99,8 @@ struct Run<'a> {
     seats: Vec<Seat>,
     timing: Timing,
     mission: String,
+    /// Tour missions: the fleet's job (to check the tours agents send).
+    tours: Option<FleetTours>,
 }
 
 /// Runs the mission and returns the best plan's run result and the network figures.
@@ -113,32 +119,7 @@ pub fn run(
     let settings = FollowerSettings::of(&o);
     let mut leader = Leader::new(Arc::clone(&model), &o, settings.schedule);
     let mut context = leader.context(0);
-    let seats = scenario
-        .vehicles
-        .iter()
-        .map(|v| Seat {
-            id: v.id.clone(),
-            alive: false,
-            joined: false,
-            local: None,
-            degraded: None,
-            last_elites: Vec::new(),
-            this_round: None,
-            elites_received: 0,
-            agent_iterations: 0,
-            agent_evaluations: 0,
-            done: None,
-            gone: None,
-        })
-        .collect();
-    let mut r = Run {
-        scenario,
-        model,
-        net,
-        seats,
-        timing,
-        mission: mission.to_string(),
-    };
+    let mut r = Run::new(scenario, model, net, timing, mission);
     r.join(&context, local.as_deref_mut(), stop)?;
     let total_rounds = rounds(o.iterations, o.distributed.exchange_every);
     let mut convergence = Vec::with_capacity(o.iterations);
@@ -263,6 +244,63 @@ pub fn run(
         runtime_s: started.elapsed().as_secs_f64(),
     };
     Ok((result, figures))
+}
+
+/// Runs a tour mission (seed 003): every agent plans its own share's tour; see [`tours`].
+/// Returns the fleet's job (a function of the scenario), every vehicle's tour and the figures.
+pub fn run_tour_mission(
+    scenario: &Scenario,
+    net: &mut Network,
+    mission: &str,
+    timing: Timing,
+    local: Option<&mut LocalAgents>,
+    stop: &AtomicBool,
+    observe: &mut dyn FnMut(&Status),
+) -> anyhow::Result<(FleetTours, Vec<TourPlan>, DistributedFigures)> {
+    let job = FleetTours::new(scenario).map_err(anyhow::Error::msg)?;
+    let model = Arc::new(FleetModel::new(scenario));
+    let mut r = Run::new(scenario, model, net, timing, mission);
+    let (tours, figures) = tours::run_tours(&mut r, &job, local, stop, observe)?;
+    Ok((job, tours, figures))
+}
+
+impl<'a> Run<'a> {
+    fn new(
+        scenario: &'a Scenario,
+        model: Arc<FleetModel>,
+        net: &'a mut Network,
+        timing: Timing,
+        mission: &str,
+    ) -> Run<'a> {
+        let seats = scenario
+            .vehicles
+            .iter()
+            .map(|v| Seat {
+                id: v.id.clone(),
+                alive: false,
+                joined: false,
+                local: None,
+                degraded: None,
+                last_elites: Vec::new(),
+                this_round: None,
+                elites_received: 0,
+                agent_iterations: 0,
+                agent_evaluations: 0,
+                done: None,
+                gone: None,
+                tour: None,
+            })
+            .collect();
+        Run {
+            scenario,
+            model,
+            net,
+            seats,
+            timing,
+            mission: mission.to_string(),
+            tours: None,
+        }
+    }
 }
 
 impl Run<'_> {
@@ -427,6 +465,9 @@ impl Run<'_> {
                     }
                 }
                 Some(Event::Message(AgentToCoordinator::Joined { .. })) => {}
+                Some(Event::Message(m @ AgentToCoordinator::Tour { .. })) => self.net.out_of_turn(
+                    &format!("a tour from {} in an exchange mission", m.vehicle()),
+                ),
                 None => {}
             }
         }
