@@ -1,0 +1,168 @@
+//! Unit tests of `cost`.
+
+use super::*;
+use crate::scenario::VehicleKind;
+use approx::assert_abs_diff_eq;
+
+fn v(x: f64, y: f64, z: f64) -> Vec3 {
+    Vec3::new(x, y, z)
+}
+
+fn vehicle() -> Vehicle {
+    Vehicle {
+        id: "a".into(),
+        kind: VehicleKind::Auv,
+        start: [0.0, 0.0, 0.0],
+        goal: [300.0, 0.0, 0.0],
+        speed_min_mps: 0.5,
+        speed_max_mps: 1.5,
+        max_turn_deg: 35.0,
+        max_pitch_deg: 20.0,
+    }
+}
+
+#[test]
+fn length_term_by_hand() {
+    // A 3-4-5 detour: 5 + 5 = 10 m against a straight 8 m.
+    let pts = [v(0., 0., 0.), v(4., 3., 0.), v(8., 0., 0.)];
+    let len: f64 = pts.windows(2).map(|w| (w[1] - w[0]).norm()).sum();
+    assert_abs_diff_eq!(length_term(len, 8.0), 1.25, epsilon = 1e-12);
+}
+
+#[test]
+fn depth_term_by_hand() {
+    // Surface at z = 100, column 100 m. Leg 1: 10 m at depth 50 → 50 average.
+    // Leg 2: 30 m from depth 50 to depth 80 (vertical) → average 65.
+    // Weighted mean (10·50 + 30·65) / 40 = 61.25 m → 0.6125.
+    let pts = [v(0., 0., 50.), v(10., 0., 50.), v(10., 0., 20.)];
+    assert_abs_diff_eq!(depth_term(&pts, 100.0, 100.0), 0.6125, epsilon = 1e-12);
+    // Along the surface: 0.
+    assert_abs_diff_eq!(
+        depth_term(&[v(0., 0., 100.), v(5., 0., 100.)], 100.0, 100.0),
+        0.0
+    );
+}
+
+#[test]
+fn soft_threat_by_hand() {
+    // Straight through the centre of a soft sphere of inflated radius 20: 40 m inside,
+    // straight distance 100 → 0.4. A second sphere missed entirely adds nothing.
+    let soft = [
+        Sphere {
+            centre: v(50., 0., 0.),
+            radius: 20.0,
+        },
+        Sphere {
+            centre: v(50., 50., 0.),
+            radius: 20.0,
+        },
+    ];
+    let pts = [v(0., 0., 0.), v(100., 0., 0.)];
+    assert_abs_diff_eq!(soft_threat_term(&pts, &soft, 100.0), 0.4, epsilon = 1e-9);
+}
+
+#[test]
+fn time_term_by_hand() {
+    let veh = vehicle();
+    // 300 m: window [200, 600] s. Mission 400 → 0; 150 → (200 − 150)/150; 900 → 300/900.
+    assert_abs_diff_eq!(time_term(300.0, &veh, 400.0), 0.0);
+    assert_abs_diff_eq!(time_term(300.0, &veh, 150.0), 50.0 / 150.0, epsilon = 1e-12);
+    assert_abs_diff_eq!(
+        time_term(300.0, &veh, 900.0),
+        300.0 / 900.0,
+        epsilon = 1e-12
+    );
+}
+
+#[test]
+fn hard_penalty_counts_legs_that_cross_between_waypoints() {
+    // Both waypoints are outside the sphere (radius 10 at (50, 5, 0)); the leg passes 5 m
+    // from the centre: one hit, penalty 1 + 5/10.
+    let hard = [Sphere {
+        centre: v(50., 5., 0.),
+        radius: 10.0,
+    }];
+    let (p, n) = hard_penalty(&[v(0., 0., 0.), v(100., 0., 0.)], &hard);
+    assert_eq!(n, 1);
+    assert_abs_diff_eq!(p, 1.5, epsilon = 1e-12);
+    let (p, n) = hard_penalty(&[v(0., 20., 0.), v(100., 20., 0.)], &hard);
+    assert_eq!((p, n), (0.0, 0));
+}
+
+#[test]
+fn hard_penalty_guards_a_leg_that_grazes_the_inflated_sphere() {
+    // The leg runs exactly on the surface (5 + 10 = 15 from the centre's line): a checker
+    // calls that clear, but the planner demands the contact guard beyond it, so it is one hit
+    // with penalty 1. A leg 1 mm further out is clear.
+    let hard = [Sphere {
+        centre: v(50., 15., 0.),
+        radius: 15.0,
+    }];
+    let (p, n) = hard_penalty(&[v(0., 0., 0.), v(100., 0., 0.)], &hard);
+    assert_eq!(n, 1);
+    assert_abs_diff_eq!(p, 1.0, epsilon = 1e-12);
+    let (p, n) = hard_penalty(&[v(0., -0.001, 0.), v(100., -0.001, 0.)], &hard);
+    assert_eq!((p, n), (0.0, 0));
+}
+
+#[test]
+fn turn_and_pitch_penalties_by_hand() {
+    let max = 35f64.to_radians();
+    // A 45° turn exceeds 35° by 10°: 1 + 10/35. A 30° turn is free.
+    let pts = [v(0., 0., 0.), v(1., 0., 0.), v(2., 1., 0.)];
+    assert_abs_diff_eq!(turn_penalty(&pts, max), 1.0 + 10.0 / 35.0, epsilon = 1e-9);
+    let c = 30f64.to_radians();
+    let pts = [v(0., 0., 0.), v(1., 0., 0.), v(1. + c.cos(), c.sin(), 0.)];
+    assert_abs_diff_eq!(turn_penalty(&pts, max), 0.0);
+    // A vertical leg between an eastward and a westward leg hides nothing: 180° turn,
+    // 1 + 145/35.
+    let pts = [v(0., 0., 0.), v(1., 0., 0.), v(1., 0., 1.), v(0., 0., 1.)];
+    assert_abs_diff_eq!(turn_penalty(&pts, max), 1.0 + 145.0 / 35.0, epsilon = 1e-9);
+    // A 45° climb exceeds 20° by 25°: 1 + 25/20; a 10° climb is free.
+    let pmax = 20f64.to_radians();
+    let pts = [
+        v(0., 0., 0.),
+        v(1., 0., 1.),
+        v(2., 0., 1.0 + 10f64.to_radians().tan()),
+    ];
+    assert_abs_diff_eq!(pitch_penalty(&pts, pmax), 1.0 + 25.0 / 20.0, epsilon = 1e-9);
+}
+
+proptest::proptest! {
+    #[test]
+    fn sphere_terms_match_the_brute_force(
+        pts in proptest::collection::vec((0.0f64..1000.0, 0.0f64..1000.0, 0.0f64..1000.0), 2..30),
+        spheres in proptest::collection::vec((0.0f64..1000.0, 0.0f64..1000.0, 0.0f64..1000.0, 1.0f64..300.0, proptest::bool::ANY), 1..12),
+    ) {
+        let pts: Vec<Vec3> = pts.iter().map(|p| v(p.0, p.1, p.2)).collect();
+        let (mut hard, mut soft) = (Vec::new(), Vec::new());
+        for s in &spheres {
+            let sp = Sphere { centre: v(s.0, s.1, s.2), radius: s.3 };
+            if s.4 { hard.push(sp) } else { soft.push(sp) }
+        }
+        let fast = sphere_terms(&pts, &hard, &soft);
+        let (mut p, mut hits, mut inside) = (0.0, 0, 0.0);
+        for w in pts.windows(2) {
+            for s in &hard {
+                let d = crate::geometry::segment_point_distance(&w[0], &w[1], &s.centre);
+                if d < s.radius {
+                    p += 1.0 + (s.radius - d) / s.radius;
+                    hits += 1;
+                }
+            }
+            for s in &soft {
+                inside += chord_inside_sphere(&w[0], &w[1], &s.centre, s.radius);
+            }
+        }
+        proptest::prop_assert_eq!(fast.hard_hits, hits);
+        proptest::prop_assert!((fast.hard_penalty - p).abs() < 1e-9);
+        proptest::prop_assert!((fast.soft_inside - inside).abs() < 1e-6);
+    }
+}
+
+#[test]
+fn separation_penalty_by_hand() {
+    assert_abs_diff_eq!(separation_penalty(30.0, 50.0), 1.4, epsilon = 1e-12);
+    assert_abs_diff_eq!(separation_penalty(50.0, 50.0), 0.0);
+    assert_abs_diff_eq!(space_term(12.5), 12.5);
+}

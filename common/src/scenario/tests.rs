@@ -1,0 +1,134 @@
+//! Unit tests of `scenario`.
+
+use super::*;
+
+const GOOD: &str = r#"
+name = "t"
+[bounds]
+min = [0.0, 0.0, 0.0]
+max = [100.0, 100.0, 100.0]
+[[obstacles]]
+id = "H1"
+kind = "hard"
+centre = [50.0, 50.0, 50.0]
+radius_m = 10.0
+inflation_m = 5.0
+[[vehicles]]
+id = "a"
+kind = "auv"
+start = [1.0, 1.0, 1.0]
+goal = [99.0, 99.0, 99.0]
+speed_min_mps = 0.5
+speed_max_mps = 1.5
+max_turn_deg = 35.0
+max_pitch_deg = 20.0
+[fleet]
+d_min_m = 5.0
+mission_time_s = 200.0
+"#;
+
+fn parse(text: &str) -> Result<Scenario, ScenarioError> {
+    Scenario::parse(text, Path::new("scenarios/x.toml"))
+}
+
+#[test]
+fn good_file_parses_with_table5_defaults() -> Result<(), ScenarioError> {
+    let s = parse(GOOD)?;
+    assert_eq!(s.optimizer.populations, 20);
+    assert_eq!(s.optimizer.particles, 50);
+    assert_eq!(s.optimizer.iterations, 200);
+    assert_eq!(s.optimizer.weights, [0.2, 0.1, 0.3, 0.1, 0.3]);
+    assert_eq!(s.obstacles[0].inflated_radius(), 15.0);
+    Ok(())
+}
+
+#[test]
+fn bad_value_names_file_field_and_value() {
+    let text = GOOD.replace("speed_max_mps = 1.5", "speed_max_mps = 0.1");
+    let msg = parse(&text)
+        .err()
+        .map(|e| e.to_string())
+        .unwrap_or_default();
+    assert!(msg.contains("scenarios/x.toml"), "{msg}");
+    assert!(msg.contains("vehicles[0].speed_max_mps"), "{msg}");
+    assert!(msg.contains("0.1"), "{msg}");
+}
+
+#[test]
+fn start_inside_hard_obstacle_is_rejected() {
+    let text = GOOD.replace("start = [1.0, 1.0, 1.0]", "start = [45.0, 50.0, 50.0]");
+    let msg = parse(&text)
+        .err()
+        .map(|e| e.to_string())
+        .unwrap_or_default();
+    assert!(
+        msg.contains("vehicles[0].start") && msg.contains("H1"),
+        "{msg}"
+    );
+}
+
+#[test]
+fn unknown_key_and_wrong_type_are_named() {
+    let text = GOOD.replace("max_pitch_deg = 20.0", "max_pitch_deg = 20.0\nmax_pich = 3");
+    let msg = parse(&text)
+        .err()
+        .map(|e| e.to_string())
+        .unwrap_or_default();
+    assert!(msg.contains("max_pich"), "{msg}");
+    let text = GOOD.replace("radius_m = 10.0", "radius_m = \"ten\"");
+    let msg = parse(&text)
+        .err()
+        .map(|e| e.to_string())
+        .unwrap_or_default();
+    assert!(msg.contains("radius_m") && msg.contains("x.toml"), "{msg}");
+}
+
+#[test]
+fn duplicate_vehicle_and_zero_budget_are_rejected() {
+    let dup = GOOD.to_string()
+        + r#"
+[[vehicles]]
+id = "a"
+kind = "auv"
+start = [2.0, 1.0, 1.0]
+goal = [98.0, 99.0, 99.0]
+speed_min_mps = 0.5
+speed_max_mps = 1.5
+max_turn_deg = 35.0
+max_pitch_deg = 20.0
+"#;
+    let msg = parse(&dup).err().map(|e| e.to_string()).unwrap_or_default();
+    assert!(
+        msg.contains("vehicles[1].id") && msg.contains("duplicates"),
+        "{msg}"
+    );
+    let zero = GOOD.to_string() + "[optimizer]\niterations = 0\n";
+    let msg = parse(&zero)
+        .err()
+        .map(|e| e.to_string())
+        .unwrap_or_default();
+    assert!(msg.contains("optimizer.iterations"), "{msg}");
+}
+
+#[test]
+fn vehicle_ids_must_be_usable_on_the_network() {
+    for bad in ["", "auv 1", "auv/1", "auv*"] {
+        let text = GOOD.replace("id = \"a\"", &format!("id = {bad:?}"));
+        let msg = parse(&text)
+            .err()
+            .map(|e| e.to_string())
+            .unwrap_or_default();
+        assert!(
+            msg.contains("vehicles[0].id") && msg.contains("network"),
+            "{bad:?}: {msg}"
+        );
+    }
+}
+
+#[test]
+fn algorithm_names_round_trip() {
+    for a in Algorithm::ALL {
+        assert_eq!(a.as_str().parse::<Algorithm>(), Ok(a));
+    }
+    assert!("ga".parse::<Algorithm>().is_err());
+}
