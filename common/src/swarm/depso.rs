@@ -31,7 +31,7 @@
 use rand::Rng;
 
 use super::ldiwpso::ldiw_weight;
-use super::population::{Coefficients, Limits, Population};
+use super::population::{Coefficients, Population};
 use super::pso::PsoState;
 use super::{Problem, Progress, Solver};
 
@@ -173,12 +173,12 @@ impl<P: Problem> Solver<P> for DePso {
 
     fn init(&mut self, problem: &P) -> PsoState {
         // Step 1, seed 003 eq. (14): random initial positions (the problem's sampler).
-        let population = Population::sample(problem, self.particles.max(1), self.seed);
-        PsoState {
-            evaluations: population.evaluations,
-            population,
-            limits: Limits::of(problem, self.max_velocity_fraction),
-        }
+        PsoState::sampled(
+            problem,
+            self.particles,
+            self.seed,
+            self.max_velocity_fraction,
+        )
     }
 
     fn step(&mut self, problem: &P, mut state: PsoState, progress: Progress) -> PsoState {

@@ -18,7 +18,7 @@
 
 use rand::Rng;
 
-use super::population::{Limits, Particle, Population};
+use super::population::Particle;
 use super::pso::PsoState;
 use super::{Problem, Progress, Solver};
 
@@ -118,12 +118,12 @@ impl<P: Problem> Solver<P> for Ipso {
     }
 
     fn init(&mut self, problem: &P) -> PsoState {
-        let population = Population::sample(problem, self.particles.max(1), self.seed);
-        PsoState {
-            evaluations: population.evaluations,
-            population,
-            limits: Limits::of(problem, self.max_velocity_fraction),
-        }
+        PsoState::sampled(
+            problem,
+            self.particles,
+            self.seed,
+            self.max_velocity_fraction,
+        )
     }
 
     fn step(&mut self, problem: &P, mut state: PsoState, progress: Progress) -> PsoState {

@@ -7,7 +7,7 @@
 //! Table 5 (c1 = 2.0, c2 = 1.5, ω 0.9 → 0.4) so the three leg planners differ only in their
 //! mechanism.
 
-use super::population::{Coefficients, Limits, Population};
+use super::population::Coefficients;
 use super::pso::PsoState;
 use super::{Problem, Progress, Solver};
 
@@ -60,12 +60,12 @@ impl<P: Problem> Solver<P> for LdiwPso {
 
     fn init(&mut self, problem: &P) -> PsoState {
         // seed 003 eq. (14): uniform initial positions (or the problem's own sampler).
-        let population = Population::sample(problem, self.particles.max(1), self.seed);
-        PsoState {
-            evaluations: population.evaluations,
-            population,
-            limits: Limits::of(problem, self.max_velocity_fraction),
-        }
+        PsoState::sampled(
+            problem,
+            self.particles,
+            self.seed,
+            self.max_velocity_fraction,
+        )
     }
 
     fn step(&mut self, problem: &P, mut state: PsoState, progress: Progress) -> PsoState {

@@ -62,6 +62,25 @@ pub struct PsoState {
     pub evaluations: u64,
 }
 
+impl PsoState {
+    /// A population of `particles` (at least one) from the problem's sampler, evaluated, with
+    /// velocities capped at `max_velocity_fraction` of each range: the start every
+    /// single-population variant shares.
+    pub fn sampled<P: Problem>(
+        problem: &P,
+        particles: usize,
+        seed: u64,
+        max_velocity_fraction: f64,
+    ) -> PsoState {
+        let population = Population::sample(problem, particles.max(1), seed);
+        PsoState {
+            evaluations: population.evaluations,
+            population,
+            limits: Limits::of(problem, max_velocity_fraction),
+        }
+    }
+}
+
 impl SolverState for PsoState {
     fn best_cost(&self) -> f64 {
         self.population.elite_cost
@@ -85,12 +104,12 @@ impl<P: Problem> Solver<P> for Pso {
     }
 
     fn init(&mut self, problem: &P) -> PsoState {
-        let population = Population::sample(problem, self.particles, self.seed);
-        PsoState {
-            evaluations: population.evaluations,
-            population,
-            limits: Limits::of(problem, self.max_velocity_fraction),
-        }
+        PsoState::sampled(
+            problem,
+            self.particles,
+            self.seed,
+            self.max_velocity_fraction,
+        )
     }
 
     fn step(&mut self, problem: &P, mut state: PsoState, progress: Progress) -> PsoState {
