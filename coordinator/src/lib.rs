@@ -16,6 +16,7 @@ pub mod summary;
 pub mod svg;
 pub mod svg_current;
 pub mod svg_terrain;
+pub mod svg_tour;
 pub mod tour_planner;
 
 use std::io::IsTerminal;

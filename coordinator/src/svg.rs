@@ -276,6 +276,8 @@ fn draw_view(
         chart.draw_series(goals).map_err(fail("goal marker"))?;
     }
 
+    crate::svg_tour::draw_inspection_points(&mut chart, plan, (a, b), &colour)?;
+
     // Obstacle ids last, so no fill or path hides them; ids of spheres whose centres coincide in
     // this view are stacked instead of printed over each other.
     let label = (FONT, 14)
