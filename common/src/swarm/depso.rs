@@ -30,8 +30,8 @@
 
 use rand::Rng;
 
-use super::ldiwpso::ldiw_weight;
-use super::population::{Coefficients, Population};
+use super::ldiwpso::ldiw_move;
+use super::population::Population;
 use super::pso::PsoState;
 use super::{Problem, Progress, Solver};
 
@@ -183,13 +183,7 @@ impl<P: Problem> Solver<P> for DePso {
 
     fn step(&mut self, problem: &P, mut state: PsoState, progress: Progress) -> PsoState {
         // Step 3, seed 003 eq. (18)–(19) with the eq. (3) inertia.
-        let c = Coefficients {
-            w: ldiw_weight(self.w.0, self.w.1, progress),
-            c1: self.c1,
-            c2: self.c2,
-            c3: 0.0,
-        };
-        state.evaluations += state.population.step(problem, c, None, &state.limits);
+        ldiw_move(problem, &mut state, self.w, (self.c1, self.c2), progress);
         // Steps 4–6.
         state.evaluations += self.de_pass(problem, &mut state);
         state

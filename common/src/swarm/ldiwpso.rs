@@ -51,6 +51,24 @@ impl LdiwPso {
     }
 }
 
+/// One PSO move of the whole population with the eq. (3) inertia (`w` from its start to its
+/// end value) and learning factors `c`; the move DE-PSO also makes before its DE pass.
+pub fn ldiw_move<P: Problem>(
+    problem: &P,
+    state: &mut PsoState,
+    w: (f64, f64),
+    (c1, c2): (f64, f64),
+    progress: Progress,
+) {
+    let c = Coefficients {
+        w: ldiw_weight(w.0, w.1, progress),
+        c1,
+        c2,
+        c3: 0.0,
+    };
+    state.evaluations += state.population.step(problem, c, None, &state.limits);
+}
+
 impl<P: Problem> Solver<P> for LdiwPso {
     type State = PsoState;
 
@@ -69,13 +87,7 @@ impl<P: Problem> Solver<P> for LdiwPso {
     }
 
     fn step(&mut self, problem: &P, mut state: PsoState, progress: Progress) -> PsoState {
-        let c = Coefficients {
-            w: ldiw_weight(self.w.0, self.w.1, progress),
-            c1: self.c1,
-            c2: self.c2,
-            c3: 0.0,
-        };
-        state.evaluations += state.population.step(problem, c, None, &state.limits);
+        ldiw_move(problem, &mut state, self.w, (self.c1, self.c2), progress);
         state
     }
 }

@@ -326,6 +326,22 @@ impl Run<'_> {
         )
     }
 
+    /// An agent's liveliness token came (`alive`) or went, once the fleet has joined.
+    fn presence(&mut self, vehicle: &str, alive: bool) {
+        let Some(i) = self.index(vehicle) else {
+            return;
+        };
+        if alive {
+            self.seats[i].gone = None;
+            self.seats[i].alive = true;
+        } else {
+            self.lost(
+                i,
+                "its agent left the network (liveliness token gone)".into(),
+            );
+        }
+    }
+
     /// Vehicle `i`'s agent was seen to go: after [`GONE_GRACE`] without its elites it is
     /// planned here (see [`Run::collect`]).
     fn lost(&mut self, i: usize, why: String) {
@@ -452,18 +468,8 @@ impl Run<'_> {
                         }
                     }
                 }
-                Some(Event::Gone(v)) => {
-                    if let Some(i) = self.index(&v) {
-                        let why = "its agent left the network (liveliness token gone)";
-                        self.lost(i, why.to_string());
-                    }
-                }
-                Some(Event::Alive(v)) => {
-                    if let Some(i) = self.index(&v) {
-                        self.seats[i].gone = None;
-                        self.seats[i].alive = true;
-                    }
-                }
+                Some(Event::Gone(v)) => self.presence(&v, false),
+                Some(Event::Alive(v)) => self.presence(&v, true),
                 Some(Event::Message(AgentToCoordinator::Joined { .. })) => {}
                 Some(Event::Message(m @ AgentToCoordinator::Tour { .. })) => self.net.out_of_turn(
                     &format!("a tour from {} in an exchange mission", m.vehicle()),

@@ -160,20 +160,8 @@ impl Run<'_> {
                         self.degrade_tour(i, job, why);
                     }
                 }
-                Some(Event::Gone(v)) => {
-                    if let Some(i) = self.index(&v) {
-                        self.lost(
-                            i,
-                            "its agent left the network (liveliness token gone)".into(),
-                        );
-                    }
-                }
-                Some(Event::Alive(v)) => {
-                    if let Some(i) = self.index(&v) {
-                        self.seats[i].gone = None;
-                        self.seats[i].alive = true;
-                    }
-                }
+                Some(Event::Gone(v)) => self.presence(&v, false),
+                Some(Event::Alive(v)) => self.presence(&v, true),
                 Some(Event::Message(AgentToCoordinator::Joined { .. })) | None => {}
                 Some(Event::Message(m)) => self
                     .net
