@@ -38,6 +38,9 @@ pub enum Command {
     BenchEnergy(crate::bench_energy::BenchEnergyArgs),
     /// Compare LDIW-PSO, LCPSO and DE-PSO on cage-inspection tours (seed 003 Table 6).
     BenchCages(crate::bench_cages::BenchCagesArgs),
+    /// Compare seed 002's arc-smoothed Boustrophedon with the Hybrid A* baseline on seeded maps
+    /// (coverage, planning time, clearance, cross-track error; Table 2 and Figure 7).
+    BenchCoverage(crate::coverage_cmd::BenchCoverageArgs),
 }
 
 /// `shoal-coordinator plan`.

@@ -7,6 +7,7 @@ pub mod bench_functions;
 pub mod bench_pool;
 pub mod cli;
 pub mod compare;
+pub mod coverage_cmd;
 pub mod crawler_table;
 pub mod distributed;
 pub mod energy_planner;
@@ -14,6 +15,7 @@ pub mod generate;
 pub mod planner;
 pub mod summary;
 pub mod svg;
+pub mod svg_coverage;
 pub mod svg_current;
 pub mod svg_terrain;
 pub mod svg_tour;
@@ -47,6 +49,7 @@ pub fn run(command: Command, shutdown: Arc<AtomicBool>) -> anyhow::Result<i32> {
         Command::BenchFunctions(args) => bench_functions::command(&args, &shutdown),
         Command::BenchEnergy(args) => bench_energy::command(&args, &shutdown),
         Command::BenchCages(args) => bench_cages::command(&args, &shutdown),
+        Command::BenchCoverage(args) => coverage_cmd::bench_coverage(&args),
         Command::Health(args) => {
             shoal_common::health::check(&args.file, std::time::Duration::from_secs(10))
                 .map_err(anyhow::Error::msg)?;
@@ -201,6 +204,28 @@ pub fn distributed_options(
 
 fn plan_command(args: &PlanArgs, shutdown: Arc<AtomicBool>) -> anyhow::Result<i32> {
     let scenario = load_scenario(args)?;
+    if let Some(settings) = &scenario.coverage {
+        if !args.in_process {
+            bail!(
+                "{}: a [coverage] mission plans one crawler inside this process: add --in-process",
+                args.scenario.display()
+            );
+        }
+        std::fs::create_dir_all(&args.out)
+            .with_context(|| format!("cannot create output directory {}", args.out.display()))?;
+        let feasible = coverage_cmd::plan_coverage_command(
+            &args.scenario,
+            &scenario,
+            settings,
+            &args.out,
+            args.quiet,
+        )?;
+        return Ok(if feasible {
+            EXIT_FEASIBLE
+        } else {
+            EXIT_VIOLATIONS
+        });
+    }
     let algorithm = scenario.optimizer.algorithm;
     if algorithm.is_energy_planner() && !args.in_process {
         bail!(

@@ -16,10 +16,24 @@
 //!
 //! Frame: x east, y north, z up, metres, as in [`crate::terrain`].
 
+pub mod arcs;
+pub mod boustrophedon;
+pub mod boxes;
+pub mod dubins;
 pub mod edt;
+pub mod hybrid_astar;
+pub mod hybrid_detour;
+pub mod metrics;
+pub mod mission;
+pub mod params;
+pub mod path;
 pub mod perlin;
+pub mod reach;
+pub mod rows;
 pub mod spec;
+pub mod sweeps;
 pub mod terrain25;
+pub mod tracking;
 
 pub use perlin::{FractalNoise, Perlin};
 pub use spec::{

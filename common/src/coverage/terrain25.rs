@@ -40,6 +40,9 @@ pub enum Terrain25Error {
     /// A field of [`TerrainSpec`] or [`TraversalLimits`] is out of range.
     #[error("terrain spec: `{field}`: {what}")]
     InvalidSpec { field: String, what: String },
+    /// A coverage-planner setting is out of range.
+    #[error("coverage settings: `{field}`: {what}")]
+    InvalidParam { field: String, what: String },
     /// The map would have more than [`MAX_CELLS`] cells.
     #[error("a {nx} × {ny} cell map exceeds the {MAX_CELLS} cell limit")]
     TooLarge { nx: usize, ny: usize },

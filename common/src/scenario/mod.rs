@@ -10,10 +10,12 @@ use serde::{Deserialize, Serialize};
 
 use crate::geometry::Vec3;
 
+mod coverage;
 mod inspection;
 mod ocean;
 mod optimizer;
 mod seabed;
+pub use coverage::CoverageSettings;
 pub use inspection::{FirstPointMode, InspectionSettings};
 pub use ocean::{CurrentModel, Currents, EnergySettings};
 pub use optimizer::{Algorithm, DistributedSettings, OptimizerSettings};
@@ -87,6 +89,9 @@ pub struct Scenario {
     /// Cage-inspection tours (seed 003); required by the tour planners.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub inspection: Option<InspectionSettings>,
+    /// Area coverage by a mining crawler (seed 002); its presence makes `plan` cover an area.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub coverage: Option<CoverageSettings>,
 }
 
 /// Axis-aligned box of the navigation space, metres.
@@ -368,6 +373,9 @@ impl Scenario {
         if let Some(inspection) = &self.inspection {
             inspection.validate(self, &bad)?;
         }
+        if let Some(coverage) = &self.coverage {
+            coverage.validate(&bad)?;
+        }
         if algorithm.is_tour_planner() && self.inspection.is_none() {
             return Err(bad(
                 "optimizer.algorithm".into(),
@@ -432,11 +440,11 @@ impl Scenario {
             if v.kind != VehicleKind::Crawler {
                 continue;
             }
-            if self.seabed.is_none() {
+            if self.seabed.is_none() && self.coverage.is_none() {
                 return Err(bad(
                     format!("vehicles[{i}].kind"),
                     "\"crawler\"".into(),
-                    "a crawler drives on the seabed: add a [seabed] table (relief or grid)",
+                    "a crawler drives on the seabed: add a [seabed] table (relief or grid) or a [coverage] table",
                 ));
             }
             for (name, p) in [("start", &v.start), ("goal", &v.goal)] {

@@ -1,0 +1,270 @@
+//! Coverage missions (seed 002) from the command line: `plan` on a scenario with a `[coverage]`
+//! table, and `bench-coverage`, the paper's Table 2 comparison (arc method vs the Hybrid A*
+//! baseline) over seeded maps.
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+use anyhow::Context;
+use serde::Serialize;
+use shoal_common::coverage::boxes::Rect;
+use shoal_common::coverage::mission::{build_map, run_coverage, CoverageReport};
+use shoal_common::coverage::params::DetourMethod;
+use shoal_common::scenario::{CoverageSettings, Scenario};
+
+use crate::svg_coverage::render_coverage;
+
+/// `plan.json` of a coverage mission.
+#[derive(Debug, Serialize)]
+pub struct CoveragePlanFile<'a> {
+    /// Scenario name.
+    pub scenario: &'a str,
+    /// Always `coverage`: tells readers this is not a fleet trajectory plan.
+    pub kind: &'static str,
+    /// No clearance violation and, when tracked, the vehicle reached the end.
+    pub feasible: bool,
+    /// Plain-words remarks.
+    pub notices: Vec<String>,
+    /// The figures.
+    pub coverage: &'a CoverageReport,
+}
+
+/// The area a scenario covers: its bounds' horizontal extent.
+pub fn scenario_area(scenario: &Scenario) -> Rect {
+    let b = &scenario.bounds;
+    Rect::new(b.min[0], b.min[1], b.max[0], b.max[1])
+}
+
+/// Runs the mission of `scenario` (which has a `[coverage]` table) into `out`; returns the exit
+/// status (0 feasible, 2 otherwise, as `plan`).
+pub fn plan_coverage_command(
+    scenario_file: &Path,
+    scenario: &Scenario,
+    settings: &CoverageSettings,
+    out: &Path,
+    quiet: bool,
+) -> anyhow::Result<bool> {
+    let seed = settings.terrain_seed.unwrap_or(scenario.optimizer.seed);
+    let dir = scenario_file.parent().unwrap_or(Path::new("."));
+    let map = build_map(settings, seed, dir)
+        .with_context(|| format!("{}: [coverage] map", scenario_file.display()))?;
+    let mut last = -1.0;
+    let mut progress = |stage: &str, f: f64| {
+        if !quiet && (f - last >= 0.1 || f == 0.0 || f >= 1.0) {
+            eprintln!("coverage: {stage} {:.0} %", 100.0 * f);
+            last = if f >= 1.0 { -1.0 } else { f };
+        }
+    };
+    let terrain_seed = settings.heightmap.is_none().then_some(seed);
+    let (report, _) = run_coverage(
+        settings,
+        &map,
+        scenario_area(scenario),
+        terrain_seed,
+        scenario.optimizer.seed,
+        &mut progress,
+    )
+    .with_context(|| format!("{}: coverage mission", scenario_file.display()))?;
+    let notices = notices(&report);
+    let feasible = report.samples_below_clearance == 0
+        && report.tracking.as_ref().is_none_or(|t| t.reached_end);
+    let file = CoveragePlanFile {
+        scenario: &scenario.name,
+        kind: "coverage",
+        feasible,
+        notices: notices.clone(),
+        coverage: &report,
+    };
+    let json = serde_json::to_string_pretty(&file).context("cannot serialise the plan")?;
+    let path = out.join("plan.json");
+    std::fs::write(&path, json).with_context(|| format!("cannot write {}", path.display()))?;
+    let svg = render_coverage(&report, &map)?;
+    let path = out.join("plan.svg");
+    std::fs::write(&path, svg).with_context(|| format!("cannot write {}", path.display()))?;
+    let mut text = summary(&scenario.name, &report);
+    for n in &notices {
+        text.push_str(&format!("notice: {n}\n"));
+    }
+    text.push_str(&format!(
+        "Wrote {} and {}\n",
+        out.join("plan.json").display(),
+        out.join("plan.svg").display()
+    ));
+    let mut stdout = std::io::stdout().lock();
+    let _ = stdout.write_all(text.as_bytes());
+    Ok(feasible)
+}
+
+/// What a reader should know that the numbers alone do not say.
+fn notices(r: &CoverageReport) -> Vec<String> {
+    let mut out = Vec::new();
+    if r.samples_below_clearance > 0 {
+        out.push(format!(
+            "{} path samples are closer than {} m to impassable terrain (minimum {:.2} m)",
+            r.samples_below_clearance, r.safety_clearance_m, r.clearance.min
+        ));
+    }
+    let [_, _, _, transits, unreached, stranded] = r.event_counts;
+    if transits > 0 {
+        out.push(format!(
+            "{transits} transits ({:.0} m) join sweeps the Boustrophedon could not chain",
+            r.length_by_kind_m[3]
+        ));
+    }
+    if unreached + stranded > 0 {
+        out.push(format!(
+            "{unreached} row stretches were not reached and {stranded} sweeps ended in a dead end; that area is left uncovered"
+        ));
+    }
+    if let Some(t) = &r.tracking {
+        if !t.reached_end {
+            out.push("the tracked vehicle did not reach the end of the path in time".into());
+        }
+        if t.qp_failures > 0 {
+            out.push(format!(
+                "{} of {} MPC solves failed and held the previous command",
+                t.qp_failures, t.qp_solves
+            ));
+        }
+    }
+    out
+}
+
+/// The human summary of one mission.
+pub fn summary(name: &str, r: &CoverageReport) -> String {
+    let mut s = format!(
+        "{name}: coverage {:.2} % of the area ({:.2} % of the passable area), planning {:.3} s\n",
+        100.0 * r.coverage.ratio,
+        100.0 * r.coverage.ratio_of_passable,
+        r.planning_time_s
+    );
+    let [det, vb, skip, tr, unr, st] = r.event_counts;
+    s.push_str(&format!(
+        "  path {:.1} km in {} sweeps: {det} detours, {vb} virtual boundaries, {skip} row skips, {tr} transits, {unr} unreached, {st} dead ends\n",
+        r.path_length_m / 1000.0,
+        r.sweeps
+    ));
+    s.push_str(&format!(
+        "  clearance min {:.2} m, median {:.1} m; {} samples < {} m; slope median {:.1}°, max {:.1}°; max |κ| {:.3} 1/m\n",
+        r.clearance.min,
+        r.clearance.median,
+        r.samples_below_clearance,
+        r.safety_clearance_m,
+        r.slope.median,
+        r.slope.max,
+        r.max_curvature
+    ));
+    if let Some(t) = &r.tracking {
+        s.push_str(&format!(
+            "  tracking: |cte| max {:.2} m, median {:.3} m, rms {:.3} m; {} QPs ({} failed); {:.1} h simulated in {:.1} s\n",
+            t.max_abs_cte_m,
+            t.median_abs_cte_m,
+            t.rms_cte_m,
+            t.qp_solves,
+            t.qp_failures,
+            t.sim_time_s / 3600.0,
+            t.wall_time_s
+        ));
+    }
+    s
+}
+
+/// `shoal-coordinator bench-coverage`.
+#[derive(Debug, Clone, clap::Args)]
+pub struct BenchCoverageArgs {
+    /// Coverage scenario file.
+    #[arg(default_value = "scenarios/cpp-seabed.toml")]
+    pub scenario: PathBuf,
+    /// Terrain seeds 1..=N.
+    #[arg(long, default_value_t = 10)]
+    pub seeds: u64,
+    /// Skip the tracking simulation (planning figures only).
+    #[arg(long)]
+    pub no_track: bool,
+    /// Also write the table to this file.
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+}
+
+/// Runs both methods on every seed and prints seed 002 Table 2 style rows.
+pub fn bench_coverage(args: &BenchCoverageArgs) -> anyhow::Result<i32> {
+    let scenario = Scenario::load(&args.scenario)?;
+    let Some(settings) = scenario.coverage.clone() else {
+        anyhow::bail!("{}: no [coverage] table", args.scenario.display());
+    };
+    let dir = args.scenario.parent().unwrap_or(Path::new("."));
+    let mut table = String::from(
+        "| seed | method | coverage % | passable % | planning s | samples < clearance | min clearance m | max |cte| m | median |cte| m | detours | virtual boundaries | transits | unreached |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
+    );
+    let mut sums: Vec<(DetourMethod, Vec<[f64; 5]>)> = Vec::new();
+    for seed in 1..=args.seeds {
+        for method in [DetourMethod::Arcs, DetourMethod::HybridAStar] {
+            let mut s = settings.clone();
+            s.planner.detour = method;
+            s.track = !args.no_track;
+            let map = build_map(&s, seed, dir)?;
+            let (r, _) = run_coverage(
+                &s,
+                &map,
+                scenario_area(&scenario),
+                Some(seed),
+                seed,
+                &mut |_, _| {},
+            )?;
+            let (max_cte, med_cte) = r.tracking.as_ref().map_or((f64::NAN, f64::NAN), |t| {
+                (t.max_abs_cte_m, t.median_abs_cte_m)
+            });
+            let name = match method {
+                DetourMethod::Arcs => "arcs",
+                DetourMethod::HybridAStar => "hybrid-a-star",
+            };
+            let row = format!(
+                "| {seed} | {name} | {:.2} | {:.2} | {:.3} | {} | {:.2} | {:.2} | {:.3} | {} | {} | {} | {} |\n",
+                100.0 * r.coverage.ratio,
+                100.0 * r.coverage.ratio_of_passable,
+                r.planning_time_s,
+                r.samples_below_clearance,
+                r.clearance.min,
+                max_cte,
+                med_cte,
+                r.event_counts[0],
+                r.event_counts[1],
+                r.event_counts[3],
+                r.event_counts[4]
+            );
+            eprint!("{row}");
+            table.push_str(&row);
+            let entry = [
+                r.coverage.ratio,
+                r.planning_time_s,
+                r.samples_below_clearance as f64,
+                max_cte,
+                med_cte,
+            ];
+            match sums.iter_mut().find(|(m, _)| *m == method) {
+                Some((_, v)) => v.push(entry),
+                None => sums.push((method, vec![entry])),
+            }
+        }
+    }
+    table.push_str("\n| method | mean coverage % | min coverage % | max planning s | runs with samples < clearance | worst max |cte| m | mean median |cte| m |\n|---|---|---|---|---|---|---|\n");
+    for (method, rows) in &sums {
+        let n = rows.len().max(1) as f64;
+        let worst = |k: usize| rows.iter().map(|r| r[k]).fold(f64::NEG_INFINITY, f64::max);
+        table.push_str(&format!(
+            "| {:?} | {:.2} | {:.2} | {:.3} | {} | {:.2} | {:.3} |\n",
+            method,
+            100.0 * rows.iter().map(|r| r[0]).sum::<f64>() / n,
+            100.0 * rows.iter().map(|r| r[0]).fold(f64::INFINITY, f64::min),
+            worst(1),
+            rows.iter().filter(|r| r[2] > 0.0).count(),
+            worst(3),
+            rows.iter().map(|r| r[4]).sum::<f64>() / n
+        ));
+    }
+    print!("{table}");
+    if let Some(path) = &args.out {
+        std::fs::write(path, &table).with_context(|| format!("cannot write {}", path.display()))?;
+    }
+    Ok(0)
+}
