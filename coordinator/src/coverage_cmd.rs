@@ -194,7 +194,7 @@ pub fn bench_coverage(args: &BenchCoverageArgs) -> anyhow::Result<i32> {
     };
     let dir = args.scenario.parent().unwrap_or(Path::new("."));
     let mut table = String::from(
-        "| seed | method | coverage % | passable % | planning s | samples < clearance | min clearance m | max |cte| m | median |cte| m | detours | virtual boundaries | transits | unreached |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
+        "| seed | method | coverage % | passable % | planning s | samples < clearance | min clearance m | max abs cte m | median abs cte m | detours | virtual boundaries | transits | unreached |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     let mut sums: Vec<(DetourMethod, Vec<[f64; 5]>)> = Vec::new();
     for seed in 1..=args.seeds {
@@ -247,7 +247,7 @@ pub fn bench_coverage(args: &BenchCoverageArgs) -> anyhow::Result<i32> {
             }
         }
     }
-    table.push_str("\n| method | mean coverage % | min coverage % | max planning s | runs with samples < clearance | worst max |cte| m | mean median |cte| m |\n|---|---|---|---|---|---|---|\n");
+    table.push_str("\n| method | mean coverage % | min coverage % | max planning s | runs with samples < clearance | worst max abs cte m | mean median abs cte m |\n|---|---|---|---|---|---|---|\n");
     for (method, rows) in &sums {
         let n = rows.len().max(1) as f64;
         let worst = |k: usize| rows.iter().map(|r| r[k]).fold(f64::NEG_INFINITY, f64::max);
