@@ -178,9 +178,9 @@ mod tests {
         assert_eq!(book.stretches(2), &[(5.0, 30.0), (60.0, 95.0)]);
         assert_eq!(book.stretches(3), &[(5.0, 45.0), (60.0, 95.0)]);
         assert_eq!(book.next_open(), Some((0, 0)));
-        book.drive(0, 95.0, 49.0);
+        book.drive(0, 95.0, 51.0);
         assert!(!book.is_done(0, 10.0));
-        book.drive(0, 49.0, 40.0);
+        book.drive(0, 51.0, 40.0);
         assert!(book.is_done(0, 10.0));
         assert_eq!(book.next_open(), Some((1, 0)));
         // Inside a box counts as done: nothing to land on there.
