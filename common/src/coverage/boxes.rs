@@ -170,8 +170,6 @@ pub fn no_go_boxes(map: &TerrainMap25, clearance: f64, merge_gap: f64) -> Vec<Re
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::coverage::TraversalLimits;
-    use crate::terrain::HeightGrid;
     use approx::assert_abs_diff_eq;
 
     #[test]
@@ -214,14 +212,7 @@ mod tests {
         }
         // A single steep spike: its four neighbours see a 20 m rise over 4 m.
         z[15 * n + 15] = 20.0;
-        let grid = match HeightGrid::new([0.0, 0.0], 2.0, n, n, z) {
-            Ok(g) => g,
-            Err(e) => panic!("test grid: {e}"),
-        };
-        match TerrainMap25::from_grid(&grid, &TraversalLimits::default()) {
-            Ok(map) => map,
-            Err(e) => panic!("test map: {e}"),
-        }
+        crate::coverage::test_map(n, z)
     }
 
     #[test]

@@ -212,8 +212,6 @@ pub fn coverage(
 mod tests {
     use super::*;
     use crate::coverage::path::PieceKind;
-    use crate::coverage::TraversalLimits;
-    use crate::terrain::HeightGrid;
     use approx::assert_abs_diff_eq;
 
     fn flat_map(n: usize, cliff: Option<(usize, usize)>) -> TerrainMap25 {
@@ -221,14 +219,7 @@ mod tests {
         if let Some((i, j)) = cliff {
             z[j * n + i] = 50.0;
         }
-        let grid = match HeightGrid::new([0.0, 0.0], 2.0, n, n, z) {
-            Ok(g) => g,
-            Err(e) => panic!("{e}"),
-        };
-        match TerrainMap25::from_grid(&grid, &TraversalLimits::default()) {
-            Ok(m) => m,
-            Err(e) => panic!("{e}"),
-        }
+        crate::coverage::test_map(n, z)
     }
 
     fn line(y: f64, x0: f64, x1: f64) -> Vec<PathSample> {

@@ -41,3 +41,17 @@ pub use spec::{
     UndulationSpec,
 };
 pub use terrain25::{slope_field_deg, Terrain25Error, TerrainMap25, MAX_CELLS};
+
+/// Test maps: an `n × n` grid of 2 m cells from row-major heights (south row first), with the
+/// default limits.
+#[cfg(test)]
+pub(crate) fn test_map(n: usize, z: Vec<f64>) -> TerrainMap25 {
+    let grid = match crate::terrain::HeightGrid::new([0.0, 0.0], 2.0, n, n, z) {
+        Ok(g) => g,
+        Err(e) => panic!("test grid: {e}"),
+    };
+    match TerrainMap25::from_grid(&grid, &TraversalLimits::default()) {
+        Ok(map) => map,
+        Err(e) => panic!("test map: {e}"),
+    }
+}
