@@ -105,7 +105,13 @@ fn check_plan(
             s.y,
             s.kind
         );
-        if let Some(b) = plan.boxes.iter().find(|b| b.contains_strictly(s.x, s.y)) {
+        // The box-interior phase drives inside merged boxes, outside each obstacle's own.
+        let no_go = if plan.inner_boxes.is_empty() {
+            &plan.boxes
+        } else {
+            &plan.inner_boxes
+        };
+        if let Some(b) = no_go.iter().find(|b| b.contains_strictly(s.x, s.y)) {
             panic!("sample ({}, {}) [{:?}] inside box {b:?}", s.x, s.y, s.kind);
         }
     }
@@ -463,5 +469,90 @@ fn invalid_settings_and_areas_name_the_field_and_value() -> TestResult {
         &CoverageParams::default(),
     )?;
     assert_eq!(one.rows, 1);
+    Ok(())
+}
+
+/// Two steep plateaus 30 m apart (north–south) whose inflated boxes are merged into one: the
+/// first phase treats the merged box as no-go, the box-interior phase then sweeps the row that
+/// runs between them (y = 135 m, 15 m from either cliff), still outside the plateaus' band boxes
+/// and at the safety clearance.
+#[test]
+fn the_gap_inside_a_merged_box_is_swept_by_the_interior_phase() -> TestResult {
+    let a = block(100.0, 100.0, 200.0, 120.0, 40.0);
+    let b = block(100.0, 150.0, 200.0, 170.0, 40.0);
+    let map = grid_map(300.0, |x, y| a(x, y) + b(x, y))?;
+    let params = CoverageParams {
+        merge_gap_m: Some(20.0),
+        ..CoverageParams::default()
+    };
+    let plan = plan_coverage(&map, Rect::new(0.0, 0.0, 300.0, 300.0), &params)?;
+    // One merged box over the gap in the first phase; none in the second.
+    let spans_gap = |r: &Rect| r.y0 < 130.0 && r.y1 > 140.0 && r.x0 < 150.0 && r.x1 > 150.0;
+    assert!(plan.boxes.iter().any(spans_gap), "{:?}", plan.boxes);
+    assert!(!plan.inner_boxes.is_empty());
+    assert!(
+        !plan.inner_boxes.iter().any(spans_gap),
+        "{:?}",
+        plan.inner_boxes
+    );
+    let samples = check_plan(&plan, &map, &params, 0.5);
+    let in_gap = samples
+        .iter()
+        .filter(|s| (s.y - 135.0).abs() < 1e-6 && s.x > 110.0 && s.x < 190.0)
+        .count();
+    assert!(
+        in_gap > 100,
+        "{in_gap} samples on the gap's row between the plateaus"
+    );
+    Ok(())
+}
+
+/// Two plateaus on the west edge leave a corridor 30 m high between them (y 120–150 m) in which
+/// no U-turn keeps the 8 m clearance. A sweep driving west along the corridor's row (y = 135 m)
+/// whose next row is already covered must not end at the corridor's boxed-in west end, where a
+/// forward-only crawler cannot turn and every later transit would fail: it stops where the turn
+/// it found fits, east of the plateaus, and gives the rest of the row up.
+#[test]
+fn no_sweep_ends_in_a_boxed_in_row_end() -> TestResult {
+    use shoal_common::coverage::boustrophedon::{ArcDetour, Field, Machine, RowState, SweepEnd};
+    use shoal_common::coverage::boxes::no_go_boxes;
+    use shoal_common::coverage::path::CoveragePath;
+    use shoal_common::coverage::rows::RowBook;
+    let a = block(0.0, 100.0, 60.0, 120.0, 40.0);
+    let b = block(0.0, 150.0, 60.0, 170.0, 40.0);
+    let map = grid_map(300.0, |x, y| a(x, y) + b(x, y))?;
+    let params = CoverageParams::default();
+    let field = Field::new(
+        &map,
+        Rect::new(0.0, 0.0, 300.0, 300.0),
+        no_go_boxes(&map, params.safety_clearance_m, params.merge_gap()),
+        &params,
+        true,
+    );
+    let ys: Vec<f64> = (0..30).map(|k| 5.0 + 10.0 * k as f64).collect();
+    let mut book = RowBook::new(ys, (5.0, 295.0), &field.boxes, 5.0);
+    book.drive(14, 5.0, 295.0); // the row north of the corridor is covered
+    let mut m = Machine {
+        field: &field,
+        path: CoveragePath::default(),
+        events: Vec::new(),
+        book,
+    };
+    let start = RowState {
+        row: 13,
+        y: 135.0,
+        dir: -1.0,
+        x: 250.0,
+        x_end: 5.0,
+    };
+    assert_eq!(m.sweep(start, &ArcDetour), SweepEnd::Covered);
+    let Some((_, last)) = m.path.pieces.last() else {
+        panic!("no path");
+    };
+    let end = last.end();
+    // The plateaus' cliffs end at x = 60 m; a turn needs 8 m of clearance beyond them.
+    assert!(end.x > 60.0, "the sweep ended at ({}, {})", end.x, end.y);
+    assert!((end.y - 135.0).abs() < 1e-9);
+    assert!(m.book.is_done(13, 20.0), "the corridor's rest is given up");
     Ok(())
 }

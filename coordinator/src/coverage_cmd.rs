@@ -75,14 +75,27 @@ pub fn plan_coverage_command(
         notices: notices.clone(),
         coverage: &report,
     };
-    let json = serde_json::to_string_pretty(&file).context("cannot serialise the plan")?;
+    let svg = render_coverage(&report, &map)?;
+    write_outputs(out, &file, &svg, summary(&scenario.name, &report), &notices)?;
+    Ok(feasible)
+}
+
+/// Writes `plan.json` (from `file`) and `plan.svg` into `out`, then prints `summary`, the
+/// notices and where the files are.
+pub fn write_outputs(
+    out: &Path,
+    file: &impl Serialize,
+    svg: &str,
+    summary: String,
+    notices: &[String],
+) -> anyhow::Result<()> {
+    let json = serde_json::to_string_pretty(file).context("cannot serialise the plan")?;
     let path = out.join("plan.json");
     std::fs::write(&path, json).with_context(|| format!("cannot write {}", path.display()))?;
-    let svg = render_coverage(&report, &map)?;
     let path = out.join("plan.svg");
     std::fs::write(&path, svg).with_context(|| format!("cannot write {}", path.display()))?;
-    let mut text = summary(&scenario.name, &report);
-    for n in &notices {
+    let mut text = summary;
+    for n in notices {
         text.push_str(&format!("notice: {n}\n"));
     }
     text.push_str(&format!(
@@ -90,13 +103,12 @@ pub fn plan_coverage_command(
         out.join("plan.json").display(),
         out.join("plan.svg").display()
     ));
-    let mut stdout = std::io::stdout().lock();
-    let _ = stdout.write_all(text.as_bytes());
-    Ok(feasible)
+    let _ = std::io::stdout().lock().write_all(text.as_bytes());
+    Ok(())
 }
 
 /// What a reader should know that the numbers alone do not say.
-fn notices(r: &CoverageReport) -> Vec<String> {
+pub fn notices(r: &CoverageReport) -> Vec<String> {
     let mut out = Vec::new();
     if r.samples_below_clearance > 0 {
         out.push(format!(

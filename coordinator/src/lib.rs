@@ -8,6 +8,7 @@ pub mod bench_pool;
 pub mod cli;
 pub mod compare;
 pub mod coverage_cmd;
+pub mod coverage_fleet;
 pub mod crawler_table;
 pub mod distributed;
 pub mod energy_planner;
@@ -205,21 +206,37 @@ pub fn distributed_options(
 fn plan_command(args: &PlanArgs, shutdown: Arc<AtomicBool>) -> anyhow::Result<i32> {
     let scenario = load_scenario(args)?;
     if let Some(settings) = &scenario.coverage {
-        if !args.in_process {
+        let fleet = scenario.vehicles.len() > 1;
+        if !fleet && !args.in_process {
             bail!(
-                "{}: a [coverage] mission plans one crawler inside this process: add --in-process",
+                "{}: a [coverage] mission with one crawler plans inside this process: add --in-process (several crawlers split the area among their agents)",
                 args.scenario.display()
             );
         }
         std::fs::create_dir_all(&args.out)
             .with_context(|| format!("cannot create output directory {}", args.out.display()))?;
-        let feasible = coverage_cmd::plan_coverage_command(
-            &args.scenario,
-            &scenario,
-            settings,
-            &args.out,
-            args.quiet,
-        )?;
+        let feasible = if fleet {
+            let options = if args.in_process {
+                None
+            } else {
+                Some(distributed_options(args, &scenario)?)
+            };
+            coverage_fleet::plan_fleet_coverage(
+                &args.scenario,
+                &scenario,
+                &args.out,
+                args.quiet,
+                options.as_ref().map(|o| (o, shutdown.as_ref())),
+            )?
+        } else {
+            coverage_cmd::plan_coverage_command(
+                &args.scenario,
+                &scenario,
+                settings,
+                &args.out,
+                args.quiet,
+            )?
+        };
         return Ok(if feasible {
             EXIT_FEASIBLE
         } else {

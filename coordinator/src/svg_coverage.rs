@@ -4,6 +4,8 @@
 //! slope under the path, |cross-track error| — on the right.
 
 use plotters::prelude::*;
+use shoal_common::coverage::boxes::Rect;
+use shoal_common::coverage::fleet::FleetCoverageReport;
 use shoal_common::coverage::metrics::Distribution;
 use shoal_common::coverage::mission::CoverageReport;
 use shoal_common::coverage::TerrainMap25;
@@ -18,39 +20,37 @@ const NO_GO: RGBColor = RGBColor(210, 30, 30);
 const PLANNED: RGBColor = RGBColor(30, 70, 200);
 const TRACKED: RGBColor = RGBColor(240, 140, 0);
 
-/// Renders the report over its map.
-pub fn render_coverage(report: &CoverageReport, map: &TerrainMap25) -> anyhow::Result<String> {
-    let mut buf = String::new();
-    {
-        let root = SVGBackend::with_string(&mut buf, SIZE).into_drawing_area();
-        root.fill(&WHITE).map_err(fail("background"))?;
-        let (left, right) = root.split_horizontally(960);
-        draw_map(&left, report, map)?;
-        let panels = right.split_evenly((3, 1));
-        let cte = report.tracking.as_ref().map(|t| &t.cross_track);
-        let clearance_title = format!(
-            "(a) clearance to impassable cells, m — {} samples < {} m",
-            report.samples_below_clearance, report.safety_clearance_m
-        );
-        let hists: [(&str, Option<&Distribution>); 3] = [
-            (&clearance_title, Some(&report.clearance)),
-            ("(b) slope under the path, degrees", Some(&report.slope)),
-            ("(c) |cross-track error| of the tracked path, m", cte),
-        ];
-        for (area, (title, dist)) in panels.iter().zip(hists) {
-            draw_histogram(area, title, dist)?;
-        }
-        root.present().map_err(fail("document"))?;
-    }
-    Ok(buf)
+/// Colours of the crawlers of a fleet (planned paths; tracked paths are drawn lighter).
+const FLEET: [RGBColor; 6] = [
+    RGBColor(30, 70, 200),
+    RGBColor(0, 140, 70),
+    RGBColor(150, 40, 170),
+    RGBColor(0, 150, 170),
+    RGBColor(120, 80, 20),
+    RGBColor(200, 30, 120),
+];
+
+/// One crawler's paths on the map.
+struct Track<'a> {
+    label: String,
+    planned: &'a [[f64; 2]],
+    tracked: &'a [[f64; 2]],
+    planned_colour: RGBColor,
+    tracked_colour: RGBColor,
 }
 
-fn draw_map<DB: DrawingBackend>(
-    area: &DrawingArea<DB, plotters::coord::Shift>,
-    report: &CoverageReport,
-    map: &TerrainMap25,
-) -> anyhow::Result<()> {
-    let a = report.area;
+/// What the map panel shows.
+struct MapView<'a> {
+    area: Rect,
+    title: String,
+    boxes: &'a [Rect],
+    tracks: Vec<Track<'a>>,
+    /// Strip edges of a fleet (drawn as lines across the area).
+    strip_edges: Vec<f64>,
+}
+
+/// Renders the report over its map.
+pub fn render_coverage(report: &CoverageReport, map: &TerrainMap25) -> anyhow::Result<String> {
     let title = format!(
         "{} — coverage {:.2} %, planning {:.3} s, {} detours, {} virtual boundaries",
         match report.method {
@@ -62,8 +62,117 @@ fn draw_map<DB: DrawingBackend>(
         report.event_counts[0],
         report.event_counts[1]
     );
+    let view = MapView {
+        area: report.area,
+        title,
+        boxes: &report.boxes,
+        tracks: vec![Track {
+            label: "planned".into(),
+            planned: &report.planned_path,
+            tracked: &report.tracked_path,
+            planned_colour: PLANNED,
+            tracked_colour: TRACKED,
+        }],
+        strip_edges: Vec::new(),
+    };
+    let clearance_title = format!(
+        "(a) clearance to impassable cells, m — {} samples < {} m",
+        report.samples_below_clearance, report.safety_clearance_m
+    );
+    let cte = report.tracking.as_ref().map(|t| &t.cross_track);
+    render(
+        map,
+        &view,
+        [
+            (&clearance_title, Some(&report.clearance)),
+            ("(b) slope under the path, degrees", Some(&report.slope)),
+            ("(c) |cross-track error| of the tracked path, m", cte),
+        ],
+    )
+}
+
+/// Renders a fleet's strips, paths and fleet-wide distributions over the map.
+pub fn render_fleet_coverage(
+    report: &FleetCoverageReport,
+    map: &TerrainMap25,
+) -> anyhow::Result<String> {
+    let sep = &report.separation;
+    let title = format!(
+        "{} crawlers — coverage {:.2} %, min separation {:.1} m (d_min {} m)",
+        report.vehicles.len(),
+        100.0 * report.coverage.ratio,
+        sep.min_distance_m,
+        sep.d_min_m
+    );
+    let tracks = report
+        .vehicles
+        .iter()
+        .enumerate()
+        .map(|(k, v)| {
+            let colour = FLEET[k % FLEET.len()];
+            Track {
+                label: v.vehicle.clone(),
+                planned: &v.report.planned_path,
+                tracked: &v.report.tracked_path,
+                planned_colour: colour,
+                tracked_colour: TRACKED,
+            }
+        })
+        .collect();
+    let view = MapView {
+        area: report.area,
+        title,
+        boxes: report.vehicles.first().map_or(&[], |v| &v.report.boxes),
+        tracks,
+        strip_edges: report.vehicles.iter().skip(1).map(|v| v.strip.y0).collect(),
+    };
+    let clearance_title = format!(
+        "(a) clearance to impassable cells, m — {} samples < {} m",
+        report.samples_below_clearance, report.safety_clearance_m
+    );
+    render(
+        map,
+        &view,
+        [
+            (&clearance_title, Some(&report.clearance)),
+            ("(b) slope under the paths, degrees", Some(&report.slope)),
+            (
+                "(c) |cross-track error| of the tracked paths, m",
+                report.cross_track.as_ref(),
+            ),
+        ],
+    )
+}
+
+/// The map on the left, three histograms on the right.
+fn render(
+    map: &TerrainMap25,
+    view: &MapView,
+    hists: [(&str, Option<&Distribution>); 3],
+) -> anyhow::Result<String> {
+    let mut buf = String::new();
+    {
+        let root = SVGBackend::with_string(&mut buf, SIZE).into_drawing_area();
+        root.fill(&WHITE).map_err(fail("background"))?;
+        let (left, right) = root.split_horizontally(960);
+        draw_map(&left, view, map)?;
+        let panels = right.split_evenly((3, 1));
+        for (area, (title, dist)) in panels.iter().zip(hists) {
+            draw_histogram(area, title, dist)?;
+        }
+        root.present().map_err(fail("document"))?;
+    }
+    Ok(buf)
+}
+
+fn draw_map<DB: DrawingBackend>(
+    area: &DrawingArea<DB, plotters::coord::Shift>,
+    view: &MapView,
+    map: &TerrainMap25,
+) -> anyhow::Result<()> {
+    let a = view.area;
     let mut chart = ChartBuilder::on(area)
-        .caption(title, ("sans-serif", 18))
+        .caption(&view.title, ("sans-serif", 18))
         .margin(10)
         .x_label_area_size(30)
         .y_label_area_size(45)
@@ -104,8 +213,7 @@ fn draw_map<DB: DrawingBackend>(
         .map_err(fail("terrain"))?;
     chart
         .draw_series(
-            report
-                .boxes
+            view.boxes
                 .iter()
                 .map(|b| Rectangle::new([(b.x0, b.y0), (b.x1, b.y1)], NO_GO.mix(0.25).filled())),
         )
@@ -114,25 +222,44 @@ fn draw_map<DB: DrawingBackend>(
         .legend(|(x, y)| Rectangle::new([(x, y - 5), (x + 14, y + 5)], NO_GO.mix(0.4).filled()));
     chart
         .draw_series(
-            report
-                .boxes
+            view.boxes
                 .iter()
                 .map(|b| Rectangle::new([(b.x0, b.y0), (b.x1, b.y1)], NO_GO.stroke_width(2))),
         )
         .map_err(fail("no-go box edges"))?;
-    let planned: Vec<(f64, f64)> = report.planned_path.iter().map(|p| (p[0], p[1])).collect();
-    chart
-        .draw_series(LineSeries::new(planned, PLANNED.stroke_width(1)))
-        .map_err(fail("planned path"))?
-        .label("planned")
-        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 14, y)], PLANNED.stroke_width(2)));
-    if !report.tracked_path.is_empty() {
-        let tracked: Vec<(f64, f64)> = report.tracked_path.iter().map(|p| (p[0], p[1])).collect();
+    for t in &view.tracks {
+        let planned: Vec<(f64, f64)> = t.planned.iter().map(|p| (p[0], p[1])).collect();
+        let colour = t.planned_colour;
         chart
-            .draw_series(LineSeries::new(tracked, TRACKED.mix(0.8).stroke_width(1)))
-            .map_err(fail("tracked path"))?
-            .label("tracked")
-            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 14, y)], TRACKED.stroke_width(2)));
+            .draw_series(LineSeries::new(planned, colour.stroke_width(1)))
+            .map_err(fail("planned path"))?
+            .label(t.label.clone())
+            .legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 14, y)], colour.stroke_width(2))
+            });
+    }
+    for (k, t) in view.tracks.iter().enumerate() {
+        if t.tracked.is_empty() {
+            continue;
+        }
+        let tracked: Vec<(f64, f64)> = t.tracked.iter().map(|p| (p[0], p[1])).collect();
+        let colour = t.tracked_colour;
+        let series = chart
+            .draw_series(LineSeries::new(tracked, colour.mix(0.8).stroke_width(1)))
+            .map_err(fail("tracked path"))?;
+        if k == 0 {
+            series.label("tracked").legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 14, y)], colour.stroke_width(2))
+            });
+        }
+    }
+    for &y in &view.strip_edges {
+        chart
+            .draw_series(LineSeries::new(
+                [(a.x0, y), (a.x1, y)],
+                BLACK.stroke_width(2),
+            ))
+            .map_err(fail("strip edge"))?;
     }
     chart
         .configure_series_labels()

@@ -10,6 +10,7 @@ use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use shoal_common::cost::FleetModel;
+use shoal_common::coverage::fleet::FleetCoverage;
 use shoal_common::distributed::follower::{FollowerSettings, Followers};
 use shoal_common::distributed::{round_iterations, rounds, Chromosome, Context};
 use shoal_common::scenario::Scenario;
@@ -91,6 +92,9 @@ pub fn run(
     stop: &AtomicBool,
     idle: Duration,
 ) -> MissionReport {
+    if a.scenario.coverage.is_some() {
+        return run_strip(&a, send, dropped);
+    }
     if a.scenario.optimizer.algorithm.is_tour_planner() {
         return run_tour(&a, send, dropped);
     }
@@ -170,16 +174,70 @@ fn run_tour(
     send: &dyn Fn(AgentToCoordinator),
     dropped: &AtomicU32,
 ) -> MissionReport {
+    run_share(a, send, dropped, &|a| {
+        let job = FleetTours::new(&a.scenario)?;
+        let tour = job.plan_vehicle(a.index);
+        let words = format!(
+            "tour of {} points planned: {:.1} m",
+            tour.order.len(),
+            tour.tour_length_m
+        );
+        Ok((
+            AgentToCoordinator::tour(&a.mission, &a.vehicle, &tour),
+            words,
+        ))
+    })
+}
+
+/// A fleet coverage mission (seed 002 with several crawlers): the vehicle's strip follows from
+/// the scenario alone ([`FleetCoverage`]), so the agent builds the seabed map, plans (and
+/// tracks) its strip, sends it, and is done. A heightmap file is looked up from the agent's
+/// working directory; when it is not there the coordinator plans the strip instead.
+fn run_strip(
+    a: &Assignment,
+    send: &dyn Fn(AgentToCoordinator),
+    dropped: &AtomicU32,
+) -> MissionReport {
+    run_share(a, send, dropped, &|a| {
+        let job = FleetCoverage::new(&a.scenario)?;
+        let map = job.map(Path::new(".")).map_err(|e| e.to_string())?;
+        let plan = job
+            .plan_vehicle(&map, a.index, &mut |stage, f| {
+                tracing::debug!("strip {}: {stage} {:.0} %", a.index, 100.0 * f)
+            })
+            .map_err(|e| e.to_string())?;
+        let words = format!(
+            "strip {} planned: coverage {:.2} %, {:.0} m",
+            a.index,
+            100.0 * plan.report.coverage.ratio,
+            plan.path.length()
+        );
+        let message = AgentToCoordinator::Coverage {
+            mission: a.mission.clone(),
+            vehicle: a.vehicle.clone(),
+            strip: a.index as u32,
+            plan: Box::new(plan),
+        };
+        Ok((message, words))
+    })
+}
+
+/// Plans a one-shot share: the result message and its summary in words, or why there is none.
+type SharePlanner = dyn Fn(&Assignment) -> Result<(AgentToCoordinator, String), String>;
+
+/// A mission planned in one go: `plan` gives the result message and its summary in words (or
+/// why there is none); the result goes up, then `Done`.
+fn run_share(
+    a: &Assignment,
+    send: &dyn Fn(AgentToCoordinator),
+    dropped: &AtomicU32,
+    plan: &SharePlanner,
+) -> MissionReport {
     let iterations = a.scenario.optimizer.iterations as u32;
-    let outcome = match FleetTours::new(&a.scenario) {
-        Ok(job) => {
-            let tour = job.plan_vehicle(a.index);
-            send(AgentToCoordinator::tour(&a.mission, &a.vehicle, &tour));
-            format!(
-                "tour of {} points planned: {:.1} m",
-                tour.order.len(),
-                tour.tour_length_m
-            )
+    let outcome = match plan(a) {
+        Ok((message, words)) => {
+            send(message);
+            words
         }
         Err(why) => why,
     };

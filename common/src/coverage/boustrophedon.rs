@@ -27,7 +27,7 @@ use std::f64::consts::PI;
 use serde::{Deserialize, Serialize};
 
 use super::arcs::{lane_change, lane_change_run, u_turn};
-use super::boxes::Rect;
+use super::boxes::{BoxIndex, Rect};
 use super::params::CoverageParams;
 use super::path::{CoveragePath, Piece, PieceKind, Pose2};
 use super::rows::RowBook;
@@ -49,9 +49,10 @@ pub enum BoundaryReason {
     UTurnBlocked,
 }
 
-/// One decision of the state machine, for the plan's log.
+/// One decision of the state machine, for the plan's log. Externally tagged
+/// (`{"detour": {…}}`) so the wire codec, which cannot read internally tagged enums, carries it.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(tag = "event", rename_all = "kebab-case")]
+#[serde(rename_all = "kebab-case")]
 pub enum PlannerEvent {
     /// A detour around a box.
     Detour {
@@ -152,6 +153,29 @@ pub struct Field<'a> {
     /// Whether the boxes are no-go for the path (seed 002's method) or only mark threats on
     /// the rows (the Hybrid A* baseline, which only honours the dilated map).
     pub boxes_are_no_go: bool,
+    /// `boxes` bucketed by band, for [`Field::point_ok`].
+    pub index: BoxIndex,
+}
+
+impl<'a> Field<'a> {
+    /// The field of `boxes` over `area` (indexes the boxes).
+    pub fn new(
+        map: &'a TerrainMap25,
+        area: Rect,
+        boxes: Vec<Rect>,
+        params: &'a CoverageParams,
+        boxes_are_no_go: bool,
+    ) -> Field<'a> {
+        let index = BoxIndex::new(&boxes, params.row_spacing());
+        Field {
+            map,
+            area,
+            boxes,
+            params,
+            boxes_are_no_go,
+            index,
+        }
+    }
 }
 
 impl Field<'_> {
@@ -164,7 +188,7 @@ impl Field<'_> {
             && x <= a.x1 + EPS
             && y >= a.y0 - EPS
             && y <= a.y1 + EPS
-            && !(self.boxes_are_no_go && self.boxes.iter().any(|b| b.contains_strictly(x, y)))
+            && !(self.boxes_are_no_go && self.index.any_contains_strictly(&self.boxes, x, y))
             && self.map.clearance_to_impassable(x, y) >= self.params.safety_clearance_m
     }
 
@@ -407,8 +431,22 @@ impl Machine<'_, '_> {
                     continue;
                 }
                 if self.book.is_done(next, x_v) {
-                    // The sweep has reached rows already covered: finish this row and stop.
-                    self.straight(st, x_start);
+                    // The sweep has reached rows already covered: finish this row and stop —
+                    // unless no turn either way fits at the row's end (a row end boxed in on
+                    // both sides), where a forward-only vehicle could never leave and every
+                    // later transit would fail: then stop at the turn just found and give the
+                    // rest of the row up.
+                    let end = Pose2::new(x_start, st.y, st.pose().heading);
+                    let spacing = self.field.params.row_spacing();
+                    let leaves = [spacing, -spacing]
+                        .iter()
+                        .any(|&o| self.field.pieces_ok(&[u_turn(end, o)]));
+                    if leaves || (x_v - x_start).abs() <= 1e-9 {
+                        self.straight(st, x_start);
+                    } else {
+                        self.straight(st, x_v);
+                        self.book.abandon_at(st.row, x_start);
+                    }
                     return Err(SweepEnd::Covered);
                 }
                 if (x_v - x_start).abs() > 1e-9 {

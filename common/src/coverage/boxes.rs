@@ -84,14 +84,66 @@ impl Rect {
     }
 }
 
+/// Boxes bucketed in horizontal bands, so a point test looks only at the boxes of its band (the
+/// band boxes number in the hundreds and the planner tests millions of points).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct BoxIndex {
+    y0: f64,
+    band: f64,
+    buckets: Vec<Vec<usize>>,
+}
+
+impl BoxIndex {
+    /// Indexes `boxes` in bands of `band` metres.
+    pub fn new(boxes: &[Rect], band: f64) -> Self {
+        let band = if band.is_finite() && band > 0.0 {
+            band
+        } else {
+            10.0
+        };
+        let y0 = boxes.iter().map(|b| b.y0).fold(f64::INFINITY, f64::min);
+        let y1 = boxes.iter().map(|b| b.y1).fold(f64::NEG_INFINITY, f64::max);
+        if !(y0.is_finite() && y1.is_finite()) {
+            return Self::default();
+        }
+        let slot = |y: f64| ((y - y0) / band).floor().max(0.0) as usize;
+        let mut buckets = vec![Vec::new(); slot(y1) + 1];
+        for (k, b) in boxes.iter().enumerate() {
+            for bucket in &mut buckets[slot(b.y0)..=slot(b.y1)] {
+                bucket.push(k);
+            }
+        }
+        Self { y0, band, buckets }
+    }
+
+    /// Whether a box of `boxes` (the ones indexed) holds `(x, y)` strictly inside.
+    pub fn any_contains_strictly(&self, boxes: &[Rect], x: f64, y: f64) -> bool {
+        if self.buckets.is_empty() || y.is_nan() || y < self.y0 {
+            return false;
+        }
+        let k = ((y - self.y0) / self.band).floor() as usize;
+        self.buckets.get(k).is_some_and(|bucket| {
+            bucket
+                .iter()
+                .any(|&i| boxes.get(i).is_some_and(|b| b.contains_strictly(x, y)))
+        })
+    }
+}
+
 /// Bounding boxes of the 8-connected components of impassable cells, over cell centres.
 pub fn impassable_components(map: &TerrainMap25) -> Vec<Rect> {
+    components_in_rows(map, 0, map.ny())
+}
+
+/// [`impassable_components`] of the cell rows `j_lo..j_hi` alone (connectivity inside them).
+fn components_in_rows(map: &TerrainMap25, j_lo: usize, j_hi: usize) -> Vec<Rect> {
     let (nx, ny) = (map.nx(), map.ny());
+    let j_hi = j_hi.min(ny);
     let blocked = map.impassable();
     let mut seen = vec![false; blocked.len()];
     let mut out = Vec::new();
     let mut stack = Vec::new();
-    for start in 0..blocked.len() {
+    for start in j_lo * nx..j_hi * nx {
         if !blocked[start] || seen[start] {
             continue;
         }
@@ -104,7 +156,7 @@ pub fn impassable_components(map: &TerrainMap25) -> Vec<Rect> {
             for dj in -1i64..=1 {
                 for di in -1i64..=1 {
                     let (ni, nj) = (i as i64 + di, j as i64 + dj);
-                    if ni < 0 || nj < 0 || ni >= nx as i64 || nj >= ny as i64 {
+                    if ni < 0 || nj < j_lo as i64 || ni >= nx as i64 || nj >= j_hi as i64 {
                         continue;
                     }
                     let n = nj as usize * nx + ni as usize;
@@ -120,6 +172,19 @@ pub fn impassable_components(map: &TerrainMap25) -> Vec<Rect> {
         out.push(Rect::new(ax, ay, bx, by));
     }
     out
+}
+
+/// The obstacles' outline as a staircase: the bounding boxes of the impassable components inside
+/// each horizontal band of `band_m` (cell rows), grown by `clearance` and not fused. Around an
+/// L-shaped or ring-shaped cluster these hug the shape where one box per component would cover
+/// the passable ground inside its corners.
+pub fn band_boxes(map: &TerrainMap25, clearance: f64, band_m: f64) -> Vec<Rect> {
+    let rows = ((band_m / map.cell_m()).round() as usize).max(1);
+    (0..map.ny())
+        .step_by(rows)
+        .flat_map(|j| components_in_rows(map, j, j + rows))
+        .map(|r| r.inflated(clearance))
+        .collect()
 }
 
 /// Fuses boxes closer than `merge_gap` until no two are (the result does not depend on the
@@ -237,5 +302,66 @@ mod tests {
                 assert!(map.clearance_to_impassable(x, y) > 8.0 - 1e-9, "({x}, {y})");
             }
         }
+    }
+
+    #[test]
+    fn band_boxes_hug_an_l_shaped_obstacle_and_cover_every_cell() {
+        // A 50 x 50 grid of 2 m cells; an L of steep cells: a column at x = 20 m from y = 10 to
+        // 80 m, and a foot along y = 10 m from x = 20 to 80 m (one cell thick each).
+        let n = 50;
+        let mut z = vec![0.0; n * n];
+        for k in 5..=40 {
+            z[k * n + 10] = 100.0; // the column (i = 10)
+            z[5 * n + k] = 100.0; // the foot (j = 5)
+        }
+        let map = crate::coverage::test_map(n, z);
+        let whole = impassable_components(&map);
+        assert_eq!(whole.len(), 1, "{whole:?}");
+        let bands = band_boxes(&map, 0.0, 10.0);
+        let band_area: f64 = bands.iter().map(Rect::area).sum();
+        assert!(
+            band_area < 0.5 * whole[0].area(),
+            "{band_area} vs {}",
+            whole[0].area()
+        );
+        // Every impassable cell centre lies in some band box.
+        let blocked = map.impassable();
+        for j in 0..n {
+            for i in 0..n {
+                if blocked[j * n + i] {
+                    let [x, y] = map.cell_centre(i, j);
+                    assert!(
+                        bands.iter().any(|b| b.contains(x, y)),
+                        "({x}, {y}) uncovered"
+                    );
+                }
+            }
+        }
+        // Grown by the clearance.
+        let grown = band_boxes(&map, 8.0, 10.0);
+        assert_eq!(grown.len(), bands.len());
+        assert_abs_diff_eq!(grown[0].x0, bands[0].x0 - 8.0);
+    }
+
+    #[test]
+    fn the_box_index_answers_as_a_scan_of_every_box() {
+        let boxes = vec![
+            Rect::new(0.0, 0.0, 10.0, 25.0),
+            Rect::new(20.0, 12.0, 30.0, 14.0),
+            Rect::new(5.0, 40.0, 50.0, 41.0),
+        ];
+        let index = BoxIndex::new(&boxes, 10.0);
+        for j in -10..=100 {
+            for i in -10..=120 {
+                let (x, y) = (i as f64 * 0.5, j as f64 * 0.5);
+                let scan = boxes.iter().any(|b| b.contains_strictly(x, y));
+                assert_eq!(
+                    index.any_contains_strictly(&boxes, x, y),
+                    scan,
+                    "({x}, {y})"
+                );
+            }
+        }
+        assert!(!BoxIndex::new(&[], 10.0).any_contains_strictly(&[], 0.0, 0.0));
     }
 }

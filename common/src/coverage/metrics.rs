@@ -112,6 +112,96 @@ impl Distribution {
     }
 }
 
+impl Distribution {
+    /// The distribution of several parts' values together, when every part's histogram has the
+    /// same edges (None otherwise, or with no parts). Count, extremes and mean are exact; the
+    /// 5th percentile, median and 95th percentile are read off the merged histogram by linear
+    /// interpolation inside a bin, so they are exact to one bin width.
+    pub fn merge(parts: &[&Distribution]) -> Option<Distribution> {
+        let first = parts.first()?;
+        let edges = &first.histogram.edges;
+        if edges.len() < 2 || parts.iter().any(|p| &p.histogram.edges != edges) {
+            return None;
+        }
+        let mut histogram = Histogram {
+            edges: edges.clone(),
+            counts: vec![0; edges.len() - 1],
+            below: 0,
+            above: 0,
+        };
+        for p in parts {
+            for (c, &k) in histogram.counts.iter_mut().zip(&p.histogram.counts) {
+                *c += k;
+            }
+            histogram.below += p.histogram.below;
+            histogram.above += p.histogram.above;
+        }
+        let count: usize = parts.iter().map(|p| p.count).sum();
+        let weighted: Vec<&&Distribution> = parts.iter().filter(|p| p.mean.is_finite()).collect();
+        let weight: usize = weighted.iter().map(|p| p.count).sum();
+        let mean = if weight == 0 {
+            f64::NAN
+        } else {
+            weighted
+                .iter()
+                .map(|p| p.mean * p.count as f64)
+                .sum::<f64>()
+                / weight as f64
+        };
+        let min = parts
+            .iter()
+            .map(|p| p.min)
+            .filter(|v| !v.is_nan())
+            .fold(f64::INFINITY, f64::min);
+        let max = parts
+            .iter()
+            .map(|p| p.max)
+            .filter(|v| !v.is_nan())
+            .fold(f64::NEG_INFINITY, f64::max);
+        let (min, max) = if min <= max {
+            (min, max)
+        } else {
+            (f64::NAN, f64::NAN)
+        };
+        let q = |p: f64| histogram.quantile(p, min, max);
+        Some(Distribution {
+            count,
+            min,
+            p5: q(0.05),
+            median: q(0.5),
+            p95: q(0.95),
+            max,
+            mean,
+            histogram: histogram.clone(),
+        })
+    }
+}
+
+impl Histogram {
+    /// The `p` quantile of the counted values, interpolated linearly inside its bin; values
+    /// below or above the range stand at `min` / `max`.
+    fn quantile(&self, p: f64, min: f64, max: f64) -> f64 {
+        let total = self.below + self.counts.iter().sum::<usize>() + self.above;
+        if total == 0 {
+            return f64::NAN;
+        }
+        let rank = p.clamp(0.0, 1.0) * total as f64;
+        let mut seen = self.below as f64;
+        if rank < seen {
+            return min;
+        }
+        for (k, &c) in self.counts.iter().enumerate() {
+            let c = c as f64;
+            if c > 0.0 && rank <= seen + c {
+                let (a, b) = (self.edges[k], self.edges[k + 1]);
+                return (a + (rank - seen) / c * (b - a)).clamp(min, max);
+            }
+            seen += c;
+        }
+        max
+    }
+}
+
 /// Distance from `(x, y)` to the nearest impassable cell centre, exact when below `exact_below`.
 pub fn exact_clearance(map: &TerrainMap25, x: f64, y: f64, exact_below: f64) -> f64 {
     let estimate = map.clearance_to_impassable(x, y);
@@ -234,6 +324,31 @@ mod tests {
                 kind: PieceKind::Straight,
             })
             .collect()
+    }
+
+    #[test]
+    fn merged_distribution_adds_counts_and_reads_quantiles_off_the_bins() {
+        // Part a: 1.5, 2.5 (mean 2); part b: 0.5, 0.5, 3.5, 3.5 (mean 2); bins of 1 over [0, 4).
+        let a = Distribution::new(&[1.5, 2.5], 0.0, 4.0, 4);
+        let b = Distribution::new(&[0.5, 0.5, 3.5, 3.5], 0.0, 4.0, 4);
+        let m = match Distribution::merge(&[&a, &b]) {
+            Some(m) => m,
+            None => panic!("same edges must merge"),
+        };
+        assert_eq!(m.count, 6);
+        assert_eq!(m.histogram.counts, vec![2, 1, 1, 2]);
+        assert_abs_diff_eq!(m.mean, 2.0, epsilon = 1e-12);
+        assert_abs_diff_eq!(m.min, 0.5, epsilon = 1e-12);
+        assert_abs_diff_eq!(m.max, 3.5, epsilon = 1e-12);
+        // Median: rank 3 of 6 ends bin [1, 2) (cumulative 2 + 1) -> its upper edge, 2.0.
+        assert_abs_diff_eq!(m.median, 2.0, epsilon = 1e-12);
+        // p5: rank 0.3 is 0.15 of the way into bin [0, 1) -> 0.15, clamped to min 0.5.
+        assert_abs_diff_eq!(m.p5, 0.5, epsilon = 1e-12);
+        // p95: rank 5.7 is 0.85 into the last bin's 2 values -> 3.85, clamped to max 3.5.
+        assert_abs_diff_eq!(m.p95, 3.5, epsilon = 1e-12);
+        let other = Distribution::new(&[1.0], 0.0, 5.0, 5);
+        assert!(Distribution::merge(&[&a, &other]).is_none());
+        assert!(Distribution::merge(&[]).is_none());
     }
 
     #[test]

@@ -20,7 +20,7 @@ use crate::scenario::CoverageSettings;
 const EXACT_CLEARANCE_BELOW_M: f64 = 40.0;
 
 /// Spacing of the samples the figures are measured on, metres.
-const MEASURE_STEP_M: f64 = 1.0;
+pub const MEASURE_STEP_M: f64 = 1.0;
 
 /// Spacing of the path points written into the report for plotting, metres.
 const PLOT_STEP_M: f64 = 4.0;
@@ -109,6 +109,38 @@ pub struct CoverageReport {
     pub tracked_path: Vec<[f64; 2]>,
 }
 
+/// What lies under a path's samples: clearance to impassable cells (Figure 7a) and slope
+/// (Figure 7b), and how many samples are closer than the safety clearance.
+pub struct PathUnder {
+    /// Clearance distribution, metres (exact below 40 m).
+    pub clearance: Distribution,
+    /// Slope distribution, degrees.
+    pub slope: Distribution,
+    /// Samples closer than the safety clearance.
+    pub below: usize,
+}
+
+impl PathUnder {
+    /// Measures `samples` on `map` against `safety_clearance_m`.
+    pub fn measure(map: &TerrainMap25, samples: &[PathSample], safety_clearance_m: f64) -> Self {
+        let clearances: Vec<f64> = samples
+            .iter()
+            .map(|s| exact_clearance(map, s.x, s.y, EXACT_CLEARANCE_BELOW_M))
+            .collect();
+        let below = clearances
+            .iter()
+            .filter(|&&c| c < safety_clearance_m - 1e-9)
+            .count();
+        let slopes: Vec<f64> = samples.iter().map(|s| map.slope_at(s.x, s.y)).collect();
+        let max_slope = map.limits().critical_slope_deg;
+        PathUnder {
+            clearance: Distribution::new(&clearances, 0.0, EXACT_CLEARANCE_BELOW_M, 40),
+            slope: Distribution::new(&slopes, 0.0, max_slope.max(1.0), 30),
+            below,
+        }
+    }
+}
+
 /// Builds the 2.5D map of a scenario's `[coverage]` table (`dir` resolves `heightmap`).
 pub fn build_map(
     settings: &CoverageSettings,
@@ -138,16 +170,7 @@ pub fn run_coverage(
     progress("planning", 1.0);
     let samples = plan.path.sample(MEASURE_STEP_M);
     let swath = params.row_spacing();
-    let clearances: Vec<f64> = samples
-        .iter()
-        .map(|s| exact_clearance(map, s.x, s.y, EXACT_CLEARANCE_BELOW_M))
-        .collect();
-    let below = clearances
-        .iter()
-        .filter(|&&c| c < params.safety_clearance_m - 1e-9)
-        .count();
-    let slopes: Vec<f64> = samples.iter().map(|s| map.slope_at(s.x, s.y)).collect();
-    let max_slope = map.limits().critical_slope_deg;
+    let under = PathUnder::measure(map, &samples, params.safety_clearance_m);
     let tracking = if settings.track && !samples.is_empty() {
         let started = Instant::now();
         let terrain = |x: f64, y: f64| elevation_gradient(map, x, y);
@@ -176,10 +199,10 @@ pub fn run_coverage(
         rows: plan.rows,
         sweeps: plan.sweeps,
         event_counts: plan.event_counts(),
-        clearance: Distribution::new(&clearances, 0.0, EXACT_CLEARANCE_BELOW_M, 40),
+        clearance: under.clearance,
         safety_clearance_m: params.safety_clearance_m,
-        samples_below_clearance: below,
-        slope: Distribution::new(&slopes, 0.0, max_slope.max(1.0), 30),
+        samples_below_clearance: under.below,
+        slope: under.slope,
         max_curvature: samples
             .iter()
             .map(|s| s.curvature.abs())

@@ -21,6 +21,7 @@ pub mod boustrophedon;
 pub mod boxes;
 pub mod dubins;
 pub mod edt;
+pub mod fleet;
 pub mod hybrid_astar;
 pub mod hybrid_detour;
 pub mod metrics;

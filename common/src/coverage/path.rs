@@ -58,9 +58,9 @@ pub enum PieceKind {
     Transit,
 }
 
-/// One exact piece of path.
+/// One exact piece of path. Externally tagged (`{"line": {…}}`) so the wire codec carries it.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(tag = "type", rename_all = "kebab-case")]
+#[serde(rename_all = "kebab-case")]
 pub enum Piece {
     /// A straight segment from `from` to `to`.
     Line {
@@ -184,6 +184,26 @@ pub struct CoveragePath {
 }
 
 impl CoveragePath {
+    /// Whether every number of every piece is finite and every arc has a positive radius (a
+    /// path read from the network is checked with this before it is used).
+    pub fn is_valid(&self) -> bool {
+        self.pieces.iter().all(|(_, p)| match *p {
+            Piece::Line { from, to } => from.iter().chain(&to).all(|v| v.is_finite()),
+            Piece::Arc {
+                centre,
+                radius,
+                start_angle,
+                sweep,
+            } => {
+                centre.iter().all(|v| v.is_finite())
+                    && radius.is_finite()
+                    && radius > 0.0
+                    && start_angle.is_finite()
+                    && sweep.is_finite()
+            }
+        })
+    }
+
     /// Total length, metres.
     pub fn length(&self) -> f64 {
         self.pieces.iter().map(|(_, p)| p.length()).sum()

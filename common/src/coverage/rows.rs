@@ -27,6 +27,8 @@ pub struct RowBook {
     driven: Vec<Vec<f64>>,
     /// Stretches given up on (no transit reached them).
     abandoned: Vec<Vec<bool>>,
+    /// Every drive booked, `(row, a, b)`, in order.
+    drives: Vec<(usize, f64, f64)>,
     /// Shortest stretch worth a sweep, metres.
     min_len: f64,
 }
@@ -70,6 +72,7 @@ impl RowBook {
             free,
             driven,
             abandoned,
+            drives: Vec::new(),
             min_len: min_stretch(r_min),
         }
     }
@@ -97,11 +100,18 @@ impl RowBook {
     /// Books a drive along row `k` from `a` to `b` (either order).
     pub fn drive(&mut self, k: usize, a: f64, b: f64) {
         let (lo, hi) = (a.min(b), a.max(b));
+        self.drives.push((k, lo, hi));
         if let (Some(free), Some(driven)) = (self.free.get(k), self.driven.get_mut(k)) {
             for (s, d) in free.iter().zip(driven.iter_mut()) {
                 *d += (hi.min(s.1) - lo.max(s.0)).max(0.0);
             }
         }
+    }
+
+    /// Every drive booked so far, `(row, x_lo, x_hi)`: another book of the same rows (cut by
+    /// other boxes) replays them to know what is already driven.
+    pub fn drives(&self) -> &[(usize, f64, f64)] {
+        &self.drives
     }
 
     /// Whether the stretch of row `k` holding `x` is covered (or `x` is in no stretch).
@@ -130,6 +140,17 @@ impl RowBook {
             .copied()
             .unwrap_or(true);
         b - a < self.min_len || driven >= 0.5 * (b - a) || abandoned
+    }
+
+    /// Gives up on the stretch of row `k` holding `x` (if any).
+    pub fn abandon_at(&mut self, k: usize, x: f64) {
+        if let Some(i) = self
+            .stretches(k)
+            .iter()
+            .position(|s| s.0 - 1e-9 <= x && x <= s.1 + 1e-9)
+        {
+            self.abandon(k, i);
+        }
     }
 
     /// Gives up on stretch `i` of row `k`.

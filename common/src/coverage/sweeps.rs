@@ -7,11 +7,18 @@
 //! on the same safety predicate (area, boxes, clearance) and runs another sweep from there; a
 //! stretch no transit reaches within the search budget is reported as unreached. Transits are
 //! their own piece kind, so the figures can be read with or without them.
+//!
+//! Merged boxes (the paper's fusion of nearby obstacles) also hide passable ground between the
+//! obstacles they merge, and one box around an L- or ring-shaped obstacle hides the ground in its
+//! corners. A second phase ("box interiors") runs the same sweeps and transits with tighter
+//! no-go boxes — each obstacle's boxes band by band, one row spacing high
+//! ([`super::boxes::band_boxes`]) — on the rows cut by those boxes and by everything the first
+//! phase drove; the safety clearance is checked exactly as before.
 
 use serde::{Deserialize, Serialize};
 
 use super::boustrophedon::{ArcDetour, DetourPlanner, Field, Machine, PlannerEvent, RowState};
-use super::boxes::{no_go_boxes, Rect};
+use super::boxes::{band_boxes, no_go_boxes, Rect};
 use super::hybrid_astar::{self, HybridAStarParams};
 use super::hybrid_detour::HybridDetour;
 use super::params::{CoverageParams, DetourMethod};
@@ -24,6 +31,12 @@ use super::{Terrain25Error, TerrainMap25};
 /// this factor longer than the shortest, and found with far fewer expansions).
 const TRANSIT_GUIDE_WEIGHT: f64 = 1.5;
 
+/// How far the grid guide of a transit is expanded: this many times the transit's chord plus a
+/// margin (a detour around an obstacle rarely exceeds twice the straight line; beyond it the
+/// guide reads flat and the search is only slower, never wrong).
+const GUIDE_REACH: f64 = 3.0;
+const GUIDE_MARGIN_M: f64 = 200.0;
+
 /// A coverage plan for one area.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct CoveragePlan {
@@ -31,6 +44,9 @@ pub struct CoveragePlan {
     pub path: CoveragePath,
     /// The merged, inflated no-go boxes used (the red rectangles of Figure 6).
     pub boxes: Vec<Rect>,
+    /// The band boxes of the box-interior phase (empty when that phase did not run). Every
+    /// path point lies outside these.
+    pub inner_boxes: Vec<Rect>,
     /// The area planned.
     pub area: Rect,
     /// Rows the area holds.
@@ -104,101 +120,164 @@ pub fn plan_coverage_with(
             ),
         });
     }
-    let field = Field {
+    let field = Field::new(
         map,
         area,
-        boxes: no_go_boxes(map, params.safety_clearance_m, params.merge_gap()),
+        no_go_boxes(map, params.safety_clearance_m, params.merge_gap()),
         params,
         boxes_are_no_go,
-    };
+    );
     let rows = ((area.y1 - area.y0) / spacing + 1e-9).floor() as usize;
-    let ys = (0..rows)
+    let ys: Vec<f64> = (0..rows)
         .map(|k| area.y0 + spacing / 2.0 + k as f64 * spacing)
         .collect();
-    let (x_lo, x_hi) = (area.x0 + r, area.x1 - r);
-    let book = RowBook::new(ys, (x_lo, x_hi), &field.boxes, r);
-    let mut m = Machine {
-        field: &field,
+    let x_range = (area.x0 + r, area.x1 - r);
+    let mut run = Sweeping {
         path: CoveragePath::default(),
         events: Vec::new(),
-        book,
+        sweeps: 0,
+        budget: params.transit_budget,
     };
-    let transit_params = HybridAStarParams {
-        min_turn_radius_m: r,
-        max_expansions: params.transit_expansions.max(1),
-        ..HybridAStarParams::default()
-    };
-    let free = |x: f64, y: f64| field.point_ok(x, y);
-    // The search's own bounds sit 1 m outside the area so a pose on the area's edge (where
-    // every row's U-turn reaches) is inside its grid; `free` keeps the path in the area.
-    let bounds = [area.x0 - 1.0, area.y0 - 1.0, area.x1 + 1.0, area.y1 + 1.0];
-    let reach = ReachGrid::new(area, map.cell_m(), &free);
-    let mut sweeps = 0;
-    let mut budget = params.transit_budget;
-    while let Some((k, i)) = next_stretch(&m) {
-        let here = m.path.pieces.last().map(|(_, p)| p.end());
-        let Some(entry) = entry_state(&field, &m.book, k, i, here) else {
-            m.book.abandon(k, i);
-            continue;
-        };
-        if let Some(from) = here {
-            let goal = entry.pose();
-            let chord = (goal.x - from.x).hypot(goal.y - from.y);
-            let affordable = params.transit_expansions > 0 && budget > 0;
-            let transit = if affordable && reach.connected(from.xy(), goal.xy()) {
-                let guide = reach.distance_from(goal.xy(), 3.0 * chord + 200.0);
-                // Weighted A* (ε = 1.5): a transit needs to be found, not to be shortest.
-                let guide = |x: f64, y: f64| TRANSIT_GUIDE_WEIGHT * guide.at(x, y);
-                hybrid_astar::plan_guided(from, goal, &free, bounds, &transit_params, &guide)
-            } else {
-                Ok(None)
-            };
-            let transit = transit.map_err(|e| Terrain25Error::InvalidParam {
-                field: "transit".into(),
-                what: e.to_string(),
-            })?;
-            budget = budget.saturating_sub(
-                transit
-                    .as_ref()
-                    .map_or(params.transit_expansions, |f| f.expansions),
-            );
-            let Some(found) = transit else {
-                let s = m.book.stretches(k).get(i).copied().unwrap_or((0.0, 0.0));
-                m.events.push(PlannerEvent::Unreached {
-                    row: k,
-                    stretch: [s.0, s.1],
-                });
-                m.book.abandon(k, i);
-                continue;
-            };
-            m.events.push(PlannerEvent::Transit {
-                to_row: k,
-                to: goal.xy(),
-                length_m: found.path.length(),
-            });
-            m.path.pieces.extend(
-                found
-                    .path
-                    .pieces
-                    .into_iter()
-                    .map(|(_, p)| (PieceKind::Transit, p)),
-            );
-        }
-        sweeps += 1;
-        m.sweep(entry, method);
-        if !m.book.stretch_done(k, i) {
-            // The sweep could not drive its own entry stretch: do not come back to it.
-            m.book.abandon(k, i);
+    let book = run.phase(
+        &field,
+        RowBook::new(ys.clone(), x_range, &field.boxes, r),
+        method,
+    )?;
+    // Box interiors: merged boxes hold passable ground between the obstacles they merge. A
+    // second phase sweeps what is left with each obstacle's own inflated box as no-go (every
+    // point still keeps the safety clearance), starting from what the first phase drove.
+    let mut inner_boxes = Vec::new();
+    if boxes_are_no_go && params.merge_gap() > 0.0 {
+        let inner = Field::new(
+            map,
+            area,
+            band_boxes(map, params.safety_clearance_m, spacing),
+            params,
+            true,
+        );
+        if inner.boxes != field.boxes {
+            // The second book's stretches are the rows cut by the obstacles' own boxes and by
+            // what the first phase drove, so what is left inside the merged boxes is open.
+            let mut cuts = inner.boxes.clone();
+            cuts.extend(book.drives().iter().map(|&(k, a, b)| {
+                let y = book.y(k);
+                Rect::new(a, y - 0.25 * r, b, y + 0.25 * r)
+            }));
+            run.phase(&inner, RowBook::new(ys, x_range, &cuts, r), method)?;
+            inner_boxes = inner.boxes;
         }
     }
     Ok(CoveragePlan {
-        path: m.path,
+        path: run.path,
+        inner_boxes,
         boxes: field.boxes.clone(),
         area,
         rows,
-        sweeps,
-        events: m.events,
+        sweeps: run.sweeps,
+        events: run.events,
     })
+}
+
+/// The plan as it grows over the phases.
+struct Sweeping {
+    path: CoveragePath,
+    events: Vec<PlannerEvent>,
+    sweeps: usize,
+    /// Transit search expansions left for the whole plan.
+    budget: usize,
+}
+
+impl Sweeping {
+    /// Sweeps every open stretch of `book` on `field`, joined by transits, from where the path
+    /// ends; returns the book.
+    fn phase(
+        &mut self,
+        field: &Field<'_>,
+        book: RowBook,
+        method: &dyn DetourPlanner,
+    ) -> Result<RowBook, Terrain25Error> {
+        let (params, area) = (field.params, field.area);
+        let r = params.min_turn_radius_m;
+        let mut m = Machine {
+            field,
+            path: std::mem::take(&mut self.path),
+            events: std::mem::take(&mut self.events),
+            book,
+        };
+        let transit_params = HybridAStarParams {
+            min_turn_radius_m: r,
+            max_expansions: params.transit_expansions.max(1),
+            ..HybridAStarParams::default()
+        };
+        let free = |x: f64, y: f64| field.point_ok(x, y);
+        // The search's own bounds sit 1 m outside the area so a pose on the area's edge (where
+        // every row's U-turn reaches) is inside its grid; `free` keeps the path in the area.
+        let bounds = [area.x0 - 1.0, area.y0 - 1.0, area.x1 + 1.0, area.y1 + 1.0];
+        let reach = ReachGrid::new(area, field.map.cell_m(), &free);
+        while let Some((k, i)) = next_stretch(&m) {
+            let here = m.path.pieces.last().map(|(_, p)| p.end());
+            let Some(entry) = entry_state(field, &m.book, k, i, here) else {
+                m.book.abandon(k, i);
+                continue;
+            };
+            if let Some(from) = here {
+                let goal = entry.pose();
+                let chord = (goal.x - from.x).hypot(goal.y - from.y);
+                let affordable = params.transit_expansions > 0 && self.budget > 0;
+                let transit = if affordable && reach.connected(from.xy(), goal.xy()) {
+                    let guide = reach.distance_between(
+                        goal.xy(),
+                        from.xy(),
+                        GUIDE_REACH * chord + GUIDE_MARGIN_M,
+                    );
+                    // Weighted A* (ε = 1.5): a transit needs to be found, not to be shortest.
+                    let guide = |x: f64, y: f64| TRANSIT_GUIDE_WEIGHT * guide.at(x, y);
+                    hybrid_astar::plan_guided(from, goal, &free, bounds, &transit_params, &guide)
+                } else {
+                    Ok(None)
+                };
+                let transit = transit.map_err(|e| Terrain25Error::InvalidParam {
+                    field: "transit".into(),
+                    what: e.to_string(),
+                })?;
+                self.budget = self.budget.saturating_sub(
+                    transit
+                        .as_ref()
+                        .map_or(params.transit_expansions, |f| f.expansions),
+                );
+                let Some(found) = transit else {
+                    let s = m.book.stretches(k).get(i).copied().unwrap_or((0.0, 0.0));
+                    m.events.push(PlannerEvent::Unreached {
+                        row: k,
+                        stretch: [s.0, s.1],
+                    });
+                    m.book.abandon(k, i);
+                    continue;
+                };
+                m.events.push(PlannerEvent::Transit {
+                    to_row: k,
+                    to: goal.xy(),
+                    length_m: found.path.length(),
+                });
+                m.path.pieces.extend(
+                    found
+                        .path
+                        .pieces
+                        .into_iter()
+                        .map(|(_, p)| (PieceKind::Transit, p)),
+                );
+            }
+            self.sweeps += 1;
+            m.sweep(entry, method);
+            if !m.book.stretch_done(k, i) {
+                // The sweep could not drive its own entry stretch: do not come back to it.
+                m.book.abandon(k, i);
+            }
+        }
+        self.path = m.path;
+        self.events = m.events;
+        Ok(m.book)
+    }
 }
 
 /// The open stretch whose nearer end is closest to the vehicle (the first one before it

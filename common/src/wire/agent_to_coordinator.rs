@@ -3,6 +3,7 @@
 use serde::{Deserialize, Serialize};
 
 use super::WireChromosome;
+use crate::coverage::fleet::StripPlan;
 use crate::geometry::Vec3;
 use crate::tour::TourPlan;
 
@@ -65,6 +66,18 @@ pub enum AgentToCoordinator {
         /// Segment–cage intersections of `path`.
         intersections: u32,
     },
+    /// Fleet coverage missions (seed 002 with several crawlers): the plan of the agent's strip
+    /// (its figures and its exact path). Sent once, before `Done`.
+    Coverage {
+        /// Mission id.
+        mission: String,
+        /// The vehicle.
+        vehicle: String,
+        /// The strip planned (the vehicle's index in the scenario).
+        strip: u32,
+        /// The strip's plan.
+        plan: Box<StripPlan>,
+    },
 }
 
 impl AgentToCoordinator {
@@ -87,7 +100,8 @@ impl AgentToCoordinator {
             AgentToCoordinator::Elites { mission, .. }
             | AgentToCoordinator::Done { mission, .. }
             | AgentToCoordinator::Joined { mission, .. }
-            | AgentToCoordinator::Tour { mission, .. } => mission,
+            | AgentToCoordinator::Tour { mission, .. }
+            | AgentToCoordinator::Coverage { mission, .. } => mission,
         }
     }
 
@@ -97,7 +111,8 @@ impl AgentToCoordinator {
             AgentToCoordinator::Elites { vehicle, .. }
             | AgentToCoordinator::Done { vehicle, .. }
             | AgentToCoordinator::Joined { vehicle, .. }
-            | AgentToCoordinator::Tour { vehicle, .. } => vehicle,
+            | AgentToCoordinator::Tour { vehicle, .. }
+            | AgentToCoordinator::Coverage { vehicle, .. } => vehicle,
         }
     }
 }
@@ -175,5 +190,50 @@ mod tests {
         assert!(tour_from_wire(&order, &path, &leg_lengths, straight_m, 0, 1).is_err());
         assert!(tour_from_wire(&order, &[[f64::NAN, 0.0, 0.0]], &[], 0.0, 0, 2).is_err());
         assert!(tour_from_wire(&[], &[], &[], 0.0, 0, 0).is_err());
+    }
+
+    #[test]
+    fn a_coverage_strip_survives_the_codec() {
+        use crate::coverage::boxes::Rect;
+        use crate::coverage::mission::run_coverage;
+        use crate::scenario::CoverageSettings;
+        use crate::wire::codec::{decode, encode};
+        use crate::wire::Envelope;
+        // A 200 m flat map with one 20 m plateau: rows, U-turns and a detour's events.
+        let n = 100;
+        let mut z = vec![0.0; n * n];
+        for j in 45..55 {
+            for i in 45..55 {
+                z[j * n + i] = 30.0;
+            }
+        }
+        let map = crate::coverage::test_map(n, z);
+        let settings = CoverageSettings {
+            track: false,
+            ..CoverageSettings::default()
+        };
+        let area = Rect::new(0.0, 0.0, 198.0, 198.0);
+        let (report, plan) = match run_coverage(&settings, &map, area, Some(1), 1, &mut |_, _| {}) {
+            Ok(r) => r,
+            Err(e) => panic!("{e}"),
+        };
+        assert!(!report.events.is_empty(), "no events to carry");
+        let sent = AgentToCoordinator::Coverage {
+            mission: "m".into(),
+            vehicle: "crawler1".into(),
+            strip: 0,
+            plan: Box::new(StripPlan {
+                report,
+                path: plan.path,
+            }),
+        };
+        let bytes = match encode(&Envelope::new(sent.clone())) {
+            Ok(b) => b,
+            Err(e) => panic!("{e}"),
+        };
+        match decode::<AgentToCoordinator>(&bytes) {
+            Ok(back) => assert_eq!(back.body, sent),
+            Err(e) => panic!("{e}"),
+        }
     }
 }

@@ -93,62 +93,28 @@ pub fn plan_distributed(
     }
     // Tour missions: the job is a function of the scenario (every agent derives the same one);
     // a scenario without one is refused before the network opens.
-    if algorithm.is_tour_planner() {
-        shoal_common::tour::FleetTours::new(scenario).map_err(anyhow::Error::msg)?;
-    }
+    let tours = if algorithm.is_tour_planner() {
+        Some(shoal_common::tour::FleetTours::new(scenario).map_err(anyhow::Error::msg)?)
+    } else {
+        None
+    };
     let started = std::time::Instant::now();
-    let ids: Vec<String> = scenario.vehicles.iter().map(|v| v.id.clone()).collect();
-    let mut net =
-        network::Network::open(&options.listen, &options.routers, &options.mission, &ids)?;
-    let health = options
-        .health_file
-        .as_deref()
-        .map(shoal_common::health::Heartbeat::start);
-    tracing::info!(
-        mission = %options.mission,
-        "coordinator listening on {}",
-        net.endpoints.join(", ")
-    );
-    let mut local = match options.agents {
-        AgentsMode::Embedded => {
-            let bin = agents::agent_binary(options.agent_bin.as_deref())?;
-            let endpoint = net.endpoints.first().cloned().unwrap_or_default();
-            Some(agents::LocalAgents::spawn(
-                &bin,
-                &ids,
-                &endpoint,
-                &options.log_dir,
-            )?)
-        }
-        AgentsMode::External => {
-            eprintln!(
-                "mission {}: waiting up to {:.0} s for one agent per vehicle ({}) on {}",
-                options.mission,
-                options.join_timeout.as_secs_f64(),
-                ids.join(", "),
-                net.endpoints.join(", ")
-            );
-            None
-        }
-    };
-    let timing = mission::Timing {
-        join: options.join_timeout,
-        round: options.round_timeout,
-    };
-    if algorithm.is_tour_planner() {
-        let outcome = mission::run_tour_mission(
+    if let Some(job) = tours {
+        let (shares, figures) = share_mission(
             scenario,
-            &mut net,
-            &options.mission,
-            timing,
-            local.as_mut(),
+            mission::ShareJob::Tours(Box::new(job.clone())),
+            options,
             stop,
             observe,
-        );
-        drop(local);
-        net.close();
-        drop(health);
-        let (job, tours, figures) = outcome?;
+        )?;
+        let tours = shares
+            .into_iter()
+            .zip(&scenario.vehicles)
+            .map(|(share, v)| match share {
+                mission::Share::Tour(t) => Ok(t),
+                other => Err(anyhow::anyhow!("{}: no tour ({other:?})", v.id)),
+            })
+            .collect::<anyhow::Result<Vec<_>>>()?;
         let mut plan =
             crate::tour_planner::assemble(scenario, &job, &tours, "distributed", started);
         for d in &figures.degraded {
@@ -160,18 +126,17 @@ pub fn plan_distributed(
         plan.distributed = Some(figures);
         return Ok(plan);
     }
+    let mut session = Session::open(scenario, options)?;
     let outcome = mission::run(
         scenario,
-        &mut net,
+        &mut session.net,
         &options.mission,
-        timing,
-        local.as_mut(),
+        timing(options),
+        session.local.as_mut(),
         stop,
         observe,
     );
-    drop(local);
-    net.close();
-    drop(health);
+    session.close();
     let (run, figures) = outcome?;
     let model = FleetModel::new(scenario);
     let mut plan = to_plan(scenario, &model, run, "distributed");
@@ -183,4 +148,125 @@ pub fn plan_distributed(
     }
     plan.distributed = Some(figures);
     Ok(plan)
+}
+
+/// Plans a fleet coverage mission (seed 002 with several crawlers): each agent plans its own
+/// strip of `map`; a strip whose agent fails is planned here. Returns the strips' plans in
+/// scenario order and the network figures.
+pub fn plan_strips_distributed(
+    scenario: &Scenario,
+    job: shoal_common::coverage::fleet::FleetCoverage,
+    map: shoal_common::coverage::TerrainMap25,
+    options: &DistributedOptions,
+    stop: &AtomicBool,
+    observe: &mut dyn FnMut(&mission::Status),
+) -> anyhow::Result<(
+    Vec<shoal_common::coverage::fleet::StripPlan>,
+    shoal_common::plan::DistributedFigures,
+)> {
+    topics::check_id("mission", &options.mission)?;
+    let (shares, figures) = share_mission(
+        scenario,
+        mission::ShareJob::Strips(Box::new(job), Box::new(map)),
+        options,
+        stop,
+        observe,
+    )?;
+    let plans = shares
+        .into_iter()
+        .zip(&scenario.vehicles)
+        .map(|(share, v)| match share {
+            mission::Share::Strip(p) => Ok(*p),
+            mission::Share::Failed(why) => Err(anyhow::anyhow!("{}'s strip: {why}", v.id)),
+            other => Err(anyhow::anyhow!("{}: no strip plan ({other:?})", v.id)),
+        })
+        .collect::<anyhow::Result<Vec<_>>>()?;
+    Ok((plans, figures))
+}
+
+/// Runs a one-shot mission (see [`mission::ShareJob`]) on its own router and agents.
+fn share_mission(
+    scenario: &Scenario,
+    job: mission::ShareJob,
+    options: &DistributedOptions,
+    stop: &AtomicBool,
+    observe: &mut dyn FnMut(&mission::Status),
+) -> anyhow::Result<(Vec<mission::Share>, shoal_common::plan::DistributedFigures)> {
+    let mut session = Session::open(scenario, options)?;
+    let outcome = mission::run_share_mission(
+        scenario,
+        job,
+        &mut session.net,
+        &options.mission,
+        timing(options),
+        session.local.as_mut(),
+        stop,
+        observe,
+    );
+    session.close();
+    outcome
+}
+
+/// How patient the mission is, from the options.
+fn timing(options: &DistributedOptions) -> mission::Timing {
+    mission::Timing {
+        join: options.join_timeout,
+        round: options.round_timeout,
+    }
+}
+
+/// The network side of a run: the embedded router, its health file and the local agents.
+struct Session {
+    net: network::Network,
+    health: Option<shoal_common::health::Heartbeat>,
+    local: Option<agents::LocalAgents>,
+}
+
+impl Session {
+    /// Opens the router for `scenario`'s vehicles and starts the agents `options` asks for.
+    fn open(scenario: &Scenario, options: &DistributedOptions) -> anyhow::Result<Session> {
+        let ids: Vec<String> = scenario.vehicles.iter().map(|v| v.id.clone()).collect();
+        let net =
+            network::Network::open(&options.listen, &options.routers, &options.mission, &ids)?;
+        let health = options
+            .health_file
+            .as_deref()
+            .map(shoal_common::health::Heartbeat::start);
+        tracing::info!(
+            mission = %options.mission,
+            "coordinator listening on {}",
+            net.endpoints.join(", ")
+        );
+        let local = match options.agents {
+            AgentsMode::Embedded => {
+                let bin = agents::agent_binary(options.agent_bin.as_deref())?;
+                let endpoint = net.endpoints.first().cloned().unwrap_or_default();
+                Some(agents::LocalAgents::spawn(
+                    &bin,
+                    &ids,
+                    &endpoint,
+                    &options.log_dir,
+                )?)
+            }
+            AgentsMode::External => {
+                eprintln!(
+                    "mission {}: waiting up to {:.0} s for one agent per vehicle ({}) on {}",
+                    options.mission,
+                    options.join_timeout.as_secs_f64(),
+                    ids.join(", "),
+                    net.endpoints.join(", ")
+                );
+                None
+            }
+        };
+        Ok(Session { net, health, local })
+    }
+
+    /// Stops the local agents, then closes the router, then the health file.
+    fn close(self) {
+        let Session { net, health, local } = self;
+        drop(local);
+        net.close();
+        drop(health);
+    }
 }

@@ -128,11 +128,22 @@ impl Fleet {
         out: &Path,
         extra: &[&str],
     ) -> Handle {
+        self.coordinator_on(name, &scenario(scenario_name), out, extra)
+    }
+
+    /// [`Fleet::coordinator`] on a scenario file anywhere.
+    pub fn coordinator_on(
+        &mut self,
+        name: &str,
+        scenario_file: &Path,
+        out: &Path,
+        extra: &[&str],
+    ) -> Handle {
         let mut cmd = Command::new(coordinator());
         without_shoal_env(&mut cmd);
         cmd.current_dir(root())
             .arg("plan")
-            .arg(scenario(scenario_name))
+            .arg(scenario_file)
             .arg("--out")
             .arg(out)
             .args(extra);

@@ -27,8 +27,19 @@ impl Run<'_> {
                 anyhow::bail!("interrupted while waiting for the agents to join");
             }
             if let Some(agents) = local.as_deref_mut() {
-                if let Some((v, status)) = agents.exited().into_iter().next() {
-                    anyhow::bail!("the agent of {v} exited before joining ({status}); see its log");
+                for (v, status) in agents.exited() {
+                    let Some(i) = self.index(&v) else { continue };
+                    // A one-shot agent may finish (and exit) before the last one joins; its
+                    // result or `Done` can still be in flight, so it is only marked gone and
+                    // the share is planned here after the grace period if nothing comes.
+                    if self.job.is_some() || self.seats[i].joined {
+                        self.lost(i, format!("its agent process exited ({status})"));
+                        self.seats[i].joined = true;
+                    } else {
+                        anyhow::bail!(
+                            "the agent of {v} exited before joining ({status}); see its log"
+                        );
+                    }
                 }
             }
             let now = Instant::now();
@@ -81,17 +92,25 @@ impl Run<'_> {
                         seat.take_elites(iteration, evaluations, particles);
                     }
                 }
-                // A tour mission's agent can finish its tour before the others join.
-                Some(Event::Message(m @ AgentToCoordinator::Tour { .. })) => {
-                    match self.tours.take() {
-                        Some(job) => {
-                            self.take_tour(&job, m);
-                            self.tours = Some(job);
-                        }
-                        None => self.net.out_of_turn(&format!(
-                            "a tour from {} in an exchange mission",
-                            m.vehicle()
-                        )),
+                // A one-shot mission's agent can finish its share before the others join.
+                Some(Event::Message(
+                    m @ (AgentToCoordinator::Tour { .. } | AgentToCoordinator::Coverage { .. }),
+                )) => match self.job.clone() {
+                    Some(job) => self.take_share(&job, m),
+                    None => self.net.out_of_turn(&format!(
+                        "a one-shot result from {} in an exchange mission",
+                        m.vehicle()
+                    )),
+                },
+                Some(Event::Message(AgentToCoordinator::Done {
+                    vehicle,
+                    iterations,
+                    evaluations,
+                    dropped,
+                    ..
+                })) if self.job.is_some() => {
+                    if let Some(job) = self.job.clone() {
+                        self.share_done(&job, &vehicle, iterations, evaluations, dropped);
                     }
                 }
                 Some(Event::Message(m)) => self.net.out_of_turn(&format!(

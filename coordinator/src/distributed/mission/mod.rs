@@ -19,13 +19,14 @@ use shoal_common::distributed::{round_iterations, rounds, Chromosome, Context};
 use shoal_common::plan::{AgentFigures, DegradedVehicle, DistributedFigures};
 use shoal_common::scenario::Scenario;
 use shoal_common::swarm::{Progress, Termination};
-use shoal_common::tour::{FleetTours, TourPlan};
 use shoal_common::wire::agent_to_coordinator::AgentToCoordinator;
 use shoal_common::wire::coordinator_to_agent::CoordinatorToAgent;
 use shoal_common::wire::{WireChromosome, WireContext};
 
 mod join;
-mod tours;
+mod shares;
+
+pub use shares::{Share, ShareJob};
 
 use super::agents::LocalAgents;
 use super::network::{Event, Network};
@@ -72,8 +73,8 @@ struct Seat {
     done: Option<(u32, u64, u32)>,
     /// When and why its agent was seen to go (token gone, process exited).
     gone: Option<(Instant, String)>,
-    /// Tour missions: the vehicle's inspection tour, from its agent or planned here.
-    tour: Option<TourPlan>,
+    /// One-shot missions: the vehicle's share, from its agent or planned here.
+    share: Option<Share>,
 }
 
 impl Seat {
@@ -99,8 +100,8 @@ struct Run<'a> {
     seats: Vec<Seat>,
     timing: Timing,
     mission: String,
-    /// Tour missions: the fleet's job (to check the tours agents send).
-    tours: Option<FleetTours>,
+    /// One-shot missions: the fleet's job (to check the results agents send).
+    job: Option<Arc<ShareJob>>,
 }
 
 /// Runs the mission and returns the best plan's run result and the network figures.
@@ -246,22 +247,22 @@ pub fn run(
     Ok((result, figures))
 }
 
-/// Runs a tour mission (seed 003): every agent plans its own share's tour; see [`tours`].
-/// Returns the fleet's job (a function of the scenario), every vehicle's tour and the figures.
-pub fn run_tour_mission(
+/// Runs a one-shot mission (tours of seed 003, coverage strips of seed 002): every agent plans
+/// its own share; see [`shares`]. Returns every vehicle's share and the figures.
+#[allow(clippy::too_many_arguments)] // `run`'s inputs plus the job
+pub fn run_share_mission(
     scenario: &Scenario,
+    job: ShareJob,
     net: &mut Network,
     mission: &str,
     timing: Timing,
     local: Option<&mut LocalAgents>,
     stop: &AtomicBool,
     observe: &mut dyn FnMut(&Status),
-) -> anyhow::Result<(FleetTours, Vec<TourPlan>, DistributedFigures)> {
-    let job = FleetTours::new(scenario).map_err(anyhow::Error::msg)?;
+) -> anyhow::Result<(Vec<Share>, DistributedFigures)> {
     let model = Arc::new(FleetModel::new(scenario));
     let mut r = Run::new(scenario, model, net, timing, mission);
-    let (tours, figures) = tours::run_tours(&mut r, &job, local, stop, observe)?;
-    Ok((job, tours, figures))
+    shares::run_shares(&mut r, job, local, stop, observe)
 }
 
 impl<'a> Run<'a> {
@@ -288,7 +289,7 @@ impl<'a> Run<'a> {
                 agent_evaluations: 0,
                 done: None,
                 gone: None,
-                tour: None,
+                share: None,
             })
             .collect();
         Run {
@@ -298,7 +299,7 @@ impl<'a> Run<'a> {
             seats,
             timing,
             mission: mission.to_string(),
-            tours: None,
+            job: None,
         }
     }
 }
@@ -471,9 +472,12 @@ impl Run<'_> {
                 Some(Event::Gone(v)) => self.presence(&v, false),
                 Some(Event::Alive(v)) => self.presence(&v, true),
                 Some(Event::Message(AgentToCoordinator::Joined { .. })) => {}
-                Some(Event::Message(m @ AgentToCoordinator::Tour { .. })) => self.net.out_of_turn(
-                    &format!("a tour from {} in an exchange mission", m.vehicle()),
-                ),
+                Some(Event::Message(
+                    m @ (AgentToCoordinator::Tour { .. } | AgentToCoordinator::Coverage { .. }),
+                )) => self.net.out_of_turn(&format!(
+                    "a one-shot result from {} in an exchange mission",
+                    m.vehicle()
+                )),
                 None => {}
             }
         }

@@ -1,0 +1,319 @@
+//! One-shot missions: the agents join as for any mission, then each plans its own share once
+//! and sends it up — the inspection tour of its share of the points (seed 003, [`FleetTours`])
+//! or the coverage of its strip of the area (seed 002, [`FleetCoverage`]). Every process derives
+//! the shares from the scenario alone. A vehicle whose agent leaves, ends without a result, or
+//! stays silent past the deadline has its share planned here instead (degraded mode), so a plan
+//! is always produced.
+
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+use shoal_common::coverage::fleet::{FleetCoverage, StripPlan};
+use shoal_common::coverage::TerrainMap25;
+use shoal_common::distributed::Context;
+use shoal_common::plan::{AgentFigures, DegradedVehicle, DistributedFigures};
+use shoal_common::tour::{FleetTours, TourPlan};
+use shoal_common::trajectory::Trajectory;
+use shoal_common::wire::agent_to_coordinator::{tour_from_wire, AgentToCoordinator};
+
+use super::super::agents::LocalAgents;
+use super::super::network::{Event, POLL};
+use super::{Run, Status, GONE_GRACE};
+
+/// Shortest time the coordinator waits for the results once every agent has joined.
+const MIN_SHARE_WAIT: Duration = Duration::from_secs(60);
+
+/// What the agents of a one-shot mission plan.
+pub enum ShareJob {
+    /// Inspection tours (seed 003).
+    Tours(Box<FleetTours>),
+    /// Coverage strips (seed 002) on the seabed map.
+    Strips(Box<FleetCoverage>, Box<TerrainMap25>),
+}
+
+/// One vehicle's result.
+#[derive(Debug, Clone)]
+pub enum Share {
+    /// Its inspection tour.
+    Tour(TourPlan),
+    /// Its strip's coverage plan.
+    Strip(Box<StripPlan>),
+    /// The coordinator could not plan it either.
+    Failed(String),
+}
+
+impl ShareJob {
+    /// Plans vehicle `i`'s share in this process.
+    fn plan_here(&self, i: usize) -> Share {
+        match self {
+            ShareJob::Tours(job) => Share::Tour(job.plan_vehicle(i)),
+            ShareJob::Strips(job, map) => match job.plan_vehicle(map, i, &mut |_, _| {}) {
+                Ok(p) => Share::Strip(Box::new(p)),
+                Err(e) => Share::Failed(e.to_string()),
+            },
+        }
+    }
+
+    /// The share a result message carries for vehicle `i`, checked; `None` when the message
+    /// is not this job's kind of result.
+    fn read(&self, i: usize, m: AgentToCoordinator) -> Option<Result<Share, String>> {
+        match (self, m) {
+            (
+                ShareJob::Tours(job),
+                AgentToCoordinator::Tour {
+                    order,
+                    path,
+                    leg_lengths,
+                    straight_m,
+                    intersections,
+                    ..
+                },
+            ) => {
+                let share = job.shares.get(i).map_or(0, Vec::len);
+                Some(
+                    tour_from_wire(
+                        &order,
+                        &path,
+                        &leg_lengths,
+                        straight_m,
+                        intersections,
+                        share,
+                    )
+                    .map(Share::Tour),
+                )
+            }
+            (ShareJob::Strips(job, _), AgentToCoordinator::Coverage { strip, plan, .. }) => {
+                Some(match job.strips.get(i) {
+                    _ if strip as usize != i => Err(format!("strip {strip} for vehicle {i}")),
+                    Some(rect) => plan.check(*rect).map(|()| Share::Strip(plan)),
+                    None => Err(format!("no strip for vehicle {i}")),
+                })
+            }
+            _ => None,
+        }
+    }
+
+    /// What the agents send, in words.
+    fn noun(&self) -> &'static str {
+        match self {
+            ShareJob::Tours(_) => "tour",
+            ShareJob::Strips(..) => "strip plan",
+        }
+    }
+}
+
+impl Share {
+    /// Its length, metres (the progress line's figure).
+    fn length_m(&self) -> f64 {
+        match self {
+            Share::Tour(t) => t.tour_length_m,
+            Share::Strip(p) => p.path.length(),
+            Share::Failed(_) => 0.0,
+        }
+    }
+}
+
+/// The assignment's context for a one-shot mission: every vehicle at its start (the agents do
+/// not score against it; `Assign` carries one for every mission).
+pub(super) fn base_context(run: &Run) -> Context {
+    Context {
+        round: 0,
+        arrival: 0.0,
+        trajectories: run
+            .scenario
+            .vehicles
+            .iter()
+            .map(|v| Trajectory {
+                times: vec![0.0],
+                points: vec![v.start()],
+            })
+            .collect(),
+    }
+}
+
+impl Run<'_> {
+    /// Plans vehicle `i`'s share here and records why.
+    fn degrade_share(&mut self, i: usize, job: &ShareJob, why: String) {
+        let seat = &mut self.seats[i];
+        if seat.share.is_some() {
+            return;
+        }
+        tracing::warn!(
+            "planning {}'s {} in the coordinator: {why}",
+            seat.id,
+            job.noun()
+        );
+        seat.share = Some(job.plan_here(i));
+        seat.alive = false;
+        seat.joined = true;
+        seat.degraded = Some(DegradedVehicle {
+            vehicle: seat.id.clone(),
+            from_round: 0,
+            reason: why,
+        });
+    }
+
+    /// Keeps a result message for its seat, or drops it (counted) when it does not fit.
+    pub(super) fn take_share(&mut self, job: &ShareJob, m: AgentToCoordinator) {
+        let vehicle = m.vehicle().to_string();
+        let Some(i) = self.index(&vehicle) else {
+            return;
+        };
+        match job.read(i, m) {
+            Some(Ok(share)) if self.seats[i].share.is_none() => {
+                self.seats[i].share = Some(share);
+                self.seats[i].joined = true;
+            }
+            Some(Ok(_)) => self
+                .net
+                .out_of_turn(&format!("a second {} from {vehicle}", job.noun())),
+            Some(Err(why)) => self.net.out_of_turn(&format!("{vehicle}: {why}")),
+            None => self.net.out_of_turn(&format!(
+                "{vehicle} sent another kind of result than a {}",
+                job.noun()
+            )),
+        }
+    }
+
+    /// An agent's `Done`: its figures are kept; without its result before it, its share is
+    /// planned here (a result always comes before `Done` on the agent's one publisher).
+    pub(super) fn share_done(
+        &mut self,
+        job: &ShareJob,
+        vehicle: &str,
+        iterations: u32,
+        evaluations: u64,
+        dropped: u32,
+    ) {
+        let Some(i) = self.index(vehicle) else {
+            return;
+        };
+        self.seats[i].done = Some((iterations, evaluations, dropped));
+        self.seats[i].agent_iterations = iterations;
+        let why = format!("its agent ended the mission without a {}", job.noun());
+        self.degrade_share(i, job, why);
+    }
+
+    /// Waits for every vehicle's share (see the module doc).
+    fn collect_shares(
+        &mut self,
+        job: &ShareJob,
+        stop: &AtomicBool,
+        observe: &mut dyn FnMut(&Status),
+    ) {
+        let deadline = Instant::now() + self.timing.round.max(MIN_SHARE_WAIT);
+        let n = self.seats.len();
+        loop {
+            let waiting: Vec<usize> = (0..n).filter(|&i| self.seats[i].share.is_none()).collect();
+            observe(&Status {
+                iteration: n - waiting.len(),
+                max_iterations: n,
+                best_cost: self
+                    .seats
+                    .iter()
+                    .filter_map(|s| s.share.as_ref())
+                    .map(Share::length_m)
+                    .sum(),
+                alive: self.seats.iter().filter(|s| s.degraded.is_none()).count(),
+                vehicles: n,
+            });
+            if waiting.is_empty() {
+                return;
+            }
+            if stop.load(Ordering::Relaxed) {
+                for i in waiting {
+                    self.degrade_share(i, job, "the coordinator was interrupted".into());
+                }
+                continue;
+            }
+            for &i in &waiting {
+                let expired = self.seats[i]
+                    .gone
+                    .as_ref()
+                    .filter(|(since, _)| since.elapsed() >= GONE_GRACE)
+                    .map(|(_, why)| why.clone());
+                if let Some(why) = expired {
+                    self.degrade_share(i, job, why);
+                }
+            }
+            if Instant::now() >= deadline {
+                for i in waiting {
+                    let why = format!(
+                        "no {} from its agent within {:.0} s",
+                        job.noun(),
+                        self.timing.round.max(MIN_SHARE_WAIT).as_secs_f64()
+                    );
+                    self.degrade_share(i, job, why);
+                }
+                continue;
+            }
+            match self.net.next(deadline.min(Instant::now() + POLL)) {
+                Some(Event::Message(
+                    m @ (AgentToCoordinator::Tour { .. } | AgentToCoordinator::Coverage { .. }),
+                )) => self.take_share(job, m),
+                Some(Event::Message(AgentToCoordinator::Done {
+                    vehicle,
+                    iterations,
+                    evaluations,
+                    dropped,
+                    ..
+                })) => self.share_done(job, &vehicle, iterations, evaluations, dropped),
+                Some(Event::Gone(v)) => self.presence(&v, false),
+                Some(Event::Alive(v)) => self.presence(&v, true),
+                Some(Event::Message(AgentToCoordinator::Joined { .. })) | None => {}
+                Some(Event::Message(m)) => self.net.out_of_turn(&format!(
+                    "{} sent elites in a one-shot mission",
+                    m.vehicle()
+                )),
+            }
+        }
+    }
+}
+
+/// Runs a one-shot mission: join, collect (or plan here) every vehicle's share, stop the agents.
+pub fn run_shares(
+    run: &mut Run,
+    job: ShareJob,
+    local: Option<&mut LocalAgents>,
+    stop: &AtomicBool,
+    observe: &mut dyn FnMut(&Status),
+) -> anyhow::Result<(Vec<Share>, DistributedFigures)> {
+    let context = base_context(run);
+    let job = Arc::new(job);
+    run.job = Some(Arc::clone(&job));
+    run.join(&context, local, stop)?;
+    run.collect_shares(&job, stop, observe);
+    run.finish("plan complete");
+    let shares = (0..run.seats.len())
+        .map(|i| {
+            run.seats[i]
+                .share
+                .clone()
+                .unwrap_or_else(|| job.plan_here(i))
+        })
+        .collect();
+    let iterations = run.scenario.optimizer.iterations as u32;
+    let figures = DistributedFigures {
+        mission: run.mission.clone(),
+        exchanges: 0,
+        messages_dropped: run.net.dropped,
+        agents: run
+            .seats
+            .iter()
+            .map(|s| AgentFigures {
+                vehicle: s.id.clone(),
+                iterations: s.done.map_or(iterations, |d| d.0),
+                elites_sent: 0,
+                messages_dropped: s.done.map(|d| d.2),
+                degraded: s.degraded.is_some(),
+            })
+            .collect(),
+        degraded: run
+            .seats
+            .iter()
+            .filter_map(|s| s.degraded.clone())
+            .collect(),
+    };
+    Ok((shares, figures))
+}
