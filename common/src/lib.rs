@@ -10,6 +10,7 @@ pub mod current;
 pub mod current_grid;
 pub mod distributed;
 pub mod energy;
+pub mod execution;
 #[cfg(test)]
 mod fixtures;
 pub mod fleet;

@@ -32,6 +32,19 @@ pub fn max(x: &[f64]) -> f64 {
     x.iter().copied().reduce(f64::max).unwrap_or(f64::NAN)
 }
 
+/// The `q`-quantile of `x` (0 ≤ q ≤ 1) by linear interpolation between the order statistics
+/// at rank `q (n − 1)`; NaN for no data.
+pub fn quantile(x: &[f64], q: f64) -> f64 {
+    if x.is_empty() {
+        return f64::NAN;
+    }
+    let mut v = x.to_vec();
+    v.sort_by(f64::total_cmp);
+    let r = q.clamp(0.0, 1.0) * (v.len() - 1) as f64;
+    let (lo, hi) = (r.floor() as usize, r.ceil() as usize);
+    v[lo] + (v[hi] - v[lo]) * (r - lo as f64)
+}
+
 /// Ranks 1..n of `x` (ties get the mean of the ranks they span), and Σ (t³ − t) over the tie
 /// groups, which the normal approximation's variance needs.
 pub fn ranks(x: &[f64]) -> (Vec<f64>, f64) {
@@ -124,6 +137,17 @@ pub fn erfc(x: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn quantiles_interpolate_between_order_statistics() {
+        let x = [4.0, 1.0, 3.0, 2.0, 5.0];
+        assert!((quantile(&x, 0.5) - 3.0).abs() < 1e-12);
+        assert!((quantile(&x, 0.0) - 1.0).abs() < 1e-12);
+        assert!((quantile(&x, 1.0) - 5.0).abs() < 1e-12);
+        // rank 0.99 × 4 = 3.96: 4 + 0.96 × (5 − 4)
+        assert!((quantile(&x, 0.99) - 4.96).abs() < 1e-12);
+        assert!(quantile(&[], 0.5).is_nan());
+    }
     use approx::{assert_abs_diff_eq, assert_relative_eq};
 
     fn test(x: &[f64], y: &[f64]) -> RankSum {

@@ -38,6 +38,17 @@ pub enum Command {
     BenchEnergy(crate::bench_energy::BenchEnergyArgs),
     /// Compare LDIW-PSO, LCPSO and DE-PSO on cage-inspection tours (seed 003 Table 6).
     BenchCages(crate::bench_cages::BenchCagesArgs),
+    /// Plan a scenario, then execute it: every agent drives its vehicle along its trajectory
+    /// (simulated vehicles by default), the coordinator watches the fleet and replans.
+    Run(crate::run_cmd::RunArgs),
+    /// Re-read a mission log (`run`'s mission.ndjson): events, figures and an SVG of the tracks.
+    Replay(crate::replay::ReplayArgs),
+    /// Measure the coordinator's CPU use and telemetry latency with N simulated vehicles.
+    BenchTelemetry(crate::bench_telemetry::BenchTelemetryArgs),
+    /// Take missions submitted over Zenoh (`shoal/submit`, JSON) and run each (plan, execute).
+    Serve(crate::serve::ServeArgs),
+    /// Print the live fleet picture of the running missions (a Zenoh query).
+    Status(crate::status_cmd::StatusArgs),
     /// Compare seed 002's arc-smoothed Boustrophedon with the Hybrid A* baseline on seeded maps
     /// (coverage, planning time, clearance, cross-track error; Table 2 and Figure 7).
     BenchCoverage(crate::coverage_cmd::BenchCoverageArgs),

@@ -5,6 +5,7 @@ pub mod bench_cages;
 pub mod bench_energy;
 pub mod bench_functions;
 pub mod bench_pool;
+pub mod bench_telemetry;
 pub mod cli;
 pub mod compare;
 pub mod coverage_cmd;
@@ -12,8 +13,13 @@ pub mod coverage_fleet;
 pub mod crawler_table;
 pub mod distributed;
 pub mod energy_planner;
+pub mod execute;
 pub mod generate;
 pub mod planner;
+pub mod replay;
+pub mod run_cmd;
+pub mod serve;
+pub mod status_cmd;
 pub mod summary;
 pub mod svg;
 pub mod svg_coverage;
@@ -51,6 +57,11 @@ pub fn run(command: Command, shutdown: Arc<AtomicBool>) -> anyhow::Result<i32> {
         Command::BenchEnergy(args) => bench_energy::command(&args, &shutdown),
         Command::BenchCages(args) => bench_cages::command(&args, &shutdown),
         Command::BenchCoverage(args) => coverage_cmd::bench_coverage(&args),
+        Command::Run(args) => run_cmd::run_command(&args, shutdown),
+        Command::Replay(args) => replay::command(&args),
+        Command::Serve(args) => serve::command(&args, shutdown),
+        Command::BenchTelemetry(args) => bench_telemetry::command(&args, &shutdown),
+        Command::Status(args) => status_cmd::command(&args),
         Command::Health(args) => {
             shoal_common::health::check(&args.file, std::time::Duration::from_secs(10))
                 .map_err(anyhow::Error::msg)?;
@@ -99,6 +110,7 @@ fn compare_command(args: &compare::CompareArgs, stop: &AtomicBool) -> anyhow::Re
         agent_bin: None,
         log_dir: std::env::temp_dir().join("shoal-compare-logs"),
         health_file: None,
+        agent_args: Vec::new(),
     });
     let cells = compare::compare(
         &scenarios,
@@ -200,6 +212,7 @@ pub fn distributed_options(
         agent_bin: args.agent_bin.clone(),
         log_dir: args.out.join("logs"),
         health_file: args.health_file.clone(),
+        agent_args: Vec::new(),
     })
 }
 
@@ -305,7 +318,7 @@ pub fn write_svg(dir: &Path, scenario: &Scenario, plan: &Plan) -> anyhow::Result
 }
 
 /// Prints to stdout; a closed pipe (`| head`) is not an error worth a panic.
-fn say(text: &str) {
+pub(crate) fn say(text: &str) {
     use std::io::Write;
     let mut out = std::io::stdout().lock();
     let _ = out.write_all(text.as_bytes()).and_then(|()| out.flush());

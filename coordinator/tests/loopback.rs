@@ -50,6 +50,7 @@ fn options(mission: &str, endpoint: &str, join_s: u64) -> DistributedOptions {
         agent_bin: None,
         log_dir: std::env::temp_dir(),
         health_file: None,
+        agent_args: Vec::new(),
     }
 }
 
@@ -69,6 +70,8 @@ fn agent(vehicle: &str, endpoint: &str) -> Agent {
         idle_timeout: 10.0,
         health_file: None,
         health_check: false,
+        link: shoal_agent::link::LinkKind::Sim,
+        position_noise: 1.0,
     };
     let flag = Arc::clone(&stop);
     Agent {

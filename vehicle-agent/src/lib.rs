@@ -7,8 +7,13 @@
 //! is stopped. The layers stay apart so a vehicle link can be added without touching the swarm:
 //! - [`network`]: the Zenoh session, subscriptions, decoding and counting of bad messages;
 //! - [`mission`]: one mission's planning loop, fed messages through a channel and sending
-//!   through a closure, with no knowledge of Zenoh.
+//!   through a closure, with no knowledge of Zenoh;
+//! - [`execute`]: one execution: the vehicle drives its plan through its [`link::VehicleLink`]
+//!   and the agent reports telemetry;
+//! - [`link`]: the vehicle-link seam (a simulator now; real vehicles plug in there).
 
+pub mod execute;
+pub mod link;
 pub mod mission;
 pub mod network;
 
@@ -49,12 +54,28 @@ pub struct AgentArgs {
     /// container healthcheck).
     #[arg(long)]
     pub health_check: bool,
+    /// How the agent drives its vehicle when a plan is executed.
+    #[arg(long, env = "SHOAL_LINK", value_enum, default_value_t = link::LinkKind::Sim)]
+    pub link: link::LinkKind,
+    /// `sim` link: position noise of the simulated fixes (standard deviation per axis), metres.
+    #[arg(long, env = "SHOAL_POSITION_NOISE", default_value_t = 1.0)]
+    pub position_noise: f64,
 }
 
 impl AgentArgs {
     /// The idle timeout as a duration (a bad value falls back to 30 s).
     pub fn idle(&self) -> Duration {
         Duration::try_from_secs_f64(self.idle_timeout).unwrap_or(Duration::from_secs(30))
+    }
+}
+
+impl AgentArgs {
+    /// The vehicle-link settings.
+    pub fn link_settings(&self) -> link::LinkSettings {
+        link::LinkSettings {
+            kind: self.link,
+            position_noise_m: self.position_noise,
+        }
     }
 }
 
@@ -74,6 +95,12 @@ pub fn run(args: AgentArgs, shutdown: Arc<AtomicBool>) -> anyhow::Result<()> {
         anyhow::bail!(
             "--idle-timeout (SHOAL_IDLE_TIMEOUT) = {}: must be a positive number of seconds",
             args.idle_timeout
+        );
+    }
+    if !(args.position_noise.is_finite() && args.position_noise >= 0.0) {
+        anyhow::bail!(
+            "--position-noise (SHOAL_POSITION_NOISE) = {}: must be a non-negative number of metres",
+            args.position_noise
         );
     }
     network::serve(&args, &shutdown)

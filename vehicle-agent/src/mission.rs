@@ -307,7 +307,11 @@ fn wait_for_migrants(
                 particles,
                 ..
             } if r == round => migrants = Some((particles, context_round)),
-            CoordinatorToAgent::Migrants { .. } | CoordinatorToAgent::Assign { .. } => {}
+            CoordinatorToAgent::Migrants { .. }
+            | CoordinatorToAgent::Assign { .. }
+            | CoordinatorToAgent::Execute { .. }
+            | CoordinatorToAgent::Update { .. }
+            | CoordinatorToAgent::Hold { .. } => {}
             CoordinatorToAgent::Stop { reason, .. } => {
                 return Wait::End(format!("stopped: {reason}"))
             }

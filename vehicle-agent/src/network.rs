@@ -21,8 +21,11 @@ use shoal_common::wire::{session, topics, Envelope};
 use zenoh::qos::CongestionControl;
 use zenoh::{Session, Wait};
 
+use crate::execute::{self, Order};
+use crate::link;
 use crate::mission::{self, Assignment, MissionReport};
 use crate::AgentArgs;
+use shoal_common::wire::open::Telemetry;
 
 /// A mission being planned on its own thread.
 struct Worker {
@@ -286,7 +289,44 @@ impl Inbound<'_> {
                     Err(why) => self.drops.drop_message("unusable assignment", &why),
                 }
             }
-            CoordinatorToAgent::Migrants { vehicle: ref v, .. } if v != vehicle => {
+            CoordinatorToAgent::Execute {
+                vehicle: v,
+                scenario_toml,
+                trajectory,
+                epoch_unix_ms,
+                time_scale,
+                telemetry_hz,
+                seed,
+                ..
+            } => {
+                if v != *vehicle {
+                    return self.drops.drop_message(
+                        "unknown vehicle",
+                        &format!("mission {mission} gave {v:?} to the agent of {vehicle}"),
+                    );
+                }
+                if self.workers.contains_key(&mission) || self.finished.contains(&mission) {
+                    return; // a repeat: our telemetry is on its way
+                }
+                match Order::new(
+                    &mission,
+                    vehicle,
+                    &scenario_toml,
+                    &trajectory,
+                    epoch_unix_ms,
+                    time_scale,
+                    telemetry_hz,
+                    seed,
+                ) {
+                    Ok(order) => self.start_execution(order),
+                    Err(why) => self.drops.drop_message("unusable execution order", &why),
+                }
+            }
+            CoordinatorToAgent::Migrants { vehicle: ref v, .. }
+            | CoordinatorToAgent::Update { vehicle: ref v, .. }
+            | CoordinatorToAgent::Hold { vehicle: ref v, .. }
+                if v != vehicle =>
+            {
                 self.drops.drop_message(
                     "unknown vehicle",
                     &format!("migrants for {v:?} reached the agent of {vehicle}"),
@@ -332,6 +372,59 @@ impl Inbound<'_> {
                     &self.args.vehicle,
                     joined(&mission, &self.args.vehicle),
                 );
+                self.workers.insert(mission, Worker { tx, stop, handle });
+            }
+            Err(e) => tracing::error!("mission {mission}: {e:#}"),
+        }
+    }
+}
+
+impl Inbound<'_> {
+    /// Starts driving the vehicle on a thread of its own, through the link the command line
+    /// chose.
+    fn start_execution(self, order: Order) {
+        let mission = order.mission.clone();
+        let mut link = match link::open(
+            &self.args.link_settings(),
+            &order.scenario,
+            order.index,
+            order.seed,
+        ) {
+            Ok(l) => l,
+            Err(e) => {
+                tracing::error!("mission {mission}: cannot open the vehicle link: {e}");
+                return;
+            }
+        };
+        let key = match topics::telemetry(&mission, &self.args.vehicle) {
+            Ok(k) => k,
+            Err(e) => return tracing::error!("mission {mission}: {e}"),
+        };
+        let (tx, rx) = mpsc::channel();
+        let stop = Arc::new(AtomicBool::new(false));
+        let session = self.session.clone();
+        let (idle, flag) = (self.args.idle(), Arc::clone(&stop));
+        let spawned = std::thread::Builder::new()
+            .name(format!("execute-{mission}"))
+            .spawn(move || {
+                // Telemetry is latest-wins: a congested link drops a report rather than block.
+                let publish = |t: &Telemetry| match codec::encode_json(t) {
+                    Ok(bytes) => {
+                        let put = session
+                            .put(key.as_str(), bytes)
+                            .congestion_control(CongestionControl::Drop)
+                            .wait();
+                        if let Err(e) = put {
+                            tracing::warn!("cannot publish on {key}: {e}");
+                        }
+                    }
+                    Err(e) => tracing::warn!("cannot encode telemetry: {e}"),
+                };
+                execute::run(order, link.as_mut(), &rx, &publish, &flag, idle)
+            })
+            .context("cannot start an execution thread");
+        match spawned {
+            Ok(handle) => {
                 self.workers.insert(mission, Worker { tx, stop, handle });
             }
             Err(e) => tracing::error!("mission {mission}: {e:#}"),

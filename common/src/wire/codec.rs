@@ -71,6 +71,26 @@ pub fn decode<T: DeserializeOwned>(bytes: &[u8]) -> Result<Envelope<T>, DecodeEr
         .map_err(|e| DecodeError::Malformed(e.to_string()))
 }
 
+/// Largest JSON payload of the open interface accepted, bytes.
+pub const MAX_JSON_BYTES: usize = 1024 * 1024;
+
+/// Writes a payload of the open interface ([`super::open`]) as JSON.
+pub fn encode_json<T: Serialize>(payload: &T) -> Result<Vec<u8>, EncodeError> {
+    serde_json::to_vec(payload).map_err(|e| EncodeError(e.to_string()))
+}
+
+/// Reads a payload of the open interface; over [`MAX_JSON_BYTES`] or not the expected JSON is
+/// an error naming what is wrong.
+pub fn decode_json<T: DeserializeOwned>(bytes: &[u8]) -> Result<T, DecodeError> {
+    if bytes.len() > MAX_JSON_BYTES {
+        return Err(DecodeError::Malformed(format!(
+            "JSON payload of {} bytes is over the {MAX_JSON_BYTES}-byte limit",
+            bytes.len()
+        )));
+    }
+    serde_json::from_slice(bytes).map_err(|e| DecodeError::Malformed(e.to_string()))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

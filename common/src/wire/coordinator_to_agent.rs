@@ -2,7 +2,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::{WireChromosome, WireContext};
+use super::{WireChromosome, WireContext, WireTrajectory};
 
 /// Coordinator → agent. Variants are only ever added at the end: their index is on the wire.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -47,6 +47,48 @@ pub enum CoordinatorToAgent {
         /// Why, in plain words.
         reason: String,
     },
+    /// Drive `vehicle` along its timed trajectory (issue 8); repeated until its telemetry comes.
+    /// Mission time `t` runs as `(unix_now − epoch) × time_scale`, so the whole fleet shares one
+    /// clock (agents on other machines need synchronised clocks, e.g. NTP).
+    Execute {
+        /// Mission id (an execution is a mission of its own).
+        mission: String,
+        /// The vehicle.
+        vehicle: String,
+        /// The scenario as TOML (vehicle limits, terrain, currents for a simulated vehicle).
+        scenario_toml: String,
+        /// The trajectory, mission-timed.
+        trajectory: WireTrajectory,
+        /// Unix time of mission time 0, milliseconds.
+        epoch_unix_ms: u64,
+        /// Mission seconds per wall second (1 = real time).
+        time_scale: f64,
+        /// Telemetry reports per wall second.
+        telemetry_hz: f64,
+        /// Seed of the simulated vehicle's noise.
+        seed: u64,
+    },
+    /// A replanned trajectory (mission-timed, from the vehicle's current position on): follow it
+    /// from now on, leaving a hold if it was holding.
+    Update {
+        /// Mission id.
+        mission: String,
+        /// The vehicle.
+        vehicle: String,
+        /// Plan revision (0 = the first plan), echoed in its telemetry.
+        revision: u32,
+        /// The trajectory.
+        trajectory: WireTrajectory,
+    },
+    /// Hold where it is (no replan could be made in time).
+    Hold {
+        /// Mission id.
+        mission: String,
+        /// The vehicle.
+        vehicle: String,
+        /// Why, in plain words.
+        reason: String,
+    },
 }
 
 impl CoordinatorToAgent {
@@ -56,7 +98,10 @@ impl CoordinatorToAgent {
             CoordinatorToAgent::Assign { mission, .. }
             | CoordinatorToAgent::Context { mission, .. }
             | CoordinatorToAgent::Migrants { mission, .. }
-            | CoordinatorToAgent::Stop { mission, .. } => mission,
+            | CoordinatorToAgent::Stop { mission, .. }
+            | CoordinatorToAgent::Execute { mission, .. }
+            | CoordinatorToAgent::Update { mission, .. }
+            | CoordinatorToAgent::Hold { mission, .. } => mission,
         }
     }
 }

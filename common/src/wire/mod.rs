@@ -12,6 +12,7 @@
 pub mod agent_to_coordinator;
 pub mod codec;
 pub mod coordinator_to_agent;
+pub mod open;
 pub mod session;
 pub mod topics;
 

@@ -9,6 +9,12 @@
 //! shoal/<mission>/vehicle/*/out          what the coordinator listens on for a mission
 //! shoal-alive/<id>                       an agent's liveliness token (agents outlive missions)
 //! shoal-coordinator/<mission>            the coordinator's liveliness token for a mission
+//! shoal/<mission>/telemetry/<id>         JSON: one vehicle's telemetry (open interface)
+//! shoal/<mission>/status                 JSON: the live fleet picture (put, and a queryable)
+//! shoal/<mission>/plan                   JSON: the current plan, on every (re)plan
+//! shoal/<mission>/events                 JSON: the coordinator's decisions
+//! shoal/<mission>/obstacles              JSON in: a new obstacle for a running mission
+//! shoal/submit                           JSON query: submit a mission (`serve`)
 //! ```
 //!
 //! Mission and vehicle ids become key chunks, so they are restricted to letters, digits, `-`, `_`
@@ -95,6 +101,67 @@ pub fn mission_of_coordinator(key: &str) -> Option<&str> {
     check_id("mission", id).ok().map(|()| id)
 }
 
+/// One vehicle's telemetry in `mission` (JSON, [`super::open::Telemetry`]).
+pub fn telemetry(mission: &str, vehicle: &str) -> Result<String, IdError> {
+    check_id("mission", mission)?;
+    check_id("vehicle", vehicle)?;
+    Ok(format!("shoal/{mission}/telemetry/{vehicle}"))
+}
+
+/// Every vehicle's telemetry in `mission`.
+pub fn all_telemetry(mission: &str) -> Result<String, IdError> {
+    check_id("mission", mission)?;
+    Ok(format!("shoal/{mission}/telemetry/*"))
+}
+
+/// The vehicle of a key built by [`telemetry`].
+pub fn vehicle_of_telemetry(key: &str) -> Option<&str> {
+    let rest = key.strip_prefix("shoal/")?;
+    let mut parts = rest.split('/');
+    let (mission, kw, vehicle) = (parts.next()?, parts.next()?, parts.next()?);
+    if parts.next().is_some() || kw != "telemetry" {
+        return None;
+    }
+    check_id("mission", mission).ok()?;
+    check_id("vehicle", vehicle).ok().map(|()| vehicle)
+}
+
+/// One of a mission's open JSON keys: `status`, `plan`, `events` or `obstacles`.
+pub fn open_key(mission: &str, what: OpenKey) -> Result<String, IdError> {
+    check_id("mission", mission)?;
+    Ok(format!("shoal/{mission}/{}", what.chunk()))
+}
+
+/// The mission-wide JSON keys of the open interface.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum OpenKey {
+    /// The live fleet picture.
+    Status,
+    /// The current plan.
+    Plan,
+    /// The coordinator's decisions.
+    Events,
+    /// New obstacles (input).
+    Obstacles,
+}
+
+impl OpenKey {
+    fn chunk(self) -> &'static str {
+        match self {
+            OpenKey::Status => "status",
+            OpenKey::Plan => "plan",
+            OpenKey::Events => "events",
+            OpenKey::Obstacles => "obstacles",
+        }
+    }
+}
+
+/// Where missions are submitted (a query with a JSON submission; `shoal-coordinator serve`).
+pub const SUBMIT: &str = "shoal/submit";
+
+/// Every running mission's fleet picture (what `shoal-coordinator status` queries).
+pub const ALL_STATUS: &str = "shoal/*/status";
+
 /// Every agent's liveliness token.
 pub const ALL_LIVELINESS: &str = "shoal-alive/*";
 
@@ -153,6 +220,18 @@ mod tests {
             Some(("m-1", "auv3"))
         );
         assert_eq!(mission_and_vehicle("shoal/m-1/vehicle/auv3/sideways"), None);
+        assert_eq!(telemetry("m-1", "auv3")?, "shoal/m-1/telemetry/auv3");
+        assert_eq!(all_telemetry("m-1")?, "shoal/m-1/telemetry/*");
+        assert_eq!(
+            vehicle_of_telemetry(&telemetry("m-1", "auv3")?),
+            Some("auv3")
+        );
+        assert_eq!(vehicle_of_telemetry("shoal/m-1/telemetry/a/b"), None);
+        assert_eq!(vehicle_of_telemetry("shoal/m-1/vehicle/auv3"), None);
+        assert_eq!(open_key("m-1", OpenKey::Status)?, "shoal/m-1/status");
+        assert_eq!(open_key("m-1", OpenKey::Plan)?, "shoal/m-1/plan");
+        assert_eq!(open_key("m-1", OpenKey::Events)?, "shoal/m-1/events");
+        assert_eq!(open_key("m-1", OpenKey::Obstacles)?, "shoal/m-1/obstacles");
         assert_eq!(
             mission_and_vehicle("shoal/m-1/vehicle/auv3/out/extra"),
             None

@@ -49,6 +49,7 @@ impl LocalAgents {
         vehicles: &[String],
         endpoint: &str,
         log_dir: &Path,
+        extra_args: &[String],
     ) -> anyhow::Result<LocalAgents> {
         std::fs::create_dir_all(log_dir)
             .with_context(|| format!("cannot create the log directory {}", log_dir.display()))?;
@@ -61,6 +62,7 @@ impl LocalAgents {
                 .with_context(|| format!("cannot create {}", log_path.display()))?;
             let child = Command::new(binary)
                 .args(["--vehicle", v, "--connect", endpoint, "--once"])
+                .args(extra_args)
                 // The coordinator's settings must not leak into the agents through SHOAL_*.
                 .env_remove("SHOAL_VEHICLE")
                 .env_remove("SHOAL_CONNECT")

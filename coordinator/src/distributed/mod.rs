@@ -53,6 +53,8 @@ pub struct DistributedOptions {
     pub log_dir: PathBuf,
     /// Rewritten every 2 s while the router is open (container healthchecks).
     pub health_file: Option<PathBuf>,
+    /// Extra command-line arguments of embedded agents (e.g. `--position-noise 2`).
+    pub agent_args: Vec<String>,
 }
 
 /// A mission id for `scenario` unique enough for one network: its name, this process and the
@@ -216,15 +218,18 @@ fn timing(options: &DistributedOptions) -> mission::Timing {
 }
 
 /// The network side of a run: the embedded router, its health file and the local agents.
-struct Session {
-    net: network::Network,
+pub(crate) struct Session {
+    pub(crate) net: network::Network,
     health: Option<shoal_common::health::Heartbeat>,
-    local: Option<agents::LocalAgents>,
+    pub(crate) local: Option<agents::LocalAgents>,
 }
 
 impl Session {
     /// Opens the router for `scenario`'s vehicles and starts the agents `options` asks for.
-    fn open(scenario: &Scenario, options: &DistributedOptions) -> anyhow::Result<Session> {
+    pub(crate) fn open(
+        scenario: &Scenario,
+        options: &DistributedOptions,
+    ) -> anyhow::Result<Session> {
         let ids: Vec<String> = scenario.vehicles.iter().map(|v| v.id.clone()).collect();
         let net =
             network::Network::open(&options.listen, &options.routers, &options.mission, &ids)?;
@@ -246,6 +251,7 @@ impl Session {
                     &ids,
                     &endpoint,
                     &options.log_dir,
+                    &options.agent_args,
                 )?)
             }
             AgentsMode::External => {
@@ -263,7 +269,7 @@ impl Session {
     }
 
     /// Stops the local agents, then closes the router, then the health file.
-    fn close(self) {
+    pub(crate) fn close(self) {
         let Session { net, health, local } = self;
         drop(local);
         net.close();

@@ -215,6 +215,11 @@ impl Network {
         self.put(&topics::fleet(&self.mission)?, message)
     }
 
+    /// The Zenoh session, for the execution's open-interface keys.
+    pub fn session(&self) -> &Session {
+        &self.session
+    }
+
     /// Closes the session (agents see the router go).
     pub fn close(self) {
         if let Err(e) = self.session.close().wait() {
@@ -244,7 +249,7 @@ pub fn serve_router(
 
 /// `tcp/HOST:0` → `tcp/HOST:<a port free right now>`; other endpoints unchanged. (Zenoh 1.10
 /// reports the bound port only through an unstable API, and agents need to know it.)
-fn resolve_port_zero(endpoint: &str) -> anyhow::Result<String> {
+pub fn resolve_port_zero(endpoint: &str) -> anyhow::Result<String> {
     let Some(rest) = endpoint.strip_prefix("tcp/") else {
         return Ok(endpoint.to_string());
     };

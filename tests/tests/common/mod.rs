@@ -12,7 +12,7 @@
 #![allow(dead_code)]
 
 pub mod fleet;
-mod process;
+pub mod process;
 
 use std::error::Error;
 use std::path::{Path, PathBuf};

@@ -1,0 +1,57 @@
+//! Executing a plan (issue 8): what a vehicle reports while it drives its timed trajectory, a
+//! kinematic simulator of the vehicle kinds ([`sim`]), and the coordinator's live fleet picture
+//! computed from the latest reports and the plans ([`picture`]).
+//!
+//! Times are *mission* seconds: 0 is the plan's start, the same clock the timed trajectories
+//! use. Positions are in the scenario frame (x east, y north, z up, metres).
+
+pub mod picture;
+pub mod sim;
+
+use serde::{Deserialize, Serialize};
+
+/// What a vehicle is doing, as its link reports it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum VehicleStatus {
+    /// Powered, no trajectory loaded yet.
+    Idle,
+    /// Following its trajectory.
+    Underway,
+    /// Commanded to hold where it is (AUV: station-keeping; crawler: stopped on the seabed).
+    Holding,
+    /// Reached the end of its trajectory and holds there.
+    Arrived,
+    /// Commanded to stop: the mission is over for it.
+    Stopped,
+    /// The link reports a fault (lost fix, motor fault, …).
+    Fault,
+}
+
+/// One state report of a vehicle (the telemetry it sends), in the scenario frame.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct VehicleState {
+    /// Mission time of the fix, seconds.
+    pub t_s: f64,
+    /// Position fix, metres (with the link's position noise).
+    pub position: [f64; 3],
+    /// Velocity over ground, m/s.
+    pub velocity: [f64; 3],
+    /// Heading of the horizontal velocity (or of the hull when still), degrees counter-clockwise
+    /// from east (+x), in (−180, 180].
+    pub heading_deg: f64,
+    /// AUVs: depth below the surface (`bounds.max[2] − z`), metres.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub depth_m: Option<f64>,
+    /// Crawlers: height above the seabed, metres.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub altitude_m: Option<f64>,
+    /// Battery left, fraction of a full charge in [0, 1].
+    pub battery: f64,
+    /// What it is doing.
+    pub status: VehicleStatus,
+    /// Mission time it reached the end of its trajectory, as the vehicle tells it (reports
+    /// come only every few mission seconds at high time scales).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub arrived_s: Option<f64>,
+}

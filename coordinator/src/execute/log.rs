@@ -1,0 +1,172 @@
+//! The mission log: one JSON object per line (NDJSON), written as the execution goes, so a
+//! crash loses at most the line being written. `shoal-coordinator replay LOG` reads it back and
+//! recomputes the figures from the records alone.
+//!
+//! Lines: `{"record": "start", …}` first, then `plan`, `telemetry` and `event` records in the
+//! order they happened, and `{"record": "end", …}` with the figures last.
+
+use std::fs::File;
+use std::io::{BufRead, BufReader, BufWriter, Write};
+use std::path::{Path, PathBuf};
+
+use anyhow::Context as _;
+use serde::{Deserialize, Serialize};
+use shoal_common::scenario::Obstacle;
+use shoal_common::wire::open::{MissionEvent, PlanNotice, Telemetry};
+
+use super::fleet::ExecutionFigures;
+
+/// What starts a log.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Start {
+    /// Mission id.
+    pub mission: String,
+    /// The scenario as TOML (obstacles as planned; new ones come as events).
+    pub scenario_toml: String,
+    /// The fleet's arrival time, mission seconds.
+    pub common_arrival_s: f64,
+    /// Half-width of the arrival window, mission seconds.
+    pub arrival_window_s: f64,
+    /// Prediction horizon, mission seconds.
+    pub horizon_s: f64,
+    /// Mission seconds per wall second.
+    pub time_scale: f64,
+    /// Unix time of mission time 0, milliseconds.
+    pub epoch_unix_ms: u64,
+}
+
+/// One line.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "record", rename_all = "snake_case")]
+pub enum Record {
+    /// First line.
+    Start(Start),
+    /// A plan or a replan.
+    Plan(PlanNotice),
+    /// A report, with when it came.
+    Telemetry {
+        /// Unix time of receipt, microseconds.
+        received_unix_us: u64,
+        /// The report.
+        telemetry: Telemetry,
+    },
+    /// A decision or an observation.
+    Event(MissionEvent),
+    /// An obstacle published during the execution.
+    Obstacle(Obstacle),
+    /// Last line.
+    End(ExecutionFigures),
+}
+
+/// Appends records to a log file.
+pub struct LogWriter {
+    out: BufWriter<File>,
+    path: PathBuf,
+}
+
+impl LogWriter {
+    /// Creates (truncates) `path`.
+    pub fn create(path: &Path) -> anyhow::Result<LogWriter> {
+        let file = File::create(path)
+            .with_context(|| format!("cannot create the mission log {}", path.display()))?;
+        Ok(LogWriter {
+            out: BufWriter::new(file),
+            path: path.to_path_buf(),
+        })
+    }
+
+    /// Writes one record (a failure is logged, not fatal: the mission goes on).
+    pub fn write(&mut self, r: &Record) {
+        let line = match serde_json::to_string(r) {
+            Ok(l) => l,
+            Err(e) => return tracing::warn!("cannot serialise a log record: {e}"),
+        };
+        if let Err(e) = writeln!(self.out, "{line}") {
+            tracing::warn!("cannot write {}: {e}", self.path.display());
+        }
+    }
+
+    /// Flushes to disk.
+    pub fn flush(&mut self) {
+        if let Err(e) = self.out.flush() {
+            tracing::warn!("cannot write {}: {e}", self.path.display());
+        }
+    }
+}
+
+/// Reads a whole log; a bad line is an error naming the file, the line and what is wrong.
+pub fn read(path: &Path) -> anyhow::Result<Vec<Record>> {
+    let file = File::open(path)
+        .with_context(|| format!("cannot open the mission log {}", path.display()))?;
+    let mut records = Vec::new();
+    for (n, line) in BufReader::new(file).lines().enumerate() {
+        let line =
+            line.with_context(|| format!("{}: cannot read line {}", path.display(), n + 1))?;
+        if line.trim().is_empty() {
+            continue;
+        }
+        let r: Record = serde_json::from_str(&line).map_err(|e| {
+            anyhow::anyhow!(
+                "{} line {}: not a mission-log record: {e}",
+                path.display(),
+                n + 1
+            )
+        })?;
+        records.push(r);
+    }
+    match records.first() {
+        Some(Record::Start(_)) => Ok(records),
+        _ => anyhow::bail!(
+            "{}: a mission log starts with a \"start\" record; this one does not",
+            path.display()
+        ),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_log_reads_back_and_a_bad_line_is_named() -> anyhow::Result<()> {
+        let dir = std::env::temp_dir().join(format!("shoal-log-test-{}", std::process::id()));
+        std::fs::create_dir_all(&dir)?;
+        let path = dir.join("m.ndjson");
+        let start = Record::Start(Start {
+            mission: "m".into(),
+            scenario_toml: "name = \"x\"".into(),
+            common_arrival_s: 100.0,
+            arrival_window_s: 10.0,
+            horizon_s: 60.0,
+            time_scale: 50.0,
+            epoch_unix_ms: 7,
+        });
+        let event = Record::Event(MissionEvent {
+            version: 1,
+            mission: "m".into(),
+            t_s: 3.5,
+            kind: "hold".into(),
+            vehicles: vec!["auv2".into()],
+            detail: "because".into(),
+        });
+        let mut w = LogWriter::create(&path)?;
+        w.write(&start);
+        w.write(&event);
+        w.flush();
+        assert_eq!(read(&path)?, vec![start, event]);
+        let text = std::fs::read_to_string(&path)?;
+        assert!(text
+            .lines()
+            .next()
+            .unwrap_or("")
+            .contains("\"record\":\"start\""));
+        std::fs::write(&path, format!("{text}{{\"record\": \"nonsense\"}}\n"))?;
+        let e = read(&path).err().map(|e| e.to_string()).unwrap_or_default();
+        assert!(e.contains("line 3") && e.contains("m.ndjson"), "{e}");
+        std::fs::write(&path, text.lines().nth(1).unwrap_or(""))?;
+        let e = read(&path).err().map(|e| e.to_string()).unwrap_or_default();
+        assert!(e.contains("starts with a \"start\" record"), "{e}");
+        std::fs::remove_dir_all(&dir)?;
+        Ok(())
+    }
+}

@@ -1,0 +1,439 @@
+//! Executing a plan (`shoal-coordinator run`, issue 8): every agent drives its vehicle along its
+//! trajectory through its vehicle link and reports telemetry; the coordinator keeps the live
+//! fleet picture ([`fleet`]), publishes it on the open JSON keys, logs everything ([`log`]) and
+//! reacts ([`react`]): a predicted loss of separation, a deviation beyond the tolerance, a
+//! vehicle that stops reporting or a new obstacle makes it replan the affected vehicles
+//! ([`replan`]) or, when no safe replan comes in time, command a hold.
+
+pub mod fleet;
+pub mod log;
+mod react;
+pub mod replan;
+
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::mpsc::{self, Receiver, RecvTimeoutError};
+use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
+
+use shoal_common::geometry::Vec3;
+use shoal_common::plan::Plan;
+use shoal_common::scenario::{Obstacle, Scenario};
+use shoal_common::trajectory::Trajectory;
+use shoal_common::wire::codec;
+use shoal_common::wire::coordinator_to_agent::CoordinatorToAgent;
+use shoal_common::wire::open::{FleetStatus, MissionEvent, PlanNotice, OPEN_VERSION};
+use shoal_common::wire::topics::{self, OpenKey};
+use shoal_common::wire::WireTrajectory;
+use zenoh::Wait;
+
+use crate::distributed::network::Event;
+use crate::distributed::{DistributedOptions, Session};
+use fleet::{ExecutionFigures, Fleet};
+use log::{LogWriter, Record, Start};
+
+/// Settings of an execution.
+#[derive(Debug, Clone)]
+pub struct ExecOptions {
+    /// Mission seconds per wall second.
+    pub time_scale: f64,
+    /// Telemetry reports per wall second and vehicle.
+    pub telemetry_hz: f64,
+    /// How far ahead separation is predicted, mission seconds.
+    pub horizon_s: f64,
+    /// Cross-track error beyond which a vehicle is replanned, metres.
+    pub deviation_m: f64,
+    /// Wall time without a report after which a vehicle is lost.
+    pub lost_after: Duration,
+    /// Wall-time budget of one replan.
+    pub replan_budget: Duration,
+    /// Half-width of the arrival window around the common arrival, mission seconds.
+    pub arrival_window_s: f64,
+    /// The mission log (NDJSON).
+    pub log: PathBuf,
+    /// Obstacles to publish at given mission times (tests and figures: an obstacle appearing
+    /// on a vehicle's path mid-mission), as any client would.
+    pub inject: Vec<(f64, Obstacle)>,
+    /// No progress line on stderr.
+    pub quiet: bool,
+    /// RNG seed (simulated noise, replanning).
+    pub seed: u64,
+}
+
+/// Raw input from the open-interface subscriptions (callbacks do no work themselves).
+enum Open {
+    Telemetry(Vec<u8>, u64),
+    Obstacle(Vec<u8>),
+}
+
+/// Unix time now, microseconds.
+fn unix_us() -> u64 {
+    SystemTime::now()
+        .duration_since(UNIX_EPOCH)
+        .map_or(0, |d| d.as_micros() as u64)
+}
+
+/// The plan's trajectories, scenario order.
+fn plan_trajectories(plan: &Plan) -> Vec<Trajectory> {
+    plan.vehicles
+        .iter()
+        .map(|v| Trajectory {
+            times: v.trajectory.iter().map(|s| s[0]).collect(),
+            points: v
+                .trajectory
+                .iter()
+                .map(|s| Vec3::new(s[1], s[2], s[3]))
+                .collect(),
+        })
+        .collect()
+}
+
+/// Everything the execution loop shares.
+pub(crate) struct Exec<'a> {
+    scenario: Scenario,
+    mission: String,
+    options: &'a ExecOptions,
+    fleet: Fleet,
+    session: Session,
+    log: LogWriter,
+    epoch_unix_ms: u64,
+    common_arrival_s: f64,
+    revision: u32,
+    events: u64,
+    replans: u64,
+    holds: u64,
+    /// Obstacles published during the execution, and when they came (wall).
+    new_obstacles: Vec<(Obstacle, Instant)>,
+    /// Per vehicle: when it was last replanned or held (wall), for a cool-down.
+    last_reaction: Vec<Option<Instant>>,
+    /// Per vehicle: the revision sent and when, to time its delivery.
+    pending: Vec<Option<(u32, Instant)>>,
+    /// Delivery times of updates (decision → first report on the new revision), ms.
+    pub(crate) deliveries_ms: Vec<f64>,
+    /// Decision times of obstacle replans (obstacle received → update sent), ms.
+    pub(crate) decisions_ms: Vec<f64>,
+    dropped: u64,
+}
+
+/// What an execution leaves.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct ExecutionReport {
+    /// The figures.
+    pub figures: ExecutionFigures,
+    /// Replans sent.
+    pub replans: u64,
+    /// Holds commanded.
+    pub holds: u64,
+    /// Obstacle replans: obstacle received → update sent, milliseconds.
+    pub obstacle_decision_ms: Vec<f64>,
+    /// Update sent → first report on the new revision, milliseconds.
+    pub update_delivery_ms: Vec<f64>,
+    /// Malformed or unusable open-interface messages dropped.
+    pub dropped: u64,
+    /// Why it ended.
+    pub ended: String,
+}
+
+impl Exec<'_> {
+    fn clock(&self) -> f64 {
+        let wall = unix_us() as f64 / 1e6 - self.epoch_unix_ms as f64 / 1e3;
+        (wall * self.options.time_scale).max(0.0)
+    }
+
+    /// Wall time since mission time 0 (zero before it).
+    fn clock_wall_since_epoch(&self) -> Duration {
+        Duration::from_micros(unix_us().saturating_sub(self.epoch_unix_ms * 1000))
+    }
+
+    fn put_json<T: serde::Serialize>(&self, key: &str, payload: &T) {
+        match codec::encode_json(payload) {
+            Ok(bytes) => {
+                if let Err(e) = self.session.net.session().put(key, bytes).wait() {
+                    tracing::warn!("cannot publish on {key}: {e}");
+                }
+            }
+            Err(e) => tracing::warn!("cannot encode for {key}: {e}"),
+        }
+    }
+
+    /// Logs and publishes an event.
+    fn event(&mut self, kind: &str, vehicles: Vec<String>, detail: String) {
+        let e = MissionEvent {
+            version: OPEN_VERSION,
+            mission: self.mission.clone(),
+            t_s: self.clock(),
+            kind: kind.to_string(),
+            vehicles,
+            detail,
+        };
+        tracing::info!(kind, "{}", e.detail);
+        if let Ok(key) = topics::open_key(&self.mission, OpenKey::Events) {
+            self.put_json(&key, &e);
+        }
+        self.log.write(&Record::Event(e));
+        self.events += 1;
+    }
+
+    /// Publishes and logs the current plan; `changed` names the vehicles this revision moved.
+    fn publish_plan(&mut self, changed: Vec<String>) {
+        let notice = PlanNotice {
+            version: OPEN_VERSION,
+            mission: self.mission.clone(),
+            revision: self.revision,
+            changed,
+            trajectories: self
+                .fleet
+                .vehicles
+                .iter()
+                .map(|v| (v.id.clone(), WireTrajectory::new(&v.id, &v.plan).samples))
+                .collect(),
+        };
+        if let Ok(key) = topics::open_key(&self.mission, OpenKey::Plan) {
+            self.put_json(&key, &notice);
+        }
+        self.log.write(&Record::Plan(notice));
+    }
+
+    fn status(&self) -> FleetStatus {
+        self.fleet.status(&self.mission, self.clock())
+    }
+
+    fn send(&self, vehicle: &str, m: CoordinatorToAgent) {
+        if let Err(e) = self.session.net.send(vehicle, m) {
+            tracing::warn!("cannot send to {vehicle}: {e:#}");
+        }
+    }
+}
+
+/// Executes `plan` of `scenario`: opens a router (and the agents `distributed` asks for), has
+/// every agent drive its vehicle, and watches until every vehicle has arrived or is lost.
+pub fn execute(
+    scenario: &Scenario,
+    plan: &Plan,
+    distributed: &DistributedOptions,
+    options: &ExecOptions,
+    stop: &AtomicBool,
+) -> anyhow::Result<ExecutionReport> {
+    execute_trajectories(
+        scenario,
+        &plan_trajectories(plan),
+        plan.common_arrival_s,
+        distributed,
+        options,
+        stop,
+    )
+}
+
+/// [`execute`] on given trajectories (scenario order, mission-timed) and their common arrival.
+pub fn execute_trajectories(
+    scenario: &Scenario,
+    plans: &[Trajectory],
+    common_arrival_s: f64,
+    distributed: &DistributedOptions,
+    options: &ExecOptions,
+    stop: &AtomicBool,
+) -> anyhow::Result<ExecutionReport> {
+    topics::check_id("mission", &distributed.mission)?;
+    let ids: Vec<String> = scenario.vehicles.iter().map(|v| v.id.clone()).collect();
+    if plans.len() != ids.len() {
+        anyhow::bail!("{} trajectories for {} vehicles", plans.len(), ids.len());
+    }
+    let session = Session::open(scenario, distributed)?;
+    let (tx, rx) = mpsc::channel::<Open>();
+    let net_session = session.net.session().clone();
+    let tel_key = topics::all_telemetry(&distributed.mission)?;
+    let tx_t = tx.clone();
+    let _telemetry = net_session
+        .declare_subscriber(tel_key.as_str())
+        .callback(move |s| {
+            let _ = tx_t.send(Open::Telemetry(
+                s.payload().to_bytes().into_owned(),
+                unix_us(),
+            ));
+        })
+        .wait()
+        .map_err(|e| anyhow::anyhow!("cannot subscribe to {tel_key}: {e}"))?;
+    let obs_key = topics::open_key(&distributed.mission, OpenKey::Obstacles)?;
+    let _obstacles = net_session
+        .declare_subscriber(obs_key.as_str())
+        .callback(move |s| {
+            let _ = tx.send(Open::Obstacle(s.payload().to_bytes().into_owned()));
+        })
+        .wait()
+        .map_err(|e| anyhow::anyhow!("cannot subscribe to {obs_key}: {e}"))?;
+    // `status` answers from the latest picture (the loop refreshes it).
+    let latest = std::sync::Arc::new(std::sync::Mutex::new(Vec::<u8>::new()));
+    let status_key = topics::open_key(&distributed.mission, OpenKey::Status)?;
+    let answer = std::sync::Arc::clone(&latest);
+    let key_for_reply = status_key.clone();
+    let _queryable = net_session
+        .declare_queryable(status_key.as_str())
+        .callback(move |q| {
+            let bytes = answer.lock().map(|b| b.clone()).unwrap_or_default();
+            if !bytes.is_empty() {
+                let _ = q.reply(key_for_reply.as_str(), bytes).wait();
+            }
+        })
+        .wait()
+        .map_err(|e| anyhow::anyhow!("cannot declare the queryable {status_key}: {e}"))?;
+    let log = LogWriter::create(&options.log)?;
+    let epoch_unix_ms = unix_us() / 1000 + 1500;
+    let mut x = Exec {
+        scenario: scenario.clone(),
+        mission: distributed.mission.clone(),
+        options,
+        fleet: Fleet::new(&ids, plans, scenario.fleet.d_min_m, options.horizon_s),
+        session,
+        log,
+        epoch_unix_ms,
+        common_arrival_s,
+        revision: 0,
+        events: 0,
+        replans: 0,
+        holds: 0,
+        new_obstacles: Vec::new(),
+        last_reaction: vec![None; ids.len()],
+        pending: vec![None; ids.len()],
+        deliveries_ms: Vec::new(),
+        decisions_ms: Vec::new(),
+        dropped: 0,
+    };
+    let scenario_toml = toml::to_string(scenario)?;
+    x.log.write(&Record::Start(Start {
+        mission: x.mission.clone(),
+        scenario_toml: scenario_toml.clone(),
+        common_arrival_s,
+        arrival_window_s: options.arrival_window_s,
+        horizon_s: options.horizon_s,
+        time_scale: options.time_scale,
+        epoch_unix_ms,
+    }));
+    x.publish_plan(ids.clone());
+    let ended = run_loop(&mut x, &rx, plans, &scenario_toml, &latest, stop);
+    for id in &ids {
+        x.send(
+            id,
+            CoordinatorToAgent::Stop {
+                mission: x.mission.clone(),
+                reason: ended.clone(),
+            },
+        );
+    }
+    x.event("mission_end", Vec::new(), ended.clone());
+    let figures = x.fleet.figures(
+        common_arrival_s,
+        options.arrival_window_s,
+        &x.scenario.obstacles,
+    );
+    x.log.write(&Record::End(figures.clone()));
+    x.log.flush();
+    let report = ExecutionReport {
+        figures,
+        replans: x.replans,
+        holds: x.holds,
+        obstacle_decision_ms: x.decisions_ms.clone(),
+        update_delivery_ms: x.deliveries_ms.clone(),
+        dropped: x.dropped,
+        ended,
+    };
+    std::thread::sleep(Duration::from_millis(200)); // let the stops go out
+    x.session.close();
+    Ok(report)
+}
+
+/// The loop: orders out, reports in, the picture refreshed and acted on.
+fn run_loop(
+    x: &mut Exec,
+    rx: &Receiver<Open>,
+    plans: &[Trajectory],
+    scenario_toml: &str,
+    latest: &std::sync::Mutex<Vec<u8>>,
+    stop: &AtomicBool,
+) -> String {
+    let o = x.options;
+    let started = Instant::now();
+    let mut resend = Instant::now();
+    let mut tick = Instant::now();
+    let mut publish = Instant::now();
+    let mut injections: Vec<(f64, Obstacle)> = o.inject.clone();
+    // Past the window, a mission that still has vehicles under way is given up.
+    let give_up_s = x.common_arrival_s + o.arrival_window_s + 600.0;
+    loop {
+        if stop.load(Ordering::Relaxed) {
+            return "interrupted".into();
+        }
+        let now_wall = Instant::now();
+        if now_wall >= resend {
+            resend = now_wall + Duration::from_secs(1);
+            for (i, v) in x.fleet.vehicles.iter().enumerate() {
+                if v.last.is_none() {
+                    x.send(
+                        &v.id,
+                        CoordinatorToAgent::Execute {
+                            mission: x.mission.clone(),
+                            vehicle: v.id.clone(),
+                            scenario_toml: scenario_toml.to_string(),
+                            trajectory: WireTrajectory::new(&v.id, &plans[i]),
+                            epoch_unix_ms: x.epoch_unix_ms,
+                            time_scale: o.time_scale,
+                            telemetry_hz: o.telemetry_hz,
+                            seed: o.seed.wrapping_add(i as u64),
+                        },
+                    );
+                }
+            }
+        }
+        match rx.recv_timeout(Duration::from_millis(20)) {
+            Ok(Open::Telemetry(bytes, received)) => react::telemetry(x, &bytes, received),
+            Ok(Open::Obstacle(bytes)) => react::obstacle_bytes(x, &bytes),
+            Err(RecvTimeoutError::Timeout) => {}
+            Err(RecvTimeoutError::Disconnected) => return "the network closed".into(),
+        }
+        while let Some(e) = x.session.net.next(Instant::now()) {
+            if let Event::Gone(v) = e {
+                tracing::info!("the agent of {v} left the network");
+            }
+        }
+        let now = x.clock();
+        while let Some(k) = injections.iter().position(|(t, _)| *t <= now) {
+            let (_, obstacle) = injections.remove(k);
+            // Published like any client would; it comes back through the subscription.
+            if let Ok(key) = topics::open_key(&x.mission, OpenKey::Obstacles) {
+                x.put_json(&key, &obstacle);
+            }
+        }
+        if tick.elapsed() >= Duration::from_millis(100) {
+            tick = Instant::now();
+            react::check(x, now);
+        }
+        if publish.elapsed() >= Duration::from_secs(1) {
+            publish = Instant::now();
+            let status = x.status();
+            if let Ok(bytes) = codec::encode_json(&status) {
+                if let Ok(mut l) = latest.lock() {
+                    *l = bytes;
+                }
+            }
+            if let Ok(key) = topics::open_key(&x.mission, OpenKey::Status) {
+                x.put_json(&key, &status);
+            }
+            if !o.quiet {
+                eprintln!("{}", react::progress_line(&status, x.fleet.reports));
+            }
+            x.log.flush();
+        }
+        let done = x
+            .fleet
+            .vehicles
+            .iter()
+            .all(|v| v.lost || v.arrived_s.is_some());
+        if done {
+            return "every vehicle arrived or is lost".into();
+        }
+        if now > give_up_s {
+            return format!("mission time {now:.0} s is past the arrival window: given up");
+        }
+        if started.elapsed() > Duration::from_secs(30) && x.fleet.reports == 0 {
+            return "no telemetry from any vehicle within 30 s".into();
+        }
+    }
+}

@@ -1,0 +1,380 @@
+//! What the coordinator does with reports and with what it sees (issue 8, item 3): a predicted
+//! loss of separation, a cross-track error beyond the tolerance, a vehicle silent too long or a
+//! new obstacle on a vehicle's remaining path makes it replan that vehicle (see
+//! [`super::replan`]); a replan that is not safe becomes a hold, retried until one is. Every
+//! decision is an event, logged and published.
+//!
+//! Who gives way in a predicted conflict: a vehicle that can (not lost, holding or arrived);
+//! between two that can, the later one in scenario order — a fixed priority, so two
+//! coordinators' decisions never chase each other.
+
+use std::time::{Duration, Instant};
+
+use shoal_common::geometry::{segment_hits_sphere, Vec3};
+use shoal_common::scenario::{Obstacle, ObstacleKind};
+use shoal_common::wire::codec;
+use shoal_common::wire::coordinator_to_agent::CoordinatorToAgent;
+use shoal_common::wire::open::{FleetStatus, Telemetry, OPEN_VERSION};
+use shoal_common::wire::WireTrajectory;
+
+use super::log::Record;
+use super::replan::{self, Request};
+use super::Exec;
+
+/// Shortest wall time between two reactions for one vehicle (a new obstacle does not wait).
+const COOL_DOWN: Duration = Duration::from_secs(2);
+
+/// A report from the telemetry key.
+pub(super) fn telemetry(x: &mut Exec, bytes: &[u8], received_us: u64) {
+    let t: Telemetry = match codec::decode_json(bytes) {
+        Ok(t) => t,
+        Err(e) => return drop_message(x, &format!("telemetry: {e}")),
+    };
+    if t.version != OPEN_VERSION || t.mission != x.mission {
+        return drop_message(
+            x,
+            &format!(
+                "telemetry of version {} for mission {:?}",
+                t.version, t.mission
+            ),
+        );
+    }
+    let Some(i) = x.fleet.index(&t.vehicle) else {
+        return drop_message(x, &format!("telemetry of unknown vehicle {:?}", t.vehicle));
+    };
+    let finite = t
+        .state
+        .position
+        .iter()
+        .chain(&t.state.velocity)
+        .all(|v| v.is_finite())
+        && t.state.t_s.is_finite();
+    if !finite {
+        return drop_message(
+            x,
+            &format!("telemetry of {} with a non-finite state", t.vehicle),
+        );
+    }
+    let was_arrived = x.fleet.vehicles[i].arrived_s.is_some();
+    let was_lost = x.fleet.vehicles[i].lost;
+    let revision = t.revision;
+    x.log.write(&Record::Telemetry {
+        received_unix_us: received_us,
+        telemetry: t.clone(),
+    });
+    if !x.fleet.report(t, received_us) {
+        return;
+    }
+    if let Some((rev, at)) = x.pending[i] {
+        if revision >= rev {
+            x.deliveries_ms.push(at.elapsed().as_secs_f64() * 1000.0);
+            x.pending[i] = None;
+        }
+    }
+    let id = x.fleet.vehicles[i].id.clone();
+    if was_lost {
+        x.event(
+            "vehicle_back",
+            vec![id.clone()],
+            format!("{id} reports again"),
+        );
+    }
+    if !was_arrived {
+        if let Some(t) = x.fleet.vehicles[i].arrived_s {
+            x.event(
+                "arrived",
+                vec![id.clone()],
+                format!("{id} arrived at t = {t:.1} s"),
+            );
+        }
+    }
+}
+
+fn drop_message(x: &mut Exec, detail: &str) {
+    x.dropped += 1;
+    if x.dropped == 1 {
+        tracing::warn!(
+            "dropped an open-interface message: {detail}; further ones are only counted"
+        );
+    }
+}
+
+/// A new obstacle from the obstacles key.
+pub(super) fn obstacle_bytes(x: &mut Exec, bytes: &[u8]) {
+    let received = Instant::now();
+    let o: Obstacle = match codec::decode_json(bytes) {
+        Ok(o) => o,
+        Err(e) => return drop_message(x, &format!("obstacle: {e}")),
+    };
+    let ok = o.centre.iter().all(|v| v.is_finite())
+        && o.radius_m.is_finite()
+        && o.radius_m > 0.0
+        && o.inflation_m.is_finite()
+        && o.inflation_m >= 0.0;
+    if !ok {
+        return drop_message(
+            x,
+            &format!(
+                "obstacle {:?}: centre {:?}, radius_m {}, inflation_m {}: need finite numbers and a positive radius",
+                o.id, o.centre, o.radius_m, o.inflation_m
+            ),
+        );
+    }
+    obstacle(x, o, received);
+}
+
+/// Adds `o` to the scenario and replans every vehicle whose remaining path it blocks.
+fn obstacle(x: &mut Exec, o: Obstacle, received: Instant) {
+    let now = x.clock();
+    let blocked: Vec<usize> = (0..x.fleet.vehicles.len())
+        .filter(|&i| {
+            let v = &x.fleet.vehicles[i];
+            !v.lost && v.arrived_s.is_none() && o.kind == ObstacleKind::Hard && {
+                let from = v.progress.map_or(now, |p| p.plan_time_s);
+                remaining_hits(&v.plan, from, v.position(), &o)
+            }
+        })
+        .collect();
+    let names: Vec<String> = blocked
+        .iter()
+        .map(|&i| x.fleet.vehicles[i].id.clone())
+        .collect();
+    x.event(
+        "obstacle",
+        names.clone(),
+        format!(
+            "{} obstacle {} at ({:.0}, {:.0}, {:.0}) m, radius {:.0} + {:.0} m: blocks {}",
+            if o.kind == ObstacleKind::Hard {
+                "hard"
+            } else {
+                "soft"
+            },
+            o.id,
+            o.centre[0],
+            o.centre[1],
+            o.centre[2],
+            o.radius_m,
+            o.inflation_m,
+            if names.is_empty() {
+                "no vehicle's path".to_string()
+            } else {
+                names.join(", ")
+            }
+        ),
+    );
+    x.log.write(&Record::Obstacle(o.clone()));
+    x.scenario.obstacles.push(o.clone());
+    x.new_obstacles.push((o, received));
+    for i in blocked {
+        if replan_vehicle(x, i, "a new obstacle blocks its path") {
+            x.decisions_ms
+                .push(received.elapsed().as_secs_f64() * 1000.0);
+        }
+    }
+}
+
+/// Whether the rest of `plan` after mission time `from`, starting at `p`, enters `o`'s
+/// inflated sphere.
+fn remaining_hits(
+    plan: &shoal_common::trajectory::Trajectory,
+    from: f64,
+    p: Vec3,
+    o: &Obstacle,
+) -> bool {
+    let mut pts = vec![p];
+    pts.extend(
+        plan.times
+            .iter()
+            .zip(&plan.points)
+            .filter(|(t, _)| **t > from)
+            .map(|(_, q)| *q),
+    );
+    pts.windows(2)
+        .any(|w| segment_hits_sphere(&w[0], &w[1], &o.centre(), o.inflated_radius()))
+}
+
+/// The periodic checks (see the module doc).
+pub(super) fn check(x: &mut Exec, now: f64) {
+    let o = x.options;
+    for i in 0..x.fleet.vehicles.len() {
+        let v = &x.fleet.vehicles[i];
+        let silent = match v.heard {
+            Some(h) => h.elapsed() > o.lost_after,
+            // Never heard: lost once the mission has run for a while without it.
+            None => now > 0.0 && x.clock_wall_since_epoch() > o.lost_after + Duration::from_secs(5),
+        };
+        if silent && !v.lost && v.arrived_s.is_none() {
+            let id = v.id.clone();
+            x.fleet.vehicles[i].lost = true;
+            x.event(
+                "vehicle_lost",
+                vec![id.clone()],
+                format!(
+                    "{id} has not reported for {:.1} s: lost; the others treat its last position as an obstacle",
+                    o.lost_after.as_secs_f64()
+                ),
+            );
+        }
+    }
+    for i in 0..x.fleet.vehicles.len() {
+        let v = &x.fleet.vehicles[i];
+        let active = !v.lost && v.arrived_s.is_none();
+        let cooled = x.last_reaction[i].is_none_or(|t| t.elapsed() >= COOL_DOWN);
+        if !(active && cooled) {
+            continue;
+        }
+        if v.holding {
+            replan_vehicle(x, i, "retrying after a hold");
+            continue;
+        }
+        if let Some(p) = v.progress {
+            if p.cross_track_m > o.deviation_m {
+                let why = format!(
+                    "cross-track error {:.1} m is over the {:.1} m tolerance",
+                    p.cross_track_m, o.deviation_m
+                );
+                replan_vehicle(x, i, &why);
+            }
+        }
+    }
+    for c in x.fleet.conflicts(now) {
+        let can = |i: usize| {
+            let v = &x.fleet.vehicles[i];
+            !v.lost && !v.holding && v.arrived_s.is_none()
+        };
+        let who = if can(c.b) {
+            c.b
+        } else if can(c.a) {
+            c.a
+        } else {
+            continue;
+        };
+        if x.last_reaction[who].is_some_and(|t| t.elapsed() < COOL_DOWN) {
+            continue;
+        }
+        let why = format!(
+            "predicted separation {:.1} m from {} at t = {:.0} s is under d_min {:.0} m",
+            c.min_distance_m,
+            x.fleet.vehicles[if who == c.a { c.b } else { c.a }].id,
+            c.at_s,
+            x.fleet.d_min
+        );
+        x.event(
+            "conflict_predicted",
+            vec![
+                x.fleet.vehicles[c.a].id.clone(),
+                x.fleet.vehicles[c.b].id.clone(),
+            ],
+            why.clone(),
+        );
+        replan_vehicle(x, who, &why);
+    }
+}
+
+/// Replans vehicle `i` and sends the update, or commands a hold; true when an update went out.
+pub(super) fn replan_vehicle(x: &mut Exec, i: usize, why: &str) -> bool {
+    let o = x.options;
+    let now = x.clock();
+    // The update must reach the vehicle before it is due: start it one budget (plus margin)
+    // of wall time ahead, in mission time.
+    let lead = (o.replan_budget + Duration::from_millis(250)).as_secs_f64() * o.time_scale;
+    let t0 = now + lead;
+    let remaining = (x.common_arrival_s + o.arrival_window_s - now).max(o.horizon_s);
+    let predictions = x.fleet.predictions_over(now, remaining);
+    let p0 = predictions[i].position_at(t0);
+    let seed = o.seed ^ (u64::from(x.revision) << 8) ^ i as u64;
+    let result = replan::replan(&Request {
+        scenario: &x.scenario,
+        vehicle: i,
+        t0,
+        p0,
+        current: &x.fleet.vehicles[i].plan,
+        others: &predictions,
+        arrival_s: x.common_arrival_s,
+        budget: o.replan_budget,
+        seed,
+    });
+    x.last_reaction[i] = Some(Instant::now());
+    let id = x.fleet.vehicles[i].id.clone();
+    if result.safe {
+        x.revision += 1;
+        let v = &mut x.fleet.vehicles[i];
+        v.plan = result.trajectory.clone();
+        v.revision = x.revision;
+        v.holding = false;
+        x.send(
+            &id,
+            CoordinatorToAgent::Update {
+                mission: x.mission.clone(),
+                vehicle: id.clone(),
+                revision: x.revision,
+                trajectory: WireTrajectory::new(&id, &result.trajectory),
+            },
+        );
+        x.pending[i] = Some((x.revision, Instant::now()));
+        x.replans += 1;
+        x.publish_plan(vec![id.clone()]);
+        x.event(
+            "replanned",
+            vec![id.clone()],
+            format!(
+                "{id} replanned ({why}) in {:.0} ms: revision {}, from t = {t0:.0} s, arrival {:.0} s, closest vehicle {:.1} m",
+                result.elapsed.as_secs_f64() * 1000.0,
+                x.revision,
+                result.trajectory.arrival(),
+                result.min_separation_m
+            ),
+        );
+        true
+    } else {
+        if !x.fleet.vehicles[i].holding {
+            x.send(
+                &id,
+                CoordinatorToAgent::Hold {
+                    mission: x.mission.clone(),
+                    vehicle: id.clone(),
+                    reason: why.to_string(),
+                },
+            );
+            x.fleet.vehicles[i].holding = true;
+            x.holds += 1;
+            x.event(
+                "hold",
+                vec![id.clone()],
+                format!(
+                    "{id} told to hold ({why}): no safe replan in {:.0} ms ({} obstacle intrusions, closest vehicle {:.1} m)",
+                    result.elapsed.as_secs_f64() * 1000.0,
+                    result.hard_hits,
+                    result.min_separation_m
+                ),
+            );
+        }
+        false
+    }
+}
+
+/// The progress line on stderr.
+pub(super) fn progress_line(s: &FleetStatus, reports: u64) -> String {
+    let fmt = |v: Option<f64>| v.map_or("–".to_string(), |d| format!("{d:.0} m"));
+    let vehicles: Vec<String> = s
+        .vehicles
+        .iter()
+        .map(|v| match (&v.progress, v.lost) {
+            (_, true) => format!("{} LOST", v.vehicle),
+            (Some(p), _) => format!(
+                "{} {:.0}% cte {:.1} m",
+                v.vehicle,
+                100.0 * p.fraction,
+                p.cross_track_m
+            ),
+            (None, _) => format!("{} –", v.vehicle),
+        })
+        .collect();
+    format!(
+        "t {:>6.0} s | {reports} reports | separation now {}, predicted {} | {}",
+        s.t_s,
+        fmt(s.current_min_separation_m),
+        fmt(s.predicted.map(|c| c.min_distance_m)),
+        vehicles.join(" | ")
+    )
+}

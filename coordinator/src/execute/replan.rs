@@ -1,0 +1,301 @@
+//! Replanning the rest of one vehicle's mission while the fleet drives (issue 8): from the
+//! position it will have when the update reaches it, to its goal, for the fleet's arrival time,
+//! with the other vehicles as moving obstacles (their trajectories as the coordinator predicts
+//! them) and any new obstacle in the scenario.
+//!
+//! It is the follower problem of distributed AMP-PSO ([`VehicleProblem`], seed 004 eq. (9)–(12)
+//! restricted to one vehicle) solved by A-PSO (seed 004 eq. (7) parameters) under a wall-time
+//! budget, warm-started: the first particle is the current plan's remainder resampled onto the
+//! M waypoints, a few more are jittered copies of it, the rest are sampled as usual. The warm
+//! particle alone is already the answer when the change does not touch the vehicle's path.
+
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::time::{Duration, Instant};
+
+use rand::rngs::StdRng;
+use rand::Rng;
+use shoal_common::cost::FleetModel;
+use shoal_common::geometry::Vec3;
+use shoal_common::scenario::Scenario;
+use shoal_common::swarm::pso::Pso;
+use shoal_common::swarm::{Executor, Problem, SolverState};
+use shoal_common::trajectory::Trajectory;
+use shoal_common::vehicle_problem::VehicleProblem;
+
+/// Jittered copies of the warm particle in the first swarm.
+const WARM_COPIES: usize = 8;
+/// Particles of the replanning swarm.
+const PARTICLES: usize = 30;
+
+/// What to replan.
+#[derive(Debug, Clone)]
+pub struct Request<'a> {
+    /// The scenario, with every obstacle known now.
+    pub scenario: &'a Scenario,
+    /// Which vehicle (scenario order).
+    pub vehicle: usize,
+    /// Mission time the new trajectory starts at.
+    pub t0: f64,
+    /// Where the vehicle will be then.
+    pub p0: Vec3,
+    /// The trajectory it follows now (mission-timed).
+    pub current: &'a Trajectory,
+    /// Every vehicle's predicted trajectory, mission-timed (this vehicle's is ignored).
+    pub others: &'a [Trajectory],
+    /// The fleet's arrival time, mission seconds.
+    pub arrival_s: f64,
+    /// Wall-time budget.
+    pub budget: Duration,
+    /// RNG seed.
+    pub seed: u64,
+}
+
+/// A replanned trajectory.
+#[derive(Debug, Clone)]
+pub struct Replanned {
+    /// Mission-timed, from `(t0, p0)` to the goal.
+    pub trajectory: Trajectory,
+    /// No hard-obstacle intrusion and every other vehicle kept at d_min or more.
+    pub safe: bool,
+    /// Hard-obstacle intrusions (leg × obstacle).
+    pub hard_hits: usize,
+    /// Smallest predicted distance to another vehicle, metres.
+    pub min_separation_m: f64,
+    /// Wall time spent.
+    pub elapsed: Duration,
+}
+
+/// `t` from mission time `t0` on, re-based so `t0` is time 0.
+fn rebase(t: &Trajectory, t0: f64) -> Trajectory {
+    let mut times = vec![0.0];
+    let mut points = vec![t.position_at(t0)];
+    for (s, p) in t.times.iter().zip(&t.points) {
+        if *s > t0 {
+            times.push(s - t0);
+            points.push(*p);
+        }
+    }
+    Trajectory { times, points }
+}
+
+/// The remainder of `current` after `t0`, from `p0`, as a chromosome of `m` waypoints (evenly
+/// spaced by arc length) and the speeds the remainder flies.
+pub fn warm_chromosome(
+    current: &Trajectory,
+    t0: f64,
+    p0: Vec3,
+    m: usize,
+    v: (f64, f64),
+) -> Vec<f64> {
+    let rest = rebase(current, t0);
+    let mut pts = rest.points.clone();
+    pts[0] = p0;
+    let cum: Vec<f64> = std::iter::once(0.0)
+        .chain(pts.windows(2).scan(0.0, |acc, w| {
+            *acc += (w[1] - w[0]).norm();
+            Some(*acc)
+        }))
+        .collect();
+    let total = cum.last().copied().unwrap_or(0.0);
+    let duration = rest.arrival().max(1e-9);
+    let speed = (total / duration).clamp(v.0, v.1);
+    let mut genes = Vec::with_capacity(4 * m);
+    for k in 1..=m {
+        let s = total * k as f64 / (m + 1) as f64;
+        let j = cum
+            .partition_point(|&c| c < s)
+            .clamp(1, pts.len().max(2) - 1);
+        let p = if pts.len() < 2 {
+            p0
+        } else {
+            let (c0, c1) = (cum[j - 1], cum[j]);
+            let f = if c1 > c0 { (s - c0) / (c1 - c0) } else { 0.0 };
+            pts[j - 1] + (pts[j] - pts[j - 1]) * f
+        };
+        genes.extend_from_slice(&[p.x, p.y, p.z]);
+    }
+    genes.extend(std::iter::repeat_n(speed, m));
+    genes
+}
+
+/// Moves every waypoint of `genes` (M waypoints, coordinates first) that lies inside a hard
+/// obstacle's inflated sphere sideways — perpendicular to the path there, horizontally when the
+/// path runs through the centre — to 1.2 × that radius from the centre: the warm start then
+/// already goes round a new obstacle, and the swarm only has to smooth it.
+pub fn push_out_of_obstacles(genes: &mut [f64], scenario: &Scenario, m: usize) {
+    let m = m.min(genes.len() / 3);
+    let at = |g: &[f64], k: usize| Vec3::new(g[3 * k], g[3 * k + 1], g[3 * k + 2]);
+    for k in 0..m {
+        let mut p = at(genes, k);
+        let prev = if k > 0 { at(genes, k - 1) } else { p };
+        let next = if k + 1 < m { at(genes, k + 1) } else { p };
+        let tangent = (next - prev)
+            .try_normalize(1e-9)
+            .unwrap_or_else(|| Vec3::new(1.0, 0.0, 0.0));
+        for o in scenario.hard_obstacles() {
+            let c = o.centre();
+            let r = o.inflated_radius();
+            let d = p - c;
+            if d.norm() >= r {
+                continue;
+            }
+            let along = d.dot(&tangent);
+            let side = (d - tangent * along)
+                .try_normalize(1e-6)
+                .or_else(|| tangent.cross(&Vec3::new(0.0, 0.0, 1.0)).try_normalize(1e-9))
+                .unwrap_or_else(|| Vec3::new(0.0, 1.0, 0.0));
+            p = c + tangent * along + side * (1.2 * r);
+        }
+        genes[3 * k..3 * k + 3].copy_from_slice(&[p.x, p.y, p.z]);
+    }
+}
+
+/// A problem whose first samples are a warm start.
+struct WarmStart<'a> {
+    inner: &'a VehicleProblem<'a>,
+    warm: Vec<f64>,
+    drawn: AtomicUsize,
+}
+
+impl Problem for WarmStart<'_> {
+    fn lower(&self) -> &[f64] {
+        self.inner.lower()
+    }
+    fn upper(&self) -> &[f64] {
+        self.inner.upper()
+    }
+    fn cost(&self, x: &[f64]) -> f64 {
+        self.inner.cost(x)
+    }
+    fn move_groups(&self) -> Vec<std::ops::Range<usize>> {
+        self.inner.move_groups()
+    }
+    fn sample(&self, rng: &mut StdRng) -> Vec<f64> {
+        let k = self.drawn.fetch_add(1, Ordering::Relaxed);
+        let (lo, hi) = (self.lower(), self.upper());
+        let clamp = |x: Vec<f64>| -> Vec<f64> {
+            x.into_iter()
+                .enumerate()
+                .map(|(d, v)| v.clamp(lo[d], hi[d]))
+                .collect()
+        };
+        match k {
+            0 => clamp(self.warm.clone()),
+            k if k <= WARM_COPIES => clamp(
+                self.warm
+                    .iter()
+                    .enumerate()
+                    .map(|(d, v)| v + 0.03 * (hi[d] - lo[d]) * rng.random_range(-1.0..=1.0))
+                    .collect(),
+            ),
+            _ => self.inner.sample(rng),
+        }
+    }
+}
+
+/// Replans (see the module doc).
+pub fn replan(r: &Request) -> Replanned {
+    let started = Instant::now();
+    let mut scenario = r.scenario.clone();
+    scenario.vehicles[r.vehicle].start = [r.p0.x, r.p0.y, r.p0.z];
+    let model = FleetModel::new(&scenario);
+    let context: Vec<Trajectory> = r.others.iter().map(|t| rebase(t, r.t0)).collect();
+    let arrival = (r.arrival_s - r.t0).max(1.0);
+    let problem = VehicleProblem::new(&model, r.vehicle, &context, arrival);
+    let v = &scenario.vehicles[r.vehicle];
+    let mut warm = warm_chromosome(
+        r.current,
+        r.t0,
+        r.p0,
+        scenario.optimizer.waypoints,
+        (v.speed_min_mps, v.speed_max_mps),
+    );
+    push_out_of_obstacles(&mut warm, &scenario, scenario.optimizer.waypoints);
+    let warm_problem = WarmStart {
+        inner: &problem,
+        warm,
+        drawn: AtomicUsize::new(0),
+    };
+    let executor = Executor {
+        max_iterations: 10_000,
+        time_limit: Some(r.budget),
+        ..Executor::default()
+    };
+    let mut solver = Pso::adaptive(PARTICLES, r.seed);
+    let out = executor.run(&warm_problem, &mut solver, |_| {});
+    let best = problem.evaluate(out.state.best_position());
+    let trajectory = Trajectory {
+        times: best.trajectory.times.iter().map(|t| t + r.t0).collect(),
+        points: best.trajectory.points,
+    };
+    Replanned {
+        trajectory,
+        safe: best.terms.hard_hits == 0 && best.min_separation >= scenario.fleet.d_min_m,
+        hard_hits: best.terms.hard_hits,
+        min_separation_m: best.min_separation,
+        elapsed: started.elapsed(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn line(t0: f64, t1: f64) -> Trajectory {
+        Trajectory {
+            times: vec![t0, t1],
+            points: vec![Vec3::new(0.0, 0.0, 100.0), Vec3::new(1000.0, 0.0, 100.0)],
+        }
+    }
+
+    #[test]
+    fn the_warm_start_is_the_rest_of_the_plan_evenly_spaced() {
+        // 1000 m in 1000 s; from t0 = 200 the rest is 800 m in 800 s from x = 200.
+        let g = warm_chromosome(
+            &line(0.0, 1000.0),
+            200.0,
+            Vec3::new(200.0, 0.0, 100.0),
+            3,
+            (0.5, 2.0),
+        );
+        assert_eq!(g.len(), 12);
+        for (k, x) in [400.0, 600.0, 800.0].iter().enumerate() {
+            assert!((g[3 * k] - x).abs() < 1e-9, "{g:?}");
+            assert!(g[3 * k + 1].abs() < 1e-9);
+        }
+        // 1 m/s, inside the range.
+        assert!(g[9..].iter().all(|v| (v - 1.0).abs() < 1e-9), "{g:?}");
+    }
+
+    #[test]
+    fn a_waypoint_inside_an_obstacle_is_pushed_sideways() -> Result<(), Box<dyn std::error::Error>>
+    {
+        let file = concat!(env!("CARGO_MANIFEST_DIR"), "/../scenarios/amp-pso-1.toml");
+        let mut s = Scenario::load(std::path::Path::new(file))?;
+        s.obstacles = vec![shoal_common::scenario::Obstacle {
+            id: "new".into(),
+            kind: shoal_common::scenario::ObstacleKind::Hard,
+            centre: [500.0, 0.0, 100.0],
+            radius_m: 40.0,
+            inflation_m: 50.0,
+        }];
+        let mut g = vec![
+            250.0, 0.0, 100.0, 500.0, 0.0, 100.0, 750.0, 0.0, 100.0, 1.0, 1.0, 1.0,
+        ];
+        push_out_of_obstacles(&mut g, &s, 3);
+        // The middle one is on the path through the centre: pushed horizontally across it, to
+        // 1.2 × 90 m from the centre; the others are outside and stay.
+        let p = Vec3::new(g[3], g[4], g[5]);
+        assert!(
+            ((p - Vec3::new(500.0, 0.0, 100.0)).norm() - 108.0).abs() < 1e-9,
+            "{p}"
+        );
+        assert!(
+            (p.x - 500.0).abs() < 1e-9 && (p.z - 100.0).abs() < 1e-9,
+            "{p}"
+        );
+        assert_eq!(&g[0..3], &[250.0, 0.0, 100.0]);
+        assert_eq!(&g[6..9], &[750.0, 0.0, 100.0]);
+        Ok(())
+    }
+}

@@ -1,0 +1,262 @@
+//! `shoal-coordinator replay LOG`: reads a mission log back, recomputes the execution's figures
+//! from its records alone (the same [`Fleet`] the live run used), lists the decisions, and
+//! draws the planned and executed tracks (`<LOG>.svg`: top view).
+
+use std::path::{Path, PathBuf};
+
+use anyhow::Context as _;
+use plotters::backend::SVGBackend;
+use plotters::element::DashedPathElement;
+use plotters::prelude::*;
+use shoal_common::scenario::{Obstacle, ObstacleKind, Scenario};
+use shoal_common::trajectory::Trajectory;
+use shoal_common::wire::open::MissionEvent;
+
+use crate::execute::fleet::{ExecutionFigures, Fleet};
+use crate::execute::log::{self, Record};
+use crate::svg::fail;
+
+/// `shoal-coordinator replay`.
+#[derive(Debug, Clone, clap::Args)]
+pub struct ReplayArgs {
+    /// The mission log (`mission.ndjson` of `run`).
+    pub log: PathBuf,
+    /// Where to draw the tracks (default: the log's path with `.svg`).
+    #[arg(long)]
+    pub svg: Option<PathBuf>,
+}
+
+/// What a log holds, replayed.
+pub struct Replayed {
+    /// The scenario, with the obstacles published during the execution.
+    pub scenario: Scenario,
+    /// The figures recomputed from the records.
+    pub figures: ExecutionFigures,
+    /// The figures the run wrote at its end, if it got there.
+    pub logged: Option<ExecutionFigures>,
+    /// Every event, in order.
+    pub events: Vec<MissionEvent>,
+    /// The first plan.
+    pub planned: Vec<Trajectory>,
+    /// The executed tracks.
+    pub tracks: Vec<Trajectory>,
+}
+
+fn samples(s: &[[f64; 4]]) -> Trajectory {
+    Trajectory {
+        times: s.iter().map(|v| v[0]).collect(),
+        points: s
+            .iter()
+            .map(|v| shoal_common::geometry::Vec3::new(v[1], v[2], v[3]))
+            .collect(),
+    }
+}
+
+/// Replays the log at `path`.
+pub fn replay(path: &Path) -> anyhow::Result<Replayed> {
+    let records = log::read(path)?;
+    let Some(Record::Start(start)) = records.first() else {
+        anyhow::bail!("{}: no start record", path.display());
+    };
+    let origin = format!("{} (start record)", path.display());
+    let mut scenario = Scenario::parse(&start.scenario_toml, Path::new(&origin))?;
+    let ids: Vec<String> = scenario.vehicles.iter().map(|v| v.id.clone()).collect();
+    let first = records.iter().find_map(|r| match r {
+        Record::Plan(p) if p.revision == 0 => Some(p.clone()),
+        _ => None,
+    });
+    let Some(first) = first else {
+        anyhow::bail!("{}: no plan record of revision 0", path.display());
+    };
+    let planned: Vec<Trajectory> = ids
+        .iter()
+        .map(|id| {
+            first
+                .trajectories
+                .iter()
+                .find(|(v, _)| v == id)
+                .map(|(_, s)| samples(s))
+                .ok_or_else(|| {
+                    anyhow::anyhow!("{}: the plan has no trajectory for {id}", path.display())
+                })
+        })
+        .collect::<anyhow::Result<_>>()?;
+    let mut fleet = Fleet::new(&ids, &planned, scenario.fleet.d_min_m, start.horizon_s);
+    let mut events = Vec::new();
+    let mut logged = None;
+    for r in &records {
+        match r {
+            Record::Plan(p) if p.revision > 0 => {
+                for (id, s) in &p.trajectories {
+                    if let Some(i) = fleet.index(id) {
+                        if p.changed.contains(id) {
+                            fleet.vehicles[i].plan = samples(s);
+                            fleet.vehicles[i].revision = p.revision;
+                        }
+                    }
+                }
+            }
+            Record::Telemetry {
+                received_unix_us,
+                telemetry,
+            } => {
+                fleet.report(telemetry.clone(), *received_unix_us);
+            }
+            Record::Event(e) => {
+                if e.kind == "vehicle_lost" {
+                    for v in &e.vehicles {
+                        if let Some(i) = fleet.index(v) {
+                            fleet.vehicles[i].lost = true;
+                        }
+                    }
+                }
+                events.push(e.clone());
+            }
+            Record::Obstacle(o) => scenario.obstacles.push(o.clone()),
+            Record::End(f) => logged = Some(f.clone()),
+            Record::Start(_) | Record::Plan(_) => {}
+        }
+    }
+    let figures = fleet.figures(
+        start.common_arrival_s,
+        start.arrival_window_s,
+        &scenario.obstacles,
+    );
+    let tracks = fleet.vehicles.iter().map(|v| v.track.clone()).collect();
+    Ok(Replayed {
+        scenario,
+        figures,
+        logged,
+        events,
+        planned,
+        tracks,
+    })
+}
+
+/// The replay command: prints the events and the figures and writes the SVG.
+pub fn command(args: &ReplayArgs) -> anyhow::Result<i32> {
+    let r = replay(&args.log)?;
+    let mut out = String::new();
+    for e in &r.events {
+        out.push_str(&format!(
+            "t {:>7.1} s  {:<18} {}\n",
+            e.t_s, e.kind, e.detail
+        ));
+    }
+    let f = &r.figures;
+    out.push_str(&format!(
+        "min separation {} (d_min {:.0} m); every vehicle in the arrival window: {}; {} reports; latency median {:.2} ms, p99 {:.2} ms\n",
+        f.min_separation_m.map_or("–".into(), |d| format!("{d:.1} m")),
+        f.d_min_m,
+        if f.all_arrived_in_window { "yes" } else { "no" },
+        f.reports,
+        f.latency_median_ms,
+        f.latency_p99_ms
+    ));
+    for v in &f.vehicles {
+        out.push_str(&format!(
+            "  {:<8} arrived {:>8}  cross-track median {:.2} m, max {:.2} m\n",
+            v.vehicle,
+            v.arrived_s.map_or("never".into(), |t| format!("{t:.0} s")),
+            v.median_cross_track_m,
+            v.max_cross_track_m
+        ));
+    }
+    match &r.logged {
+        Some(l) if l == f => out.push_str("the figures match the log's end record\n"),
+        Some(_) => {
+            out.push_str("the figures differ from the log's end record (see execution.json)\n")
+        }
+        None => out.push_str("the log has no end record: the run did not finish\n"),
+    }
+    let svg_path = args
+        .svg
+        .clone()
+        .unwrap_or_else(|| args.log.with_extension("svg"));
+    let svg = render(&r)?;
+    std::fs::write(&svg_path, svg)
+        .with_context(|| format!("cannot write {}", svg_path.display()))?;
+    out.push_str(&format!("Wrote {}\n", svg_path.display()));
+    crate::say(&out);
+    Ok(crate::EXIT_FEASIBLE)
+}
+
+/// Top view: obstacles (filled: radius; ring: inflated), planned paths dashed, executed tracks
+/// solid.
+pub fn render(r: &Replayed) -> anyhow::Result<String> {
+    const PALETTE: [RGBColor; 6] = [
+        RGBColor(31, 119, 180),
+        RGBColor(44, 160, 44),
+        RGBColor(148, 103, 189),
+        RGBColor(23, 190, 207),
+        RGBColor(227, 119, 194),
+        RGBColor(140, 86, 75),
+    ];
+    let b = &r.scenario.bounds;
+    let mut buf = String::new();
+    {
+        let root = SVGBackend::with_string(&mut buf, (900, 900)).into_drawing_area();
+        root.fill(&WHITE).map_err(fail("background"))?;
+        let mut chart = ChartBuilder::on(&root)
+            .caption(
+                format!(
+                    "{}: executed (solid) vs planned (dashed); min separation {}",
+                    r.scenario.name,
+                    r.figures
+                        .min_separation_m
+                        .map_or("–".into(), |d| format!("{d:.1} m"))
+                ),
+                ("sans-serif", 18),
+            )
+            .margin(20)
+            .x_label_area_size(30)
+            .y_label_area_size(50)
+            .build_cartesian_2d(b.min[0]..b.max[0], b.min[1]..b.max[1])
+            .map_err(fail("axes"))?;
+        chart.configure_mesh().draw().map_err(fail("mesh"))?;
+        let circle = |o: &Obstacle, r: f64| -> Vec<(f64, f64)> {
+            (0..=72)
+                .map(|k| {
+                    let a = k as f64 / 72.0 * std::f64::consts::TAU;
+                    (o.centre[0] + r * a.cos(), o.centre[1] + r * a.sin())
+                })
+                .collect()
+        };
+        for o in &r.scenario.obstacles {
+            let c = if o.kind == ObstacleKind::Hard {
+                RGBColor(150, 30, 30)
+            } else {
+                RGBColor(235, 165, 20)
+            };
+            chart
+                .draw_series([Polygon::new(circle(o, o.radius_m), c.mix(0.4).filled())])
+                .map_err(fail("obstacle"))?;
+            chart
+                .draw_series([PathElement::new(circle(o, o.inflated_radius()), c.mix(0.6))])
+                .map_err(fail("obstacle margin"))?;
+        }
+        for (k, (plan, track)) in r.planned.iter().zip(&r.tracks).enumerate() {
+            let c = PALETTE[k % PALETTE.len()];
+            let planned: Vec<(f64, f64)> = plan.points.iter().map(|p| (p.x, p.y)).collect();
+            chart
+                .draw_series([DashedPathElement::new(planned, 6, 4, c.mix(0.5))])
+                .map_err(fail("planned path"))?;
+            let executed: Vec<(f64, f64)> = track.points.iter().map(|p| (p.x, p.y)).collect();
+            chart
+                .draw_series([PathElement::new(executed, c.stroke_width(2))])
+                .map_err(fail("executed track"))?
+                .label(r.scenario.vehicles.get(k).map_or("", |v| v.id.as_str()))
+                .legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(2))
+                });
+        }
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.8))
+            .border_style(BLACK)
+            .draw()
+            .map_err(fail("legend"))?;
+        root.present().map_err(fail("document"))?;
+    }
+    Ok(buf)
+}

@@ -1,0 +1,318 @@
+//! `shoal-coordinator run <SCENARIO>`: plan (as `plan` does), then execute the plan with one
+//! agent per vehicle driving it through its vehicle link, and report the execution's figures
+//! (`<out>/execution.json`, the mission log `<out>/mission.ndjson`).
+
+use std::path::PathBuf;
+use std::sync::atomic::AtomicBool;
+use std::sync::Arc;
+use std::time::Duration;
+
+use anyhow::{bail, Context as _};
+use shoal_common::scenario::{Obstacle, ObstacleKind};
+
+use crate::cli::PlanArgs;
+use crate::execute::{self, ExecOptions, ExecutionReport};
+use crate::{distributed, planner, say, summary, write_outputs, write_svg, Progress};
+use crate::{EXIT_FEASIBLE, EXIT_VIOLATIONS};
+
+/// `shoal-coordinator run`.
+#[derive(Debug, Clone, clap::Args)]
+pub struct RunArgs {
+    /// Planning settings, as for `plan`.
+    #[command(flatten)]
+    pub plan: PlanArgs,
+    /// Mission seconds per wall second (50 runs a 2700 s mission in 54 s).
+    #[arg(long, env = "SHOAL_TIME_SCALE", default_value_t = 1.0)]
+    pub time_scale: f64,
+    /// Telemetry reports per wall second and vehicle.
+    #[arg(long, env = "SHOAL_TELEMETRY_HZ", default_value_t = 2.0)]
+    pub telemetry_hz: f64,
+    /// Prediction horizon of the separation check, mission seconds.
+    #[arg(long, env = "SHOAL_HORIZON", default_value_t = 180.0)]
+    pub horizon: f64,
+    /// Cross-track error that triggers a replan, metres (default: d_min / 2).
+    #[arg(long, env = "SHOAL_DEVIATION")]
+    pub deviation: Option<f64>,
+    /// Wall seconds without telemetry after which a vehicle is lost.
+    #[arg(long, env = "SHOAL_LOST_AFTER", default_value_t = 3.0)]
+    pub lost_after: f64,
+    /// Wall-time budget of one replan, milliseconds.
+    #[arg(long, env = "SHOAL_REPLAN_BUDGET_MS", default_value_t = 300)]
+    pub replan_budget_ms: u64,
+    /// Half-width of the arrival window around the common arrival time, mission seconds.
+    #[arg(long, env = "SHOAL_ARRIVAL_WINDOW", default_value_t = 30.0)]
+    pub arrival_window: f64,
+    /// Simulated vehicles: position noise of their fixes (standard deviation per axis), metres.
+    #[arg(long, env = "SHOAL_POSITION_NOISE", default_value_t = 1.0)]
+    pub position_noise: f64,
+    /// Publish a hard obstacle at mission time T, as a client would: `T:X,Y,Z,R` (seconds,
+    /// metres; inflation d_min), or `T:VEHICLE,R` to put it on that vehicle's planned path
+    /// 150 s of mission time after T. Repeatable.
+    #[arg(long = "inject-obstacle", value_parser = parse_injection)]
+    pub inject: Vec<(f64, Place, f64)>,
+    /// The mission log (default: <out>/mission.ndjson).
+    #[arg(long, env = "SHOAL_LOG")]
+    pub log: Option<PathBuf>,
+}
+
+/// Where an injected obstacle goes.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Place {
+    /// At a point, metres.
+    At([f64; 3]),
+    /// On a vehicle's planned path, [`AHEAD_S`] after the injection time.
+    OnPath(String),
+}
+
+/// How far ahead on a vehicle's planned path `T:VEHICLE,R` puts the obstacle, mission seconds.
+pub const AHEAD_S: f64 = 150.0;
+
+/// Reads `T:X,Y,Z,R` or `T:VEHICLE,R`: (time, place, radius).
+fn parse_injection(s: &str) -> Result<(f64, Place, f64), String> {
+    let (t, rest) = s
+        .split_once(':')
+        .ok_or_else(|| format!("{s:?}: expected T:X,Y,Z,R or T:VEHICLE,R"))?;
+    let num = |v: &str| {
+        v.trim()
+            .parse::<f64>()
+            .ok()
+            .filter(|x| x.is_finite())
+            .ok_or_else(|| format!("{s:?}: {v:?} is not a number"))
+    };
+    let parts: Vec<&str> = rest.split(',').collect();
+    let (place, r) = match parts.as_slice() {
+        [x, y, z, r] => (Place::At([num(x)?, num(y)?, num(z)?]), num(r)?),
+        [v, r] => (Place::OnPath(v.trim().to_string()), num(r)?),
+        _ => return Err(format!("{s:?}: expected T:X,Y,Z,R or T:VEHICLE,R")),
+    };
+    if r <= 0.0 {
+        return Err(format!("{s:?}: radius {r} must be positive"));
+    }
+    Ok((num(t)?, place, r))
+}
+
+/// A positive number of seconds, or an error naming the flag.
+fn positive(flag: &str, v: f64) -> anyhow::Result<f64> {
+    if v.is_finite() && v > 0.0 {
+        Ok(v)
+    } else {
+        bail!("{flag} = {v}: must be a positive number")
+    }
+}
+
+/// Plans, then executes; exit 0 when the execution kept d_min and every vehicle arrived in the
+/// window, 3 otherwise.
+pub fn run_command(args: &RunArgs, shutdown: Arc<AtomicBool>) -> anyhow::Result<i32> {
+    let p = &args.plan;
+    let scenario = crate::load_scenario(p)?;
+    if scenario.coverage.is_some() || scenario.optimizer.algorithm.is_tour_planner() {
+        bail!(
+            "{}: `run` executes fleet plans of seed 004 (amp-pso, mp-pso, …); coverage and inspection-tour plans cannot be executed yet",
+            p.scenario.display()
+        );
+    }
+    positive("--time-scale (SHOAL_TIME_SCALE)", args.time_scale)?;
+    positive("--telemetry-hz (SHOAL_TELEMETRY_HZ)", args.telemetry_hz)?;
+    positive("--horizon (SHOAL_HORIZON)", args.horizon)?;
+    positive("--lost-after (SHOAL_LOST_AFTER)", args.lost_after)?;
+    positive(
+        "--arrival-window (SHOAL_ARRIVAL_WINDOW)",
+        args.arrival_window,
+    )?;
+    if !(args.position_noise.is_finite() && args.position_noise >= 0.0) {
+        bail!(
+            "--position-noise (SHOAL_POSITION_NOISE) = {}: must be ≥ 0",
+            args.position_noise
+        );
+    }
+    let d_min = scenario.fleet.d_min_m;
+    let deviation = positive(
+        "--deviation (SHOAL_DEVIATION)",
+        args.deviation.unwrap_or(d_min / 2.0),
+    )?;
+    std::fs::create_dir_all(&p.out)
+        .with_context(|| format!("cannot create output directory {}", p.out.display()))?;
+    let mut options = crate::distributed_options(p, &scenario)?;
+    // The execution is the mission (its keys are shoal/<mission>/…); planning is its own.
+    let mission = options.mission.clone();
+    options.mission = format!("{mission}-plan");
+    let mut progress = Progress::new(scenario.optimizer.iterations, p.quiet);
+    let plan = if p.in_process {
+        planner::plan_in_process(&scenario, Some(Arc::clone(&shutdown)), &mut |r| {
+            progress.update(r)
+        })
+    } else {
+        distributed::plan_distributed(&scenario, &options, &shutdown, &mut |s| {
+            progress.update_distributed(s)
+        })?
+    };
+    progress.finish();
+    write_outputs(&p.out, &plan)?;
+    write_svg(&p.out, &scenario, &plan)?;
+    say(&summary::summary(&plan));
+    if !plan.feasible {
+        eprintln!("the plan is not feasible: it is not executed (see plan.json)");
+        return Ok(EXIT_VIOLATIONS);
+    }
+    options.mission = mission;
+    options.agent_args = vec!["--position-noise".into(), args.position_noise.to_string()];
+    options.log_dir = p.out.join("logs-exec");
+    let log = args
+        .log
+        .clone()
+        .unwrap_or_else(|| p.out.join("mission.ndjson"));
+    let exec = ExecOptions {
+        time_scale: args.time_scale,
+        telemetry_hz: args.telemetry_hz,
+        horizon_s: args.horizon,
+        deviation_m: deviation,
+        lost_after: Duration::from_secs_f64(args.lost_after),
+        replan_budget: Duration::from_millis(args.replan_budget_ms),
+        arrival_window_s: args.arrival_window,
+        log: log.clone(),
+        inject: args
+            .inject
+            .iter()
+            .enumerate()
+            .map(|(k, (t, place, r))| {
+                let centre = match place {
+                    Place::At(c) => *c,
+                    Place::OnPath(v) => {
+                        let i = scenario
+                            .vehicles
+                            .iter()
+                            .position(|x| &x.id == v)
+                            .ok_or_else(|| {
+                                anyhow::anyhow!(
+                                    "--inject-obstacle: the scenario has no vehicle {v:?}"
+                                )
+                            })?;
+                        let tr = &plan.vehicles[i].trajectory;
+                        let traj = shoal_common::trajectory::Trajectory {
+                            times: tr.iter().map(|s| s[0]).collect(),
+                            points: tr
+                                .iter()
+                                .map(|s| shoal_common::geometry::Vec3::new(s[1], s[2], s[3]))
+                                .collect(),
+                        };
+                        let c = traj.position_at(t + AHEAD_S);
+                        [c.x, c.y, c.z]
+                    }
+                };
+                Ok((
+                    *t,
+                    Obstacle {
+                        id: format!("injected#{}", k + 1),
+                        kind: ObstacleKind::Hard,
+                        centre,
+                        radius_m: *r,
+                        inflation_m: d_min,
+                    },
+                ))
+            })
+            .collect::<anyhow::Result<_>>()?,
+        quiet: p.quiet,
+        seed: scenario.optimizer.seed,
+    };
+    eprintln!(
+        "executing mission {} at {}× real time ({} vehicles, telemetry {} Hz)",
+        options.mission,
+        args.time_scale,
+        scenario.vehicles.len(),
+        args.telemetry_hz
+    );
+    let report = execute::execute(&scenario, &plan, &options, &exec, &shutdown)?;
+    let path = p.out.join("execution.json");
+    let json = serde_json::to_string_pretty(&report).context("cannot serialise the execution")?;
+    std::fs::write(&path, json).with_context(|| format!("cannot write {}", path.display()))?;
+    say(&execution_summary(&report));
+    say(&format!("Wrote {} and {}\n", path.display(), log.display()));
+    Ok(if execution_ok(&report) {
+        EXIT_FEASIBLE
+    } else {
+        EXIT_VIOLATIONS
+    })
+}
+
+/// Whether the execution kept d_min and had every vehicle arrive in the window.
+pub fn execution_ok(r: &ExecutionReport) -> bool {
+    let f = &r.figures;
+    f.min_separation_m.is_none_or(|d| d >= f.d_min_m) && f.all_arrived_in_window
+}
+
+/// The human summary of an execution.
+pub fn execution_summary(r: &ExecutionReport) -> String {
+    let f = &r.figures;
+    let mut s = format!("Execution: {}\n", r.ended);
+    for v in &f.vehicles {
+        s.push_str(&format!(
+            "  {:<8} arrived {:>8} {} | cross-track median {:.2} m, p95 {:.2} m, max {:.2} m | obstacle clearance {} | {} reports, revision {}{}\n",
+            v.vehicle,
+            v.arrived_s.map_or("never".to_string(), |t| format!("{t:.0} s")),
+            if v.in_window { "(in window)" } else { "(OUT of window)" },
+            v.median_cross_track_m,
+            v.p95_cross_track_m,
+            v.max_cross_track_m,
+            v.min_obstacle_clearance_m
+                .map_or("–".to_string(), |c| format!("{c:.1} m")),
+            v.reports,
+            v.revision,
+            if v.lost { ", LOST" } else { "" }
+        ));
+    }
+    s.push_str(&format!(
+        "  fleet: min separation {} (d_min {:.0} m){}, arrival window {:.0} ± {:.0} s, {} replans, {} holds\n",
+        f.min_separation_m.map_or("–".to_string(), |d| format!("{d:.1} m")),
+        f.d_min_m,
+        f.min_separation_pair
+            .as_ref()
+            .map_or(String::new(), |p| format!(" between {} and {}", p[0], p[1])),
+        f.common_arrival_s,
+        f.arrival_window_s,
+        r.replans,
+        r.holds
+    ));
+    s.push_str(&format!(
+        "  telemetry: {} reports, latency median {:.2} ms, p99 {:.2} ms\n",
+        f.reports, f.latency_median_ms, f.latency_p99_ms
+    ));
+    if !r.obstacle_decision_ms.is_empty() || !r.update_delivery_ms.is_empty() {
+        s.push_str(&format!(
+            "  replans: obstacle → update sent {:?} ms; update → first report on it {:?} ms\n",
+            r.obstacle_decision_ms
+                .iter()
+                .map(|v| v.round())
+                .collect::<Vec<_>>(),
+            r.update_delivery_ms
+                .iter()
+                .map(|v| v.round())
+                .collect::<Vec<_>>()
+        ));
+    }
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn injections_are_read_and_bad_ones_named() {
+        assert_eq!(
+            parse_injection("1200:800,1000,900,60"),
+            Ok((1200.0, Place::At([800.0, 1000.0, 900.0]), 60.0))
+        );
+        assert_eq!(
+            parse_injection("1150:auv2,40"),
+            Ok((1150.0, Place::OnPath("auv2".into()), 40.0))
+        );
+        let e = parse_injection("1200:800,1000,60")
+            .err()
+            .unwrap_or_default();
+        assert!(e.contains("expected T:X,Y,Z,R or T:VEHICLE,R"), "{e}");
+        let e = parse_injection("x:1,2,3,4").err().unwrap_or_default();
+        assert!(e.contains("\"x\" is not a number"), "{e}");
+        let e = parse_injection("5:1,2,3,-4").err().unwrap_or_default();
+        assert!(e.contains("must be positive"), "{e}");
+    }
+}

@@ -1,0 +1,134 @@
+//! `shoal-coordinator status`: asks the running missions for their live fleet picture (a Zenoh
+//! query on `shoal/<mission>/status`, or on every mission's) and prints it as a table.
+
+use std::time::Duration;
+
+use shoal_common::wire::open::FleetStatus;
+use shoal_common::wire::topics::{self, OpenKey};
+use shoal_common::wire::{codec, session};
+use zenoh::Wait;
+
+/// `shoal-coordinator status`.
+#[derive(Debug, Clone, clap::Args)]
+pub struct StatusArgs {
+    /// The coordinator's Zenoh endpoint(s) (comma-separated).
+    #[arg(
+        long,
+        env = "SHOAL_CONNECT",
+        value_delimiter = ',',
+        default_value = "tcp/127.0.0.1:7447"
+    )]
+    pub connect: Vec<String>,
+    /// Only this mission (default: every running one).
+    #[arg(long, env = "SHOAL_MISSION")]
+    pub mission: Option<String>,
+    /// Seconds to wait for answers.
+    #[arg(long, default_value_t = 3.0)]
+    pub timeout: f64,
+    /// Print the JSON instead of a table.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Queries and prints; exit 1 when no mission answered.
+pub fn command(args: &StatusArgs) -> anyhow::Result<i32> {
+    let key = match &args.mission {
+        Some(m) => topics::open_key(m, OpenKey::Status)?,
+        None => topics::ALL_STATUS.to_string(),
+    };
+    let timeout = Duration::try_from_secs_f64(args.timeout)
+        .ok()
+        .filter(|d| !d.is_zero())
+        .ok_or_else(|| {
+            anyhow::anyhow!(
+                "--timeout = {}: must be a positive number of seconds",
+                args.timeout
+            )
+        })?;
+    let statuses = query(&args.connect, &key, timeout)?;
+    if statuses.is_empty() {
+        eprintln!(
+            "no running mission answered on {key} within {:.1} s",
+            args.timeout
+        );
+        return Ok(crate::EXIT_ERROR);
+    }
+    let mut out = String::new();
+    for s in &statuses {
+        if args.json {
+            out.push_str(&serde_json::to_string_pretty(s)?);
+            out.push('\n');
+        } else {
+            out.push_str(&table(s));
+        }
+    }
+    crate::say(&out);
+    Ok(crate::EXIT_FEASIBLE)
+}
+
+/// The fleet pictures the missions matching `key` answer with (bad answers are skipped, with a
+/// warning).
+pub fn query(connect: &[String], key: &str, timeout: Duration) -> anyhow::Result<Vec<FleetStatus>> {
+    let config = session::client_config(connect, false)?;
+    let s = zenoh::open(config)
+        .wait()
+        .map_err(|e| anyhow::anyhow!("cannot reach {}: {e}", connect.join(", ")))?;
+    let replies = s
+        .get(key)
+        .timeout(timeout)
+        .wait()
+        .map_err(|e| anyhow::anyhow!("cannot query {key}: {e}"))?;
+    let mut out = Vec::new();
+    while let Ok(reply) = replies.recv() {
+        match reply.result() {
+            Ok(sample) => match codec::decode_json::<FleetStatus>(&sample.payload().to_bytes()) {
+                Ok(st) => out.push(st),
+                Err(e) => tracing::warn!("{}: not a fleet status: {e}", sample.key_expr()),
+            },
+            Err(e) => tracing::warn!("an error reply: {:?}", e.payload().to_bytes()),
+        }
+    }
+    let _ = s.close().wait();
+    Ok(out)
+}
+
+/// One mission's picture as a table.
+pub fn table(s: &FleetStatus) -> String {
+    let mut t = format!(
+        "mission {} at t = {:.0} s (d_min {:.0} m)\n{:<10} {:>8} {:>8} {:>8} {:>6} {:>9} {:>9} {:>8} {:>4}\n",
+        s.mission, s.t_s, s.d_min_m, "vehicle", "x m", "y m", "z m", "done", "xtrack m", "ETA s", "status", "rev"
+    );
+    for v in &s.vehicles {
+        let (p, status) = match &v.state {
+            Some(st) => (st.position, format!("{:?}", st.status).to_lowercase()),
+            None => ([f64::NAN; 3], "–".into()),
+        };
+        let status = if v.lost { "LOST".to_string() } else { status };
+        t.push_str(&format!(
+            "{:<10} {:>8.0} {:>8.0} {:>8.0} {:>5.0}% {:>9.1} {:>9.0} {:>8} {:>4}\n",
+            v.vehicle,
+            p[0],
+            p[1],
+            p[2],
+            v.progress.map_or(0.0, |p| 100.0 * p.fraction),
+            v.progress.map_or(f64::NAN, |p| p.cross_track_m),
+            v.progress.map_or(f64::NAN, |p| p.eta_s),
+            status,
+            v.revision
+        ));
+    }
+    t.push_str(&format!(
+        "separation now {}; predicted over {:.0} s: {}\n",
+        s.current_min_separation_m
+            .map_or("–".into(), |d| format!("{d:.1} m")),
+        s.horizon_s,
+        s.predicted.map_or("–".into(), |c| format!(
+            "{:.1} m at t = {:.0} s ({} – {})",
+            c.min_distance_m,
+            c.at_s,
+            s.vehicles.get(c.a).map_or("?", |v| v.vehicle.as_str()),
+            s.vehicles.get(c.b).map_or("?", |v| v.vehicle.as_str())
+        ))
+    ));
+    t
+}

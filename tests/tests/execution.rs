@@ -1,0 +1,125 @@
+//! Executing a plan end to end (issue 8): `shoal-coordinator run` plans scenario 2, one
+//! embedded agent per AUV drives a simulated vehicle along its trajectory at 100× real time, an
+//! obstacle published on auv2's path mid-mission makes the coordinator replan auv2, `status`
+//! reads the live picture over Zenoh, and `replay` recomputes the same figures from the log.
+
+mod common;
+
+use std::process::Command;
+use std::time::{Duration, Instant};
+
+use common::fleet::{endpoint, free_port, Fleet};
+use common::process::{coordinator, root};
+use common::{scenario, without_shoal_env, TestResult};
+use serde_json::Value;
+
+const LIMIT: Duration = Duration::from_secs(240);
+
+fn num(v: &Value, path: &str) -> f64 {
+    let mut x = v;
+    for k in path.split('.') {
+        x = &x[k];
+    }
+    match x.as_f64() {
+        Some(n) => n,
+        None => panic!("{path} is not a number in {v}"),
+    }
+}
+
+#[test]
+fn a_fleet_executes_its_plan_replans_around_a_new_obstacle_and_replays() -> TestResult {
+    let mut fleet = Fleet::new();
+    let out = fleet.dir().join("out");
+    let port = free_port();
+    let mut cmd = Command::new(coordinator());
+    without_shoal_env(&mut cmd);
+    cmd.current_dir(root())
+        .arg("run")
+        .arg(scenario("amp-pso-2"))
+        .args([
+            "--in-process",
+            "--iterations",
+            "40",
+            "--time-scale",
+            "50",
+            "-q",
+        ])
+        .args(["--inject-obstacle", "1150:auv2,40"])
+        .args(["--listen", &format!("tcp/127.0.0.1:{port}")])
+        .arg("--out")
+        .arg(&out);
+    let c = fleet.spawn("coordinator", cmd);
+    fleet.wait_for_stderr(c, "executing mission", Instant::now() + LIMIT);
+    std::thread::sleep(Duration::from_secs(4));
+    let mut status = Command::new(coordinator());
+    without_shoal_env(&mut status);
+    status
+        .current_dir(root())
+        .args(["status", "--connect", &endpoint(port)]);
+    let s = fleet.spawn("status", status);
+    let s = fleet.wait(s, Instant::now() + Duration::from_secs(60));
+    assert_eq!(s.code(), Some(0), "{}\n{}", s.stdout, s.stderr);
+    for needle in ["auv1", "auv2", "auv3", "separation now", "underway"] {
+        assert!(
+            s.stdout.contains(needle),
+            "status lacks {needle:?}:\n{}",
+            s.stdout
+        );
+    }
+    let r = fleet.wait(c, Instant::now() + LIMIT);
+    assert_eq!(r.code(), Some(0), "{}\n{}", r.stdout, r.stderr);
+    let report: Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("execution.json"))?)?;
+    let f = &report["figures"];
+    assert!(num(f, "min_separation_m") >= 50.0, "{f}");
+    assert_eq!(f["all_arrived_in_window"], Value::Bool(true), "{f}");
+    assert!(num(&report, "replans") >= 1.0, "{report}");
+    for v in f["vehicles"].as_array().into_iter().flatten() {
+        // Collision-free: never inside an obstacle's physical radius, new one included.
+        assert!(num(v, "min_obstacle_clearance_m") > 0.0, "{v}");
+        assert!(num(v, "max_cross_track_m") < 50.0, "{v}");
+        assert!(num(v, "reports") > 20.0, "{v}");
+    }
+    assert!(
+        num(&f["vehicles"][1], "revision") >= 1.0,
+        "auv2 was not replanned: {f}"
+    );
+    let log = std::fs::read_to_string(out.join("mission.ndjson"))?;
+    let events: Vec<Value> = log
+        .lines()
+        .filter_map(|l| serde_json::from_str::<Value>(l).ok())
+        .filter(|r| r["record"] == "event")
+        .collect();
+    let has = |kind: &str, vehicle: &str| {
+        events.iter().any(|e| {
+            e["kind"] == kind
+                && e["vehicles"]
+                    .as_array()
+                    .is_some_and(|v| v.iter().any(|x| x == vehicle))
+        })
+    };
+    assert!(has("obstacle", "auv2"), "no obstacle event blocking auv2");
+    assert!(has("replanned", "auv2"), "auv2 was not replanned");
+    // Replay: the same figures from the records alone.
+    let mut replay = Command::new(coordinator());
+    without_shoal_env(&mut replay);
+    replay
+        .current_dir(root())
+        .arg("replay")
+        .arg(out.join("mission.ndjson"));
+    let rp = fleet.spawn("replay", replay);
+    let rp = fleet.wait(rp, Instant::now() + Duration::from_secs(60));
+    assert_eq!(rp.code(), Some(0), "{}\n{}", rp.stdout, rp.stderr);
+    assert!(
+        rp.stdout.contains("the figures match the log's end record"),
+        "{}",
+        rp.stdout
+    );
+    let svg = std::fs::read_to_string(out.join("mission.svg"))?;
+    assert!(
+        svg.contains("auv2") && svg.contains("executed"),
+        "mission.svg lacks its content"
+    );
+    fleet.passed();
+    Ok(())
+}
