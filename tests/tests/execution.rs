@@ -123,3 +123,57 @@ fn a_fleet_executes_its_plan_replans_around_a_new_obstacle_and_replays() -> Test
     fleet.passed();
     Ok(())
 }
+
+#[test]
+fn a_vehicle_that_stops_reporting_is_declared_lost_and_the_rest_arrive() -> TestResult {
+    let mut fleet = Fleet::new();
+    let out = fleet.dir().join("out");
+    let port = free_port();
+    let mut cmd = Command::new(coordinator());
+    without_shoal_env(&mut cmd);
+    cmd.current_dir(root())
+        .arg("run")
+        .arg(scenario("amp-pso-2"))
+        .args([
+            "--in-process",
+            "--iterations",
+            "40",
+            "--time-scale",
+            "100",
+            "-q",
+        ])
+        .args(["--agents", "external", "--lost-after", "2"])
+        .args(["--listen", &format!("tcp/127.0.0.1:{port}")])
+        .arg("--out")
+        .arg(&out);
+    let c = fleet.spawn("coordinator", cmd);
+    let agents: Vec<_> = ["auv1", "auv2", "auv3"]
+        .iter()
+        .map(|v| fleet.agent(v, &endpoint(port), &["--idle-timeout", "5"]))
+        .collect();
+    fleet.wait_for_stderr(c, "executing mission", Instant::now() + LIMIT);
+    // Mid-mission, auv3's agent dies without a goodbye.
+    std::thread::sleep(Duration::from_secs(10));
+    fleet.kill(agents[2]);
+    let r = fleet.wait(c, Instant::now() + LIMIT);
+    // auv3 never arrives: the execution is reported as not met (exit 3), with everything else.
+    assert_eq!(r.code(), Some(3), "{}\n{}", r.stdout, r.stderr);
+    let report: Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("execution.json"))?)?;
+    let f = &report["figures"];
+    assert_eq!(f["vehicles"][2]["lost"], Value::Bool(true), "{f}");
+    assert_eq!(f["vehicles"][2]["arrived_s"], Value::Null, "{f}");
+    for k in 0..2 {
+        assert_eq!(f["vehicles"][k]["in_window"], Value::Bool(true), "{f}");
+    }
+    assert!(num(f, "min_separation_m") >= 50.0, "{f}");
+    let log = std::fs::read_to_string(out.join("mission.ndjson"))?;
+    assert!(
+        log.lines()
+            .any(|l| l.contains("\"kind\":\"vehicle_lost\"") && l.contains("auv3")),
+        "no vehicle_lost event for auv3"
+    );
+    assert!(r.stdout.contains("LOST"), "{}", r.stdout);
+    fleet.passed();
+    Ok(())
+}

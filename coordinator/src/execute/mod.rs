@@ -390,7 +390,7 @@ fn run_loop(
         }
         while let Some(e) = x.session.net.next(Instant::now()) {
             if let Event::Gone(v) = e {
-                tracing::info!("the agent of {v} left the network");
+                react::lose(x, &v, "its agent left the network (liveliness token gone)");
             }
         }
         let now = x.clock();

@@ -193,6 +193,24 @@ fn remaining_hits(
         .any(|w| segment_hits_sphere(&w[0], &w[1], &o.centre(), o.inflated_radius()))
 }
 
+/// Marks vehicle `id` lost (once) and says why; the others then treat its last fix as an
+/// obstacle in their predictions and replans.
+pub(super) fn lose(x: &mut Exec, id: &str, why: &str) {
+    let Some(i) = x.fleet.index(id) else {
+        return;
+    };
+    let v = &x.fleet.vehicles[i];
+    if v.lost || v.arrived_s.is_some() {
+        return;
+    }
+    x.fleet.vehicles[i].lost = true;
+    x.event(
+        "vehicle_lost",
+        vec![id.to_string()],
+        format!("{id} is lost: {why}; the others treat its last position as an obstacle"),
+    );
+}
+
 /// The periodic checks (see the module doc).
 pub(super) fn check(x: &mut Exec, now: f64) {
     let o = x.options;
@@ -203,17 +221,10 @@ pub(super) fn check(x: &mut Exec, now: f64) {
             // Never heard: lost once the mission has run for a while without it.
             None => now > 0.0 && x.clock_wall_since_epoch() > o.lost_after + Duration::from_secs(5),
         };
-        if silent && !v.lost && v.arrived_s.is_none() {
+        if silent {
             let id = v.id.clone();
-            x.fleet.vehicles[i].lost = true;
-            x.event(
-                "vehicle_lost",
-                vec![id.clone()],
-                format!(
-                    "{id} has not reported for {:.1} s: lost; the others treat its last position as an obstacle",
-                    o.lost_after.as_secs_f64()
-                ),
-            );
+            let why = format!("no report for {:.1} s", o.lost_after.as_secs_f64());
+            lose(x, &id, &why);
         }
     }
     for i in 0..x.fleet.vehicles.len() {
