@@ -177,3 +177,48 @@ fn a_vehicle_that_stops_reporting_is_declared_lost_and_the_rest_arrive() -> Test
     fleet.passed();
     Ok(())
 }
+
+#[test]
+fn a_vehicle_with_no_safe_replan_is_told_to_hold() -> TestResult {
+    let mut fleet = Fleet::new();
+    let out = fleet.dir().join("out");
+    let mut cmd = Command::new(coordinator());
+    without_shoal_env(&mut cmd);
+    // An obstacle on auv2's goal (1900, 1900, 500): no path can end there safely.
+    cmd.current_dir(root())
+        .arg("run")
+        .arg(scenario("amp-pso-2"))
+        .args([
+            "--in-process",
+            "--iterations",
+            "40",
+            "--time-scale",
+            "100",
+            "-q",
+        ])
+        .args(["--inject-obstacle", "1000:1900,1900,500,30"])
+        .arg("--out")
+        .arg(&out);
+    let c = fleet.spawn("coordinator", cmd);
+    let r = fleet.wait(c, Instant::now() + LIMIT);
+    assert_eq!(r.code(), Some(3), "{}\n{}", r.stdout, r.stderr);
+    let report: Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("execution.json"))?)?;
+    assert!(num(&report, "holds") >= 1.0, "{report}");
+    let f = &report["figures"];
+    assert_eq!(f["vehicles"][1]["arrived_s"], Value::Null, "{f}");
+    // Holding short of the obstacle: never inside it.
+    assert!(
+        num(&f["vehicles"][1], "min_obstacle_clearance_m") > 0.0,
+        "{f}"
+    );
+    assert!(num(f, "min_separation_m") >= 50.0, "{f}");
+    let log = std::fs::read_to_string(out.join("mission.ndjson"))?;
+    assert!(
+        log.lines()
+            .any(|l| l.contains("\"kind\":\"hold\"") && l.contains("auv2")),
+        "no hold event for auv2"
+    );
+    fleet.passed();
+    Ok(())
+}

@@ -159,6 +159,16 @@ impl Simulator {
         if plan.points.is_empty() || plan.points.len() != plan.times.len() {
             return self.hold();
         }
+        if self.status == VehicleStatus::Idle {
+            // A vehicle is launched pointing along its first leg, not wherever it was built.
+            if let Some(w) = plan
+                .points
+                .windows(2)
+                .find(|w| (w[1] - w[0]).xy().norm() > 1e-6)
+            {
+                self.heading = heading_of(&(w[1] - w[0]), self.heading);
+            }
+        }
         self.plan = Some(plan);
         self.status = VehicleStatus::Underway;
         self.arrived_at = None;
@@ -446,13 +456,22 @@ mod tests {
 
     #[test]
     fn yaw_rate_is_limited_by_the_turning_radius() {
-        let mut sim = auv(A, EAST, None); // heads east, toward its goal
+        let mut sim = auv(A, EAST, None);
+        sim.load(line(A, EAST, 0.0, 200.0)); // under way east
         assert!(sim.heading().abs() < 1e-12);
-        sim.load(line(A, NORTH, 0.0, 200.0));
+        sim.load(line(A, NORTH, 0.0, 200.0)); // a replan: now north
         sim.advance_to(1.0);
         let limit = 1.5 / SimSettings::default().turn_radius_m; // v_max / R, rad in 1 s
         let h = sim.heading();
         assert!(h > 0.0 && h <= limit + 1e-9, "{h}");
+    }
+
+    #[test]
+    fn a_vehicle_is_launched_along_its_first_leg() {
+        let mut sim = auv(A, EAST, None); // built facing its goal, east
+        assert!(sim.heading().abs() < 1e-12);
+        sim.load(line(A, NORTH, 0.0, 200.0));
+        assert!((sim.heading() - std::f64::consts::FRAC_PI_2).abs() < 1e-12);
     }
 
     #[test]

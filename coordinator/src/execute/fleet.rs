@@ -135,7 +135,11 @@ impl Fleet {
         let p = Vec3::from(t.state.position);
         let now = t.state.t_s;
         let progress = picture::progress(&v.plan, p, now, PROGRESS_WINDOW_S);
-        v.cross_track.push(progress.cross_track_m);
+        // A vehicle told to hold is off its plan by command: its distance from it is no
+        // tracking error.
+        if !v.holding {
+            v.cross_track.push(progress.cross_track_m);
+        }
         v.progress = Some(progress);
         if v.track.times.last().is_none_or(|&last| now >= last) {
             v.track.times.push(now);
