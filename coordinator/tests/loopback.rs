@@ -72,6 +72,9 @@ fn agent(vehicle: &str, endpoint: &str) -> Agent {
         health_check: false,
         link: shoal_agent::link::LinkKind::Sim,
         position_noise: 1.0,
+        mavlink_address: None,
+        mavlink_origin: None,
+        mavlink_target: None,
     };
     let flag = Arc::clone(&stop);
     Agent {

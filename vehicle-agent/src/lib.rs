@@ -60,6 +60,27 @@ pub struct AgentArgs {
     /// `sim` link: position noise of the simulated fixes (standard deviation per axis), metres.
     #[arg(long, env = "SHOAL_POSITION_NOISE", default_value_t = 1.0)]
     pub position_noise: f64,
+    /// `mavlink` link: the vehicle's address, `udpout:HOST:PORT` (we send first) or
+    /// `udpin:ADDR:PORT` (we listen; the vehicle must send first).
+    #[arg(long, env = "SHOAL_MAVLINK_ADDRESS", value_parser = link::check_mavlink_address)]
+    pub mavlink_address: Option<String>,
+    /// `mavlink` link: geodetic origin of the scenario frame, `LAT,LON,ALT` (degrees, degrees,
+    /// metres above mean sea level of scenario point (0, 0, 0)).
+    #[arg(
+        long,
+        env = "SHOAL_MAVLINK_ORIGIN",
+        value_name = "LAT,LON,ALT",
+        allow_hyphen_values = true
+    )]
+    pub mavlink_origin: Option<link::GeoOrigin>,
+    /// `mavlink` link: the vehicle's MAVLink system and component ids (default 1,1).
+    #[arg(
+        long,
+        env = "SHOAL_MAVLINK_TARGET",
+        value_name = "SYS,COMP",
+        value_parser = link::parse_mavlink_target
+    )]
+    pub mavlink_target: Option<(u8, u8)>,
 }
 
 impl AgentArgs {
@@ -75,6 +96,16 @@ impl AgentArgs {
         link::LinkSettings {
             kind: self.link,
             position_noise_m: self.position_noise,
+            mavlink: match (&self.mavlink_address, self.mavlink_origin) {
+                (Some(address), Some(origin)) => {
+                    let mut m = link::MavlinkSettings::new(address, origin);
+                    if let Some((system, component)) = self.mavlink_target {
+                        (m.target_system, m.target_component) = (system, component);
+                    }
+                    Some(m)
+                }
+                _ => None,
+            },
         }
     }
 }
@@ -101,6 +132,14 @@ pub fn run(args: AgentArgs, shutdown: Arc<AtomicBool>) -> anyhow::Result<()> {
         anyhow::bail!(
             "--position-noise (SHOAL_POSITION_NOISE) = {}: must be a non-negative number of metres",
             args.position_noise
+        );
+    }
+    if args.link == link::LinkKind::Mavlink
+        && (args.mavlink_address.is_none() || args.mavlink_origin.is_none())
+    {
+        anyhow::bail!(
+            "--link mavlink needs --mavlink-address (SHOAL_MAVLINK_ADDRESS) and \
+             --mavlink-origin (SHOAL_MAVLINK_ORIGIN)"
         );
     }
     network::serve(&args, &shutdown)

@@ -105,6 +105,8 @@ pub(crate) struct Exec<'a> {
     new_obstacles: Vec<(Obstacle, Instant)>,
     /// Per vehicle: when it was last replanned or held (wall), for a cool-down.
     last_reaction: Vec<Option<Instant>>,
+    /// Per vehicle: failed replans since it was told to hold (each retry doubles the budget).
+    hold_retries: Vec<u32>,
     /// Per vehicle: the revision sent and when, to time its delivery.
     pending: Vec<Option<(u32, Instant)>>,
     /// Delivery times of updates (decision → first report on the new revision), ms.
@@ -292,6 +294,7 @@ pub fn execute_trajectories(
         holds: 0,
         new_obstacles: Vec::new(),
         last_reaction: vec![None; ids.len()],
+        hold_retries: vec![0; ids.len()],
         pending: vec![None; ids.len()],
         deliveries_ms: Vec::new(),
         decisions_ms: Vec::new(),

@@ -286,14 +286,23 @@ pub(super) fn check(x: &mut Exec, now: f64) {
 pub(super) fn replan_vehicle(x: &mut Exec, i: usize, why: &str) -> bool {
     let o = x.options;
     let now = x.clock();
+    // A holding vehicle is safe where it is, so each retry may think longer: the budget
+    // doubles per failed retry, up to 8 ×.
+    let budget = if x.fleet.vehicles[i].holding {
+        o.replan_budget * (1u32 << x.hold_retries[i].min(3))
+    } else {
+        o.replan_budget
+    };
     // The update must reach the vehicle before it is due: start it one budget (plus margin)
     // of wall time ahead, in mission time.
-    let lead = (o.replan_budget + Duration::from_millis(250)).as_secs_f64() * o.time_scale;
+    let lead = (budget + Duration::from_millis(250)).as_secs_f64() * o.time_scale;
     let t0 = now + lead;
     let remaining = (x.common_arrival_s + o.arrival_window_s - now).max(o.horizon_s);
     let predictions = x.fleet.predictions_over(now, remaining);
     let p0 = predictions[i].position_at(t0);
-    let seed = o.seed ^ (u64::from(x.revision) << 8) ^ i as u64;
+    // A retry must not repeat the swarm that just failed.
+    let seed =
+        o.seed ^ (u64::from(x.revision) << 8) ^ (u64::from(x.hold_retries[i]) << 32) ^ i as u64;
     let result = replan::replan(&Request {
         scenario: &x.scenario,
         vehicle: i,
@@ -302,12 +311,13 @@ pub(super) fn replan_vehicle(x: &mut Exec, i: usize, why: &str) -> bool {
         current: &x.fleet.vehicles[i].plan,
         others: &predictions,
         arrival_s: x.common_arrival_s,
-        budget: o.replan_budget,
+        budget,
         seed,
     });
     x.last_reaction[i] = Some(Instant::now());
     let id = x.fleet.vehicles[i].id.clone();
     if result.safe {
+        x.hold_retries[i] = 0;
         x.revision += 1;
         let v = &mut x.fleet.vehicles[i];
         v.plan = result.trajectory.clone();
@@ -338,7 +348,20 @@ pub(super) fn replan_vehicle(x: &mut Exec, i: usize, why: &str) -> bool {
         );
         true
     } else {
-        if !x.fleet.vehicles[i].holding {
+        if x.fleet.vehicles[i].holding {
+            x.hold_retries[i] += 1;
+            x.event(
+                "still_holding",
+                vec![id.clone()],
+                format!(
+                    "{id} keeps holding: retry {} found no safe replan in {:.0} ms ({} obstacle intrusions, closest vehicle {:.1} m)",
+                    x.hold_retries[i],
+                    result.elapsed.as_secs_f64() * 1000.0,
+                    result.hard_hits,
+                    result.min_separation_m
+                ),
+            );
+        } else {
             x.send(
                 &id,
                 CoordinatorToAgent::Hold {

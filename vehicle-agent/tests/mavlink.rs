@@ -1,0 +1,528 @@
+//! The `mavlink` link against vehicles on loopback UDP: a mock vehicle written with the mavlink
+//! crate (it drops messages so the retries must work, refuses, or stays silent), and pymavlink
+//! as an independent peer (`tests/python/mavlink_peer.py`).
+//!
+//! The peer's interpreter is `$SHOAL_INTEROP_PYTHON` (CI sets it to a venv with
+//! pymavlink==2.4.50: then a missing package is a failure); without it, `python3` is used if it
+//! can import `pymavlink`, and the test says SKIPPED otherwise.
+
+use std::io::{BufRead, BufReader};
+use std::net::UdpSocket;
+use std::process::{Child, Command, Stdio};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{mpsc, Arc, Mutex, PoisonError};
+use std::thread::JoinHandle;
+use std::time::{Duration, Instant};
+
+use clap::Parser;
+use mavlink::dialects::common::{self as mav, MavCmd, MavMessage as M};
+use mavlink::{Connectable, MavConnection, MavHeader, UdpConfig, UdpMode};
+use shoal_agent::link::mavlink::{mission_items, MavlinkLink};
+use shoal_agent::link::{GeoOrigin, LinkError, MavlinkSettings, VehicleLink};
+use shoal_agent::AgentArgs;
+use shoal_common::execution::VehicleStatus;
+use shoal_common::geometry::Vec3;
+use shoal_common::trajectory::Trajectory;
+
+type TestResult = Result<(), Box<dyn std::error::Error>>;
+
+const ORIGIN: GeoOrigin = GeoOrigin::new(43.1, 5.9, 0.0);
+const VEHICLE: MavHeader = MavHeader {
+    system_id: 1,
+    component_id: 1,
+    sequence: 0,
+};
+
+/// A free UDP port on loopback (bound, read, released).
+fn free_port() -> Result<u16, std::io::Error> {
+    Ok(UdpSocket::bind("127.0.0.1:0")?.local_addr()?.port())
+}
+
+/// Three samples: 150 m east in 100 s, then 200 m north and 20 m down in 200 s.
+fn plan() -> Trajectory {
+    let points = [
+        [0.0, 0.0, -10.0],
+        [150.0, 0.0, -10.0],
+        [150.0, 200.0, -30.0],
+    ];
+    Trajectory {
+        times: vec![0.0, 100.0, 300.0],
+        points: points.map(Vec3::from).to_vec(),
+    }
+}
+
+fn settings(port: u16, timeout_ms: u64, retries: u32) -> MavlinkSettings {
+    let mut s = MavlinkSettings::new(format!("udpout:127.0.0.1:{port}"), ORIGIN);
+    (s.timeout, s.retries) = (Duration::from_millis(timeout_ms), retries);
+    s
+}
+
+/// How the mock vehicle misbehaves.
+#[derive(Clone, Copy, PartialEq)]
+enum Behaviour {
+    /// Ignores the first MISSION_COUNT and the first copy of item 2, answers everything else.
+    Lossy,
+    /// Answers MISSION_COUNT with MISSION_ACK MAV_MISSION_ERROR.
+    Refuses,
+    /// Never answers.
+    Silent,
+}
+
+/// What the mock received, and what it streams (set by the test).
+#[derive(Default)]
+struct Board {
+    counts: usize,
+    items: Vec<mav::MISSION_ITEM_INT_DATA>,
+    commands: Vec<MavCmd>,
+    position: Option<mav::GLOBAL_POSITION_INT_DATA>,
+    reached: Option<u16>,
+}
+
+/// A vehicle on loopback UDP (`udpin`), answering the mission and command protocols.
+struct Mock {
+    port: u16,
+    board: Arc<Mutex<Board>>,
+    stop: Arc<AtomicBool>,
+    thread: Option<JoinHandle<Result<(), String>>>,
+}
+
+impl Mock {
+    fn start(behaviour: Behaviour) -> Result<Mock, Box<dyn std::error::Error>> {
+        let socket = UdpSocket::bind("127.0.0.1:0")?;
+        let port = socket.local_addr()?.port();
+        let conn = UdpConfig::from_socket(socket, UdpMode::Udpin)?
+            .read_timeout(Duration::from_millis(10))
+            .connect::<M>()?;
+        let (board, stop) = (
+            Arc::new(Mutex::new(Board::default())),
+            Arc::new(AtomicBool::new(false)),
+        );
+        let (b, s) = (Arc::clone(&board), Arc::clone(&stop));
+        let thread = std::thread::spawn(move || serve(&conn, behaviour, &b, &s));
+        Ok(Mock {
+            port,
+            board,
+            stop,
+            thread: Some(thread),
+        })
+    }
+
+    fn board(&self) -> std::sync::MutexGuard<'_, Board> {
+        self.board.lock().unwrap_or_else(PoisonError::into_inner)
+    }
+}
+
+impl Drop for Mock {
+    fn drop(&mut self) {
+        self.stop.store(true, Ordering::Relaxed);
+        if let Some(Ok(Err(e))) = self.thread.take().map(JoinHandle::join) {
+            if !std::thread::panicking() {
+                panic!("the mock vehicle failed: {e}");
+            }
+        }
+    }
+}
+
+/// The mock's loop: answers, and streams the board's position and reached item every 50 ms.
+fn serve(
+    conn: &mavlink::Connection<M>,
+    behaviour: Behaviour,
+    board: &Mutex<Board>,
+    stop: &AtomicBool,
+) -> Result<(), String> {
+    let send = |m: M| conn.send(&VEHICLE, &m).map(drop).map_err(|e| e.to_string());
+    let (mut count, mut next, mut dropped_item) = (0u16, 0u16, false);
+    let mut streamed = Instant::now();
+    while !stop.load(Ordering::Relaxed) {
+        if streamed.elapsed() > Duration::from_millis(50) {
+            streamed = Instant::now();
+            let (position, reached) = {
+                let b = board.lock().unwrap_or_else(PoisonError::into_inner);
+                (b.position.clone(), b.reached)
+            };
+            if let Some(p) = position {
+                send(M::GLOBAL_POSITION_INT(p))?;
+            }
+            if let Some(seq) = reached {
+                send(M::MISSION_ITEM_REACHED(mav::MISSION_ITEM_REACHED_DATA {
+                    seq,
+                }))?;
+            }
+        }
+        let Ok((_, msg)) = conn.recv() else { continue };
+        let mut b = board.lock().unwrap_or_else(PoisonError::into_inner);
+        let request = |seq| {
+            let mut r = mav::MISSION_REQUEST_INT_DATA::default();
+            (r.seq, r.target_system, r.target_component) = (seq, 255, 190);
+            M::MISSION_REQUEST_INT(r)
+        };
+        let ack = |result| {
+            let mut a = mav::MISSION_ACK_DATA::default();
+            (a.mavtype, a.target_system, a.target_component) = (result, 255, 190);
+            M::MISSION_ACK(a)
+        };
+        match msg {
+            M::MISSION_COUNT(c) => {
+                b.counts += 1;
+                match behaviour {
+                    Behaviour::Silent => {}
+                    Behaviour::Lossy if b.counts == 1 => {} // as if our request were lost
+                    Behaviour::Refuses => send(ack(mav::MavMissionResult::MAV_MISSION_ERROR))?,
+                    Behaviour::Lossy => {
+                        (count, next) = (c.count, 0);
+                        b.items.clear();
+                        send(request(0))?;
+                    }
+                }
+            }
+            M::MISSION_ITEM_INT(item) if behaviour == Behaviour::Lossy => {
+                if item.seq == 2 && !dropped_item {
+                    dropped_item = true; // lost on the way: the link must send it again
+                    continue;
+                }
+                if item.seq == next {
+                    b.items.push(item);
+                    next += 1;
+                }
+                send(if next < count {
+                    request(next)
+                } else {
+                    ack(mav::MavMissionResult::MAV_MISSION_ACCEPTED)
+                })?;
+            }
+            M::COMMAND_LONG(c) if behaviour != Behaviour::Silent => {
+                b.commands.push(c.command);
+                let mut a = mav::COMMAND_ACK_DATA::default();
+                (a.command, a.result) = (c.command, mav::MavResult::MAV_RESULT_ACCEPTED);
+                send(M::COMMAND_ACK(a))?;
+            }
+            _ => {}
+        }
+    }
+    Ok(())
+}
+
+/// Polls `state` until `done` holds (or 3 s pass).
+fn wait_state(
+    link: &mut MavlinkLink,
+    done: impl Fn(&shoal_common::execution::VehicleState) -> bool,
+) -> Result<shoal_common::execution::VehicleState, String> {
+    let deadline = Instant::now() + Duration::from_secs(3);
+    loop {
+        let state = link.state(42.0);
+        match state {
+            Ok(s) if done(&s) => return Ok(s),
+            _ if Instant::now() > deadline => {
+                return Err(format!("gave up waiting; last: {state:?}"))
+            }
+            _ => std::thread::sleep(Duration::from_millis(20)),
+        }
+    }
+}
+
+/// GLOBAL_POSITION_INT at scenario point `p`.
+fn position_at(p: [f64; 3], v_ned_cm: [i16; 3], hdg_cdeg: u16) -> mav::GLOBAL_POSITION_INT_DATA {
+    let [lat, lon, alt] = ORIGIN.to_geodetic(p);
+    let mut g = mav::GLOBAL_POSITION_INT_DATA::default();
+    (g.lat, g.lon, g.alt) = (
+        (lat * 1e7).round() as i32,
+        (lon * 1e7).round() as i32,
+        (alt * 1e3).round() as i32,
+    );
+    ([g.vx, g.vy, g.vz], g.hdg) = (v_ned_cm, hdg_cdeg);
+    g
+}
+
+#[test]
+fn upload_survives_lost_messages_then_position_arrival_and_hold_come_through() -> TestResult {
+    let mock = Mock::start(Behaviour::Lossy)?;
+    let mut link = MavlinkLink::connect(&settings(mock.port, 200, 5))?.with_surface(Some(0.0));
+    let early = link.state(0.0);
+    assert!(matches!(early, Err(LinkError::Timeout(_))), "{early:?}");
+
+    let started = Instant::now();
+    link.upload(&plan())?;
+    assert!(
+        started.elapsed() >= Duration::from_millis(400),
+        "two timeouts before the retries"
+    );
+    {
+        let b = mock.board();
+        assert_eq!(
+            b.counts, 2,
+            "MISSION_COUNT sent again after the first was not answered"
+        );
+        let want = mission_items(&plan(), &ORIGIN, None, (1, 1));
+        assert_eq!(b.items.len(), 4);
+        for (got, want) in b.items.iter().zip(&want) {
+            assert_eq!(
+                (got.seq, got.command, got.frame),
+                (want.seq, want.command, want.frame)
+            );
+            assert_eq!(
+                (got.x, got.y, got.z, got.param2),
+                (want.x, want.y, want.z, want.param2)
+            );
+        }
+        let end = ORIGIN.to_geodetic([150.0, 200.0, -30.0]);
+        assert_eq!(
+            (b.items[3].x, b.items[3].y),
+            ((end[0] * 1e7).round() as i32, (end[1] * 1e7).round() as i32)
+        );
+        assert_eq!(b.commands, [MavCmd::MAV_CMD_MISSION_START]);
+    }
+
+    // 1 m/s north, 0.5 m/s east, 0.1 m/s up; heading 45° (north-east) is 45° ccw from east.
+    mock.board().position = Some(position_at([120.0, -35.5, -12.0], [100, 50, -10], 4500));
+    let s = wait_state(&mut link, |s| s.t_s == 42.0)?;
+    let want = [120.0, -35.5, -12.0];
+    assert!(
+        (0..3).all(|i| (s.position[i] - want[i]).abs() < 0.1),
+        "{:?}",
+        s.position
+    );
+    assert!(
+        (0..3).all(|i| (s.velocity[i] - [0.5, 1.0, 0.1][i]).abs() < 1e-9),
+        "{:?}",
+        s.velocity
+    );
+    assert!((s.heading_deg - 45.0).abs() < 1e-9 && s.depth_m == Some(12.0));
+    assert_eq!(
+        (s.status, s.battery, s.arrived_s),
+        (VehicleStatus::Underway, 1.0, None)
+    );
+
+    mock.board().reached = Some(3);
+    let s = wait_state(&mut link, |s| s.status == VehicleStatus::Arrived)?;
+    assert!(s.arrived_s.is_some_and(|t| t <= 42.0));
+
+    link.hold()?;
+    assert_eq!(link.state(43.0)?.status, VehicleStatus::Holding);
+    assert_eq!(
+        mock.board().commands.last(),
+        Some(&MavCmd::MAV_CMD_DO_PAUSE_CONTINUE)
+    );
+    assert_eq!(link.skipped(), 0);
+    Ok(())
+}
+
+#[test]
+fn a_silent_vehicle_times_out_after_the_retries() -> TestResult {
+    let mock = Mock::start(Behaviour::Silent)?;
+    let mut link = MavlinkLink::connect(&settings(mock.port, 100, 2))?;
+    let started = Instant::now();
+    match link.upload(&plan()) {
+        Err(LinkError::Timeout(why)) => assert!(why.contains("MISSION_REQUEST 0"), "{why}"),
+        other => panic!("expected a timeout, got {other:?}"),
+    }
+    let took = started.elapsed();
+    assert!(
+        took >= Duration::from_millis(300) && took < Duration::from_secs(2),
+        "{took:?}"
+    );
+    assert_eq!(
+        mock.board().counts,
+        3,
+        "the first MISSION_COUNT and two resends"
+    );
+    assert!(matches!(link.hold(), Err(LinkError::Timeout(_))));
+    Ok(())
+}
+
+#[test]
+fn a_refused_mission_is_refused() -> TestResult {
+    let mock = Mock::start(Behaviour::Refuses)?;
+    let mut link = MavlinkLink::connect(&settings(mock.port, 200, 5))?;
+    match link.upload(&plan()) {
+        Err(LinkError::Refused(why)) => assert!(why.contains("MAV_MISSION_ERROR"), "{why}"),
+        other => panic!("expected a refusal, got {other:?}"),
+    }
+    Ok(())
+}
+
+#[test]
+fn a_listening_link_skips_garbage_and_strangers() -> TestResult {
+    let port = free_port()?;
+    let mut link = MavlinkLink::connect(&MavlinkSettings::new(
+        format!("udpin:127.0.0.1:{port}"),
+        ORIGIN,
+    ))?;
+    let raw = UdpSocket::bind("127.0.0.1:0")?;
+    raw.send_to(
+        &[0xfd, 9, 0, 0, 1, 1, 1, 0, 0, 0, 1, 2, 3],
+        ("127.0.0.1", port),
+    )?; // a torn frame
+    raw.send_to(b"not mavlink at all", ("127.0.0.1", port))?;
+    let vehicle = mavlink::connect::<M>(&format!("udpout:127.0.0.1:{port}"))?;
+    let stranger = MavHeader {
+        system_id: 9,
+        ..VEHICLE
+    };
+    vehicle.send(
+        &stranger,
+        &M::GLOBAL_POSITION_INT(position_at([5.0; 3], [0; 3], 0)),
+    )?;
+    vehicle.send(
+        &VEHICLE,
+        &M::GLOBAL_POSITION_INT(position_at([-20.0, 30.0, -4.0], [0; 3], u16::MAX)),
+    )?;
+    let s = wait_state(&mut link, |_| true)?;
+    assert!(
+        (s.position[0] + 20.0).abs() < 0.1 && (s.position[1] - 30.0).abs() < 0.1,
+        "{s:?}"
+    );
+    assert_eq!((s.status, s.heading_deg), (VehicleStatus::Idle, 0.0));
+    assert!(link.skipped() >= 1, "the stranger's message is counted");
+    Ok(())
+}
+
+#[test]
+fn the_agent_flags_build_the_settings_and_bad_values_name_the_flag() -> TestResult {
+    let base = ["shoal-agent", "--vehicle", "auv1", "--link", "mavlink"];
+    let args = AgentArgs::try_parse_from(base.iter().chain(&[
+        "--mavlink-address",
+        "udpout:127.0.0.1:14550",
+        "--mavlink-origin",
+        "43.1,5.9,-2",
+        "--mavlink-target",
+        "2,1",
+    ]))?;
+    let mut want = MavlinkSettings::new("udpout:127.0.0.1:14550", GeoOrigin::new(43.1, 5.9, -2.0));
+    (want.target_system, want.target_component) = (2, 1);
+    assert_eq!(args.link_settings().mavlink, Some(want));
+    for (flag, bad) in [
+        ("--mavlink-origin", "91,0,0"),
+        ("--mavlink-address", "tcp:x:1"),
+        ("--mavlink-target", "0,1"),
+    ] {
+        let err = AgentArgs::try_parse_from(base.iter().chain(&[flag, bad]))
+            .err()
+            .map(|e| e.to_string());
+        assert!(
+            err.as_ref()
+                .is_some_and(|e| e.contains(flag) && e.contains(bad)),
+            "{flag} {bad}: {err:?}"
+        );
+    }
+    let without = AgentArgs::try_parse_from(base)?;
+    let err = shoal_agent::run(without, Arc::new(AtomicBool::new(false)))
+        .err()
+        .map(|e| e.to_string());
+    assert!(err.is_some_and(|e| e.contains("--mavlink-address")));
+    Ok(())
+}
+
+/// The interpreter for the pymavlink peer, if there is one.
+fn python() -> Option<String> {
+    if let Ok(p) = std::env::var("SHOAL_INTEROP_PYTHON") {
+        return Some(p);
+    }
+    let ok = Command::new("python3")
+        .args(["-c", "import pymavlink"])
+        .output();
+    ok.is_ok_and(|o| o.status.success())
+        .then(|| "python3".to_string())
+}
+
+/// Kills the peer if the test ends early.
+struct Peer(Child);
+
+impl Drop for Peer {
+    fn drop(&mut self) {
+        let _ = self.0.kill();
+        let _ = self.0.wait();
+    }
+}
+
+/// A number field of a flat JSON line (`"key": 1.5`), as the peer prints them.
+fn field(line: &str, key: &str) -> Option<f64> {
+    let rest = &line[line.find(&format!("\"{key}\": "))? + key.len() + 4..];
+    rest[..rest.find([',', '}'])?].trim().parse().ok()
+}
+
+#[test]
+fn pymavlink_as_the_vehicle_takes_the_mission_reports_arrival_and_stops() -> TestResult {
+    let Some(py) = python() else {
+        eprintln!("SKIPPED: no Python with pymavlink (set SHOAL_INTEROP_PYTHON; .ci/run does)");
+        return Ok(());
+    };
+    let port = free_port()?;
+    let script = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../tests/python/mavlink_peer.py"
+    );
+    let mut child = Command::new(&py)
+        .args([script, &port.to_string(), "--timeout", "20"])
+        .stdout(Stdio::piped())
+        .spawn()
+        .map_err(|e| format!("{py}: {e}"))?;
+    let stdout = child.stdout.take().ok_or("no stdout")?;
+    let mut peer = Peer(child);
+    let (tx, lines) = mpsc::channel();
+    std::thread::spawn(move || {
+        BufReader::new(stdout)
+            .lines()
+            .map_while(Result::ok)
+            .try_for_each(|l| tx.send(l))
+    });
+    let first = lines.recv_timeout(Duration::from_secs(15))?;
+    assert!(first.contains("listening"), "{first}");
+
+    let mut link = MavlinkLink::connect(&settings(port, 500, 5))?;
+    link.upload(&plan())?;
+    let s = wait_state(&mut link, |s| s.status == VehicleStatus::Arrived)?;
+    assert!(
+        (0..3).all(|i| (s.position[i] - [150.0, 200.0, -30.0][i]).abs() < 0.1),
+        "{s:?}"
+    );
+    assert!(
+        (s.heading_deg - 0.0).abs() < 1e-9,
+        "heading 90° from north is east: {s:?}"
+    );
+    link.stop()?;
+    assert_eq!(link.state(50.0)?.status, VehicleStatus::Stopped);
+
+    let deadline = Instant::now() + Duration::from_secs(10);
+    let status = loop {
+        match peer.0.try_wait()? {
+            Some(status) => break status,
+            None if Instant::now() > deadline => {
+                return Err("the peer did not exit after the stop".into())
+            }
+            None => std::thread::sleep(Duration::from_millis(20)),
+        }
+    };
+    let out: Vec<String> = lines.iter().collect(); // up to the end of its stdout
+    assert!(status.success(), "peer: {status}; stdout: {out:#?}");
+    let items: Vec<&String> = out.iter().filter(|l| l.contains("\"item\"")).collect();
+    let want = mission_items(&plan(), &ORIGIN, None, (1, 1));
+    assert_eq!(items.len(), want.len(), "{out:#?}");
+    for (line, w) in items.iter().zip(&want) {
+        let got = ["seq", "command", "x", "y", "z", "param2"].map(|k| field(line, k));
+        let expect = [
+            w.seq as f64,
+            w.command as u32 as f64,
+            w.x.into(),
+            w.y.into(),
+            w.z.into(),
+            w.param2.into(),
+        ];
+        assert!(
+            got.iter()
+                .zip(expect)
+                .all(|(g, e)| g.is_some_and(|g| (g - e).abs() <= 1e-6 * e.abs().max(1.0))),
+            "{line} vs {w:?}"
+        );
+    }
+    let commands: Vec<Option<f64>> = out
+        .iter()
+        .filter(|l| l.contains("\"command\", "))
+        .map(|l| field(l, "command"))
+        .collect();
+    let (start, pause) = (
+        MavCmd::MAV_CMD_MISSION_START as u32 as f64,
+        MavCmd::MAV_CMD_DO_PAUSE_CONTINUE as u32 as f64,
+    );
+    assert_eq!(commands, [Some(start), Some(pause)], "{out:#?}");
+    Ok(())
+}
