@@ -5,6 +5,7 @@
 
 mod common;
 
+use std::path::Path;
 use std::process::Command;
 use std::time::{Duration, Instant};
 
@@ -26,11 +27,9 @@ fn num(v: &Value, path: &str) -> f64 {
     }
 }
 
-#[test]
-fn a_fleet_executes_its_plan_replans_around_a_new_obstacle_and_replays() -> TestResult {
-    let mut fleet = Fleet::new();
-    let out = fleet.dir().join("out");
-    let port = free_port();
+/// `shoal-coordinator run scenarios/amp-pso-2.toml`, planned in process with 40 iterations, at
+/// `time_scale` × real time, writing into `out`, with `extra` flags.
+fn run_scenario_2(out: &Path, time_scale: &str, extra: &[&str]) -> Command {
     let mut cmd = Command::new(coordinator());
     without_shoal_env(&mut cmd);
     cmd.current_dir(root())
@@ -40,14 +39,38 @@ fn a_fleet_executes_its_plan_replans_around_a_new_obstacle_and_replays() -> Test
             "--in-process",
             "--iterations",
             "40",
-            "--time-scale",
-            "50",
             "-q",
+            "--time-scale",
+            time_scale,
         ])
-        .args(["--inject-obstacle", "1150:auv2,40"])
-        .args(["--listen", &format!("tcp/127.0.0.1:{port}")])
+        .args(extra)
         .arg("--out")
-        .arg(&out);
+        .arg(out);
+    cmd
+}
+
+/// `<out>/execution.json`.
+fn execution_report(out: &Path) -> Result<Value, Box<dyn std::error::Error>> {
+    Ok(serde_json::from_str(&std::fs::read_to_string(
+        out.join("execution.json"),
+    )?)?)
+}
+
+#[test]
+fn a_fleet_executes_its_plan_replans_around_a_new_obstacle_and_replays() -> TestResult {
+    let mut fleet = Fleet::new();
+    let out = fleet.dir().join("out");
+    let port = free_port();
+    let cmd = run_scenario_2(
+        &out,
+        "50",
+        &[
+            "--inject-obstacle",
+            "1150:auv2,40",
+            "--listen",
+            &format!("tcp/127.0.0.1:{port}"),
+        ],
+    );
     let c = fleet.spawn("coordinator", cmd);
     fleet.wait_for_stderr(c, "executing mission", Instant::now() + LIMIT);
     std::thread::sleep(Duration::from_secs(4));
@@ -68,8 +91,7 @@ fn a_fleet_executes_its_plan_replans_around_a_new_obstacle_and_replays() -> Test
     }
     let r = fleet.wait(c, Instant::now() + LIMIT);
     assert_eq!(r.code(), Some(0), "{}\n{}", r.stdout, r.stderr);
-    let report: Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("execution.json"))?)?;
+    let report = execution_report(&out)?;
     let f = &report["figures"];
     assert!(num(f, "min_separation_m") >= 50.0, "{f}");
     assert_eq!(f["all_arrived_in_window"], Value::Bool(true), "{f}");
@@ -129,23 +151,18 @@ fn a_vehicle_that_stops_reporting_is_declared_lost_and_the_rest_arrive() -> Test
     let mut fleet = Fleet::new();
     let out = fleet.dir().join("out");
     let port = free_port();
-    let mut cmd = Command::new(coordinator());
-    without_shoal_env(&mut cmd);
-    cmd.current_dir(root())
-        .arg("run")
-        .arg(scenario("amp-pso-2"))
-        .args([
-            "--in-process",
-            "--iterations",
-            "40",
-            "--time-scale",
-            "100",
-            "-q",
-        ])
-        .args(["--agents", "external", "--lost-after", "2"])
-        .args(["--listen", &format!("tcp/127.0.0.1:{port}")])
-        .arg("--out")
-        .arg(&out);
+    let cmd = run_scenario_2(
+        &out,
+        "100",
+        &[
+            "--agents",
+            "external",
+            "--lost-after",
+            "2",
+            "--listen",
+            &format!("tcp/127.0.0.1:{port}"),
+        ],
+    );
     let c = fleet.spawn("coordinator", cmd);
     let agents: Vec<_> = ["auv1", "auv2", "auv3"]
         .iter()
@@ -158,8 +175,7 @@ fn a_vehicle_that_stops_reporting_is_declared_lost_and_the_rest_arrive() -> Test
     let r = fleet.wait(c, Instant::now() + LIMIT);
     // auv3 never arrives: the execution is reported as not met (exit 3), with everything else.
     assert_eq!(r.code(), Some(3), "{}\n{}", r.stdout, r.stderr);
-    let report: Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("execution.json"))?)?;
+    let report = execution_report(&out)?;
     let f = &report["figures"];
     assert_eq!(f["vehicles"][2]["lost"], Value::Bool(true), "{f}");
     assert_eq!(f["vehicles"][2]["arrived_s"], Value::Null, "{f}");
@@ -182,28 +198,12 @@ fn a_vehicle_that_stops_reporting_is_declared_lost_and_the_rest_arrive() -> Test
 fn a_vehicle_with_no_safe_replan_is_told_to_hold() -> TestResult {
     let mut fleet = Fleet::new();
     let out = fleet.dir().join("out");
-    let mut cmd = Command::new(coordinator());
-    without_shoal_env(&mut cmd);
     // An obstacle on auv2's goal (1900, 1900, 500): no path can end there safely.
-    cmd.current_dir(root())
-        .arg("run")
-        .arg(scenario("amp-pso-2"))
-        .args([
-            "--in-process",
-            "--iterations",
-            "40",
-            "--time-scale",
-            "100",
-            "-q",
-        ])
-        .args(["--inject-obstacle", "1000:1900,1900,500,30"])
-        .arg("--out")
-        .arg(&out);
+    let cmd = run_scenario_2(&out, "100", &["--inject-obstacle", "1000:1900,1900,500,30"]);
     let c = fleet.spawn("coordinator", cmd);
     let r = fleet.wait(c, Instant::now() + LIMIT);
     assert_eq!(r.code(), Some(3), "{}\n{}", r.stdout, r.stderr);
-    let report: Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("execution.json"))?)?;
+    let report = execution_report(&out)?;
     assert!(num(&report, "holds") >= 1.0, "{report}");
     let f = &report["figures"];
     assert_eq!(f["vehicles"][1]["arrived_s"], Value::Null, "{f}");
