@@ -134,6 +134,17 @@ pub struct Trajectory {
 }
 
 impl Trajectory {
+    /// From `[t_s, x_m, y_m, z_m]` samples, the form `plan.json` and the wire use.
+    pub fn from_samples(samples: &[[f64; 4]]) -> Trajectory {
+        Trajectory {
+            times: samples.iter().map(|s| s[0]).collect(),
+            points: samples
+                .iter()
+                .map(|s| Vec3::new(s[1], s[2], s[3]))
+                .collect(),
+        }
+    }
+
     /// Time of the last sample: the arrival at the goal, seconds.
     pub fn arrival(&self) -> f64 {
         self.times.last().copied().unwrap_or(0.0)

@@ -42,16 +42,6 @@ pub struct Replayed {
     pub tracks: Vec<Trajectory>,
 }
 
-fn samples(s: &[[f64; 4]]) -> Trajectory {
-    Trajectory {
-        times: s.iter().map(|v| v[0]).collect(),
-        points: s
-            .iter()
-            .map(|v| shoal_common::geometry::Vec3::new(v[1], v[2], v[3]))
-            .collect(),
-    }
-}
-
 /// Replays the log at `path`.
 pub fn replay(path: &Path) -> anyhow::Result<Replayed> {
     let records = log::read(path)?;
@@ -75,7 +65,7 @@ pub fn replay(path: &Path) -> anyhow::Result<Replayed> {
                 .trajectories
                 .iter()
                 .find(|(v, _)| v == id)
-                .map(|(_, s)| samples(s))
+                .map(|(_, s)| Trajectory::from_samples(s))
                 .ok_or_else(|| {
                     anyhow::anyhow!("{}: the plan has no trajectory for {id}", path.display())
                 })
@@ -90,7 +80,7 @@ pub fn replay(path: &Path) -> anyhow::Result<Replayed> {
                 for (id, s) in &p.trajectories {
                     if let Some(i) = fleet.index(id) {
                         if p.changed.contains(id) {
-                            fleet.vehicles[i].plan = samples(s);
+                            fleet.vehicles[i].plan = Trajectory::from_samples(s);
                             fleet.vehicles[i].revision = p.revision;
                         }
                     }

@@ -188,13 +188,7 @@ pub fn run_command(args: &RunArgs, shutdown: Arc<AtomicBool>) -> anyhow::Result<
                                 )
                             })?;
                         let tr = &plan.vehicles[i].trajectory;
-                        let traj = shoal_common::trajectory::Trajectory {
-                            times: tr.iter().map(|s| s[0]).collect(),
-                            points: tr
-                                .iter()
-                                .map(|s| shoal_common::geometry::Vec3::new(s[1], s[2], s[3]))
-                                .collect(),
-                        };
+                        let traj = shoal_common::trajectory::Trajectory::from_samples(tr);
                         let c = traj.position_at(t + AHEAD_S);
                         [c.x, c.y, c.z]
                     }

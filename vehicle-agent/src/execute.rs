@@ -6,9 +6,9 @@
 use std::path::Path;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::{Receiver, RecvTimeoutError};
-use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
+use std::time::{Duration, Instant};
 
-use shoal_common::execution::VehicleStatus;
+use shoal_common::execution::{unix_us, MissionClock, VehicleStatus};
 use shoal_common::scenario::Scenario;
 use shoal_common::trajectory::Trajectory;
 use shoal_common::wire::coordinator_to_agent::CoordinatorToAgent;
@@ -37,45 +37,6 @@ pub struct Order {
     pub period: Duration,
     /// Noise seed of a simulated vehicle.
     pub seed: u64,
-}
-
-/// Mission time from the wall clock: `(unix_now − epoch) × scale`, never negative.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct MissionClock {
-    /// Unix time of mission time 0, milliseconds.
-    pub epoch_unix_ms: u64,
-    /// Mission seconds per wall second.
-    pub scale: f64,
-}
-
-impl MissionClock {
-    /// Mission time now, seconds.
-    pub fn now(&self) -> f64 {
-        let wall = unix_us() as f64 / 1e6 - self.epoch_unix_ms as f64 / 1e3;
-        (wall * self.scale).max(0.0)
-    }
-}
-
-/// Unix time now, microseconds.
-pub fn unix_us() -> u64 {
-    SystemTime::now()
-        .duration_since(UNIX_EPOCH)
-        .map_or(0, |d| d.as_micros() as u64)
-}
-
-/// Reads a trajectory from the wire, or why it is unusable.
-fn trajectory(t: &WireTrajectory) -> Result<Trajectory, String> {
-    let ok = !t.samples.is_empty()
-        && t.samples.iter().flatten().all(|v| v.is_finite())
-        && t.samples.windows(2).all(|w| w[1][0] >= w[0][0]);
-    if ok {
-        Ok(t.to_trajectory())
-    } else {
-        Err(format!(
-            "trajectory of {} is empty, not finite or not timed in order",
-            t.vehicle
-        ))
-    }
 }
 
 impl Order {
@@ -112,7 +73,7 @@ impl Order {
             vehicle: vehicle.to_string(),
             index,
             scenario,
-            plan: trajectory(wire)?,
+            plan: wire.checked()?,
             clock: MissionClock {
                 epoch_unix_ms,
                 scale: time_scale,
@@ -195,7 +156,7 @@ pub fn run(
                         revision: r,
                         trajectory: t,
                         ..
-                    } if r > revision => match trajectory(&t) {
+                    } if r > revision => match t.checked() {
                         Ok(plan) => match link.upload(&plan) {
                             Ok(()) => {
                                 revision = r;

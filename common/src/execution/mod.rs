@@ -10,6 +10,37 @@ pub mod sim;
 
 use serde::{Deserialize, Serialize};
 
+/// Unix time now, microseconds: the clock telemetry is stamped with (agent send, coordinator
+/// receipt) and the mission clock's epoch is on.
+pub fn unix_us() -> u64 {
+    std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0, |d| d.as_micros() as u64)
+}
+
+/// The fleet's one mission clock: mission time = `(unix_now − epoch) × scale`, never negative.
+/// The coordinator and every agent read the same epoch, so they share it (agents on other
+/// machines need synchronised clocks, e.g. NTP).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MissionClock {
+    /// Unix time of mission time 0, milliseconds.
+    pub epoch_unix_ms: u64,
+    /// Mission seconds per wall second.
+    pub scale: f64,
+}
+
+impl MissionClock {
+    /// Mission time now, seconds.
+    pub fn now(&self) -> f64 {
+        (self.since_epoch().as_secs_f64() * self.scale).max(0.0)
+    }
+
+    /// Wall time since mission time 0 (zero before it).
+    pub fn since_epoch(&self) -> std::time::Duration {
+        std::time::Duration::from_micros(unix_us().saturating_sub(self.epoch_unix_ms * 1000))
+    }
+}
+
 /// What a vehicle is doing, as its link reports it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]

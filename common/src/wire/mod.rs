@@ -112,15 +112,7 @@ impl WireContext {
                     t.vehicle
                 ));
             }
-            let ok = !t.samples.is_empty()
-                && t.samples.iter().flatten().all(|v| v.is_finite())
-                && t.samples.windows(2).all(|w| w[1][0] >= w[0][0]);
-            if !ok {
-                return Err(format!(
-                    "trajectory of {id} is empty, not finite or not timed in order"
-                ));
-            }
-            trajectories.push(t.to_trajectory());
+            trajectories.push(t.checked()?);
         }
         if !self.arrival_s.is_finite() {
             return Err(format!("arrival time {} is not finite", self.arrival_s));
@@ -158,13 +150,21 @@ impl WireTrajectory {
 
     /// Back to a trajectory.
     pub fn to_trajectory(&self) -> Trajectory {
-        Trajectory {
-            times: self.samples.iter().map(|s| s[0]).collect(),
-            points: self
-                .samples
-                .iter()
-                .map(|s| crate::geometry::Vec3::new(s[1], s[2], s[3]))
-                .collect(),
+        Trajectory::from_samples(&self.samples)
+    }
+
+    /// Back to a trajectory, or why it is unusable (empty, not finite, not timed in order).
+    pub fn checked(&self) -> Result<Trajectory, String> {
+        let ok = !self.samples.is_empty()
+            && self.samples.iter().flatten().all(|v| v.is_finite())
+            && self.samples.windows(2).all(|w| w[1][0] >= w[0][0]);
+        if ok {
+            Ok(self.to_trajectory())
+        } else {
+            Err(format!(
+                "trajectory of {} is empty, not finite or not timed in order",
+                self.vehicle
+            ))
         }
     }
 }

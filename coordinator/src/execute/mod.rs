@@ -13,9 +13,9 @@ pub mod replan;
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::{self, Receiver, RecvTimeoutError};
-use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
+use std::time::{Duration, Instant};
 
-use shoal_common::geometry::Vec3;
+use shoal_common::execution::{unix_us, MissionClock};
 use shoal_common::plan::Plan;
 use shoal_common::scenario::{Obstacle, Scenario};
 use shoal_common::trajectory::Trajectory;
@@ -65,25 +65,11 @@ enum Open {
     Obstacle(Vec<u8>),
 }
 
-/// Unix time now, microseconds.
-fn unix_us() -> u64 {
-    SystemTime::now()
-        .duration_since(UNIX_EPOCH)
-        .map_or(0, |d| d.as_micros() as u64)
-}
-
 /// The plan's trajectories, scenario order.
 fn plan_trajectories(plan: &Plan) -> Vec<Trajectory> {
     plan.vehicles
         .iter()
-        .map(|v| Trajectory {
-            times: v.trajectory.iter().map(|s| s[0]).collect(),
-            points: v
-                .trajectory
-                .iter()
-                .map(|s| Vec3::new(s[1], s[2], s[3]))
-                .collect(),
-        })
+        .map(|v| Trajectory::from_samples(&v.trajectory))
         .collect()
 }
 
@@ -95,14 +81,11 @@ pub(crate) struct Exec<'a> {
     fleet: Fleet,
     session: Session,
     log: LogWriter,
-    epoch_unix_ms: u64,
+    mission_clock: MissionClock,
     common_arrival_s: f64,
     revision: u32,
-    events: u64,
     replans: u64,
     holds: u64,
-    /// Obstacles published during the execution, and when they came (wall).
-    new_obstacles: Vec<(Obstacle, Instant)>,
     /// Per vehicle: when it was last replanned or held (wall), for a cool-down.
     last_reaction: Vec<Option<Instant>>,
     /// Per vehicle: failed replans since it was told to hold (each retry doubles the budget).
@@ -137,13 +120,7 @@ pub struct ExecutionReport {
 
 impl Exec<'_> {
     fn clock(&self) -> f64 {
-        let wall = unix_us() as f64 / 1e6 - self.epoch_unix_ms as f64 / 1e3;
-        (wall * self.options.time_scale).max(0.0)
-    }
-
-    /// Wall time since mission time 0 (zero before it).
-    fn clock_wall_since_epoch(&self) -> Duration {
-        Duration::from_micros(unix_us().saturating_sub(self.epoch_unix_ms * 1000))
+        self.mission_clock.now()
     }
 
     fn put_json<T: serde::Serialize>(&self, key: &str, payload: &T) {
@@ -172,7 +149,6 @@ impl Exec<'_> {
             self.put_json(&key, &e);
         }
         self.log.write(&Record::Event(e));
-        self.events += 1;
     }
 
     /// Publishes and logs the current plan; `changed` names the vehicles this revision moved.
@@ -286,13 +262,14 @@ pub fn execute_trajectories(
         fleet: Fleet::new(&ids, plans, scenario.fleet.d_min_m, options.horizon_s),
         session,
         log,
-        epoch_unix_ms,
+        mission_clock: MissionClock {
+            epoch_unix_ms,
+            scale: options.time_scale,
+        },
         common_arrival_s,
         revision: 0,
-        events: 0,
         replans: 0,
         holds: 0,
-        new_obstacles: Vec::new(),
         last_reaction: vec![None; ids.len()],
         hold_retries: vec![0; ids.len()],
         pending: vec![None; ids.len()],
@@ -376,7 +353,7 @@ fn run_loop(
                             vehicle: v.id.clone(),
                             scenario_toml: scenario_toml.to_string(),
                             trajectory: WireTrajectory::new(&v.id, &plans[i]),
-                            epoch_unix_ms: x.epoch_unix_ms,
+                            epoch_unix_ms: x.mission_clock.epoch_unix_ms,
                             time_scale: o.time_scale,
                             telemetry_hz: o.telemetry_hz,
                             seed: o.seed.wrapping_add(i as u64),

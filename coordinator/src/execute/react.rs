@@ -164,7 +164,6 @@ fn obstacle(x: &mut Exec, o: Obstacle, received: Instant) {
     );
     x.log.write(&Record::Obstacle(o.clone()));
     x.scenario.obstacles.push(o.clone());
-    x.new_obstacles.push((o, received));
     for i in blocked {
         if replan_vehicle(x, i, "a new obstacle blocks its path") {
             x.decisions_ms
@@ -219,7 +218,9 @@ pub(super) fn check(x: &mut Exec, now: f64) {
         let silent = match v.heard {
             Some(h) => h.elapsed() > o.lost_after,
             // Never heard: lost once the mission has run for a while without it.
-            None => now > 0.0 && x.clock_wall_since_epoch() > o.lost_after + Duration::from_secs(5),
+            None => {
+                now > 0.0 && x.mission_clock.since_epoch() > o.lost_after + Duration::from_secs(5)
+            }
         };
         if silent {
             let id = v.id.clone();
