@@ -186,6 +186,33 @@ pub fn turn_penalty(points: &[Vec3], max_turn: f64) -> f64 {
     p
 }
 
+/// The turn penalty of entering `points` from a vehicle already moving along `heading` (its
+/// horizontal part counts): the [`turn_penalty`] of the heading change from `heading` to the
+/// path's first leg with a horizontal extent. A replan that starts under way uses it, so the
+/// new path leaves the vehicle's present course within the same per-waypoint limit as every
+/// other turn (seed 004's turn constraint, applied at the start too). A heading with no
+/// horizontal part, or a path without a horizontal leg, adds nothing.
+pub fn entry_turn_penalty(heading: Vec3, points: &[Vec3], max_turn: f64) -> f64 {
+    let Some(first) = points.first() else {
+        return 0.0;
+    };
+    let h = Vec3::new(heading.x, heading.y, 0.0);
+    if h.norm() <= MIN_HEADING_EXTENT {
+        return 0.0;
+    }
+    let Some(k) = points
+        .iter()
+        .position(|p| (p.x - first.x).hypot(p.y - first.y) > MIN_HEADING_EXTENT)
+    else {
+        return 0.0;
+    };
+    let behind = first - h / h.norm();
+    let mut entry = Vec::with_capacity(k + 2);
+    entry.push(behind);
+    entry.extend_from_slice(&points[..=k]);
+    turn_penalty(&entry, max_turn)
+}
+
 /// Pitch penalty: for every leg whose |pitch| exceeds `max_pitch` (radians),
 /// `1 + excess / max_pitch`. The slope is compared first so only violations pay for `atan2`.
 pub fn pitch_penalty(points: &[Vec3], max_pitch: f64) -> f64 {

@@ -14,7 +14,8 @@
 
 use rand::rngs::StdRng;
 
-use crate::cost::{separation_penalty, space_term, FleetModel, VehicleTerms};
+use crate::cost::{entry_turn_penalty, separation_penalty, space_term, FleetModel, VehicleTerms};
+use crate::geometry::Vec3;
 use crate::separation::{motion_separation, Motion};
 use crate::swarm::Problem;
 use crate::trajectory::{retime_legs, Trajectory};
@@ -34,6 +35,9 @@ pub struct VehicleProblem<'a> {
     lower: Vec<f64>,
     /// Upper gene bounds.
     upper: Vec<f64>,
+    /// The course the vehicle is on at its start, when it starts under way (a replan): the
+    /// turn onto the first leg is then limited like every other turn.
+    heading_in: Option<Vec3>,
 }
 
 /// Everything one evaluation found.
@@ -71,7 +75,14 @@ impl<'a> VehicleProblem<'a> {
             arrival,
             lower: model.lower[range.clone()].to_vec(),
             upper: model.upper[range].to_vec(),
+            heading_in: None,
         }
+    }
+
+    /// The vehicle starts under way along `heading` (see [`entry_turn_penalty`]).
+    pub fn entering_along(mut self, heading: Vec3) -> Self {
+        self.heading_in = Some(heading);
+        self
     }
 
     /// Decodes and scores one chromosome.
@@ -82,6 +93,9 @@ impl<'a> VehicleProblem<'a> {
         let legs = path.leg_lengths();
         let length: f64 = legs.iter().sum();
         let mut terms = self.model.vehicle_terms(self.vehicle, &path, length);
+        if let Some(h) = self.heading_in {
+            terms.motion += entry_turn_penalty(h, &path.points, v.max_turn_deg.to_radians());
+        }
         let target = self.arrival.max(length / v.speed_max_mps);
         let trajectory = retime_legs(path, &legs, v, target);
         let mine = Motion::new(&trajectory);
@@ -226,6 +240,29 @@ mod tests {
             e.total,
             fleet.total
         );
+        Ok(())
+    }
+
+    #[test]
+    fn a_vehicle_under_way_pays_for_turning_onto_its_first_leg(
+    ) -> Result<(), Box<dyn std::error::Error>> {
+        let mut s = scenario()?;
+        s.vehicles.truncate(1);
+        let model = FleetModel::new(&s);
+        let x = &straight_particle(&model)[..24];
+        let p = VehicleProblem::new(&model, 0, &[], s.fleet.mission_time_s);
+        let base = p.evaluate(x);
+        // a's first leg runs east. Moving north-east (45°) it pays 1 + 10/35 in the motion
+        // penalty; moving east, nothing.
+        let ne = p
+            .clone()
+            .entering_along(Vec3::new(1.0, 1.0, 0.0))
+            .evaluate(x);
+        assert!((ne.terms.motion - base.terms.motion - (1.0 + 10.0 / 35.0)).abs() < 1e-9);
+        let weight = s.optimizer.penalty_weight;
+        assert!((ne.total - base.total - weight * (1.0 + 10.0 / 35.0)).abs() < 1e-6);
+        let east = p.entering_along(Vec3::new(3.0, 0.0, 0.0)).evaluate(x);
+        assert_eq!(east.terms.motion, base.terms.motion);
         Ok(())
     }
 }

@@ -2,20 +2,18 @@
 //! the agents are `shoal_agent::run` on threads, the coordinator `plan_distributed` in external
 //! mode. Every wait is bounded.
 
+mod common;
+
 use std::path::PathBuf;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::AtomicBool;
 use std::sync::mpsc;
-use std::sync::Arc;
-use std::thread::JoinHandle;
 use std::time::Duration;
 
-use shoal_agent::AgentArgs;
+use common::{agent, finish, free_endpoint, Agent, TestResult};
 use shoal_common::distributed::lockstep;
 use shoal_common::plan::Plan;
 use shoal_common::scenario::Scenario;
 use shoal_coordinator::distributed::{plan_distributed, AgentsMode, DistributedOptions};
-
-type TestResult = Result<(), Box<dyn std::error::Error>>;
 
 /// Longest any test waits for a plan.
 const LIMIT: Duration = Duration::from_secs(90);
@@ -34,11 +32,6 @@ fn scenario() -> Result<Scenario, Box<dyn std::error::Error>> {
     Ok(s)
 }
 
-fn free_endpoint() -> std::io::Result<String> {
-    let l = std::net::TcpListener::bind("127.0.0.1:0")?;
-    Ok(format!("tcp/127.0.0.1:{}", l.local_addr()?.port()))
-}
-
 fn options(mission: &str, endpoint: &str, join_s: u64) -> DistributedOptions {
     DistributedOptions {
         mission: mission.into(),
@@ -51,35 +44,6 @@ fn options(mission: &str, endpoint: &str, join_s: u64) -> DistributedOptions {
         log_dir: std::env::temp_dir(),
         health_file: None,
         agent_args: Vec::new(),
-    }
-}
-
-/// An agent on a thread, with its own stop flag.
-struct Agent {
-    stop: Arc<AtomicBool>,
-    handle: JoinHandle<anyhow::Result<()>>,
-}
-
-fn agent(vehicle: &str, endpoint: &str) -> Agent {
-    let stop = Arc::new(AtomicBool::new(false));
-    let args = AgentArgs {
-        vehicle: vehicle.into(),
-        connect: vec![endpoint.into()],
-        once: true,
-        threads: 1,
-        idle_timeout: 10.0,
-        health_file: None,
-        health_check: false,
-        link: shoal_agent::link::LinkKind::Sim,
-        position_noise: 1.0,
-        mavlink_address: None,
-        mavlink_origin: None,
-        mavlink_target: None,
-    };
-    let flag = Arc::clone(&stop);
-    Agent {
-        stop,
-        handle: std::thread::spawn(move || shoal_agent::run(args, flag)),
     }
 }
 
@@ -107,17 +71,6 @@ fn coordinate(
     });
     rx.recv_timeout(LIMIT)
         .map_err(|_| format!("no plan within {LIMIT:?}"))
-}
-
-fn finish(agents: Vec<Agent>) -> TestResult {
-    for a in agents {
-        a.stop.store(true, Ordering::Relaxed);
-        match a.handle.join() {
-            Ok(r) => r?,
-            Err(_) => return Err("an agent thread panicked".into()),
-        }
-    }
-    Ok(())
 }
 
 #[test]

@@ -106,6 +106,35 @@ fn hard_penalty_guards_a_leg_that_grazes_the_inflated_sphere() {
 }
 
 #[test]
+fn entering_a_path_against_the_heading_costs_its_turn() {
+    let max = 35f64.to_radians();
+    // Heading east; the first leg goes north-east: 45°, 1 + 10/35. The first leg is short but
+    // horizontal, so it is the one that counts, not the later ones.
+    let pts = [v(0., 0., 0.), v(1., 1., 0.), v(1., 2., 0.)];
+    assert_abs_diff_eq!(
+        entry_turn_penalty(v(2., 0., 0.), &pts, max),
+        1.0 + 10.0 / 35.0,
+        epsilon = 1e-9
+    );
+    // A vertical first leg is skipped: the next leg, due west, is a 180° turn, 1 + 145/35.
+    let pts = [v(0., 0., 0.), v(0., 0., 5.), v(-3., 0., 5.)];
+    assert_abs_diff_eq!(
+        entry_turn_penalty(v(1., 0., 0.), &pts, max),
+        1.0 + 145.0 / 35.0,
+        epsilon = 1e-9
+    );
+    // Within 35°, or with a heading that has no horizontal part (climbing straight up), or a
+    // path with no horizontal leg: nothing.
+    let c = 30f64.to_radians();
+    let pts = [v(0., 0., 0.), v(c.cos(), c.sin(), 0.)];
+    assert_abs_diff_eq!(entry_turn_penalty(v(1., 0., 0.), &pts, max), 0.0);
+    assert_abs_diff_eq!(entry_turn_penalty(v(0., 0., 1.), &pts, max), 0.0);
+    let pts = [v(0., 0., 0.), v(0., 0., 9.)];
+    assert_abs_diff_eq!(entry_turn_penalty(v(1., 0., 0.), &pts, max), 0.0);
+    assert_abs_diff_eq!(entry_turn_penalty(v(1., 0., 0.), &[], max), 0.0);
+}
+
+#[test]
 fn turn_and_pitch_penalties_by_hand() {
     let max = 35f64.to_radians();
     // A 45° turn exceeds 35° by 10°: 1 + 10/35. A 30° turn is free.

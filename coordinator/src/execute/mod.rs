@@ -5,6 +5,7 @@
 //! vehicle that stops reporting or a new obstacle makes it replan the affected vehicles
 //! ([`replan`]) or, when no safe replan comes in time, command a hold.
 
+mod detour;
 pub mod fleet;
 pub mod log;
 mod react;

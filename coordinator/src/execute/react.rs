@@ -301,6 +301,9 @@ pub(super) fn replan_vehicle(x: &mut Exec, i: usize, why: &str) -> bool {
     let remaining = (x.common_arrival_s + o.arrival_window_s - now).max(o.horizon_s);
     let predictions = x.fleet.predictions_over(now, remaining);
     let p0 = predictions[i].position_at(t0);
+    // The course there: where the prediction was heading over the last few seconds before.
+    let heading = Some(p0 - predictions[i].position_at((t0 - 5.0).max(now)))
+        .filter(|d| d.x.hypot(d.y) > 1e-3 && !x.fleet.vehicles[i].holding);
     // A retry must not repeat the swarm that just failed.
     let seed =
         o.seed ^ (u64::from(x.revision) << 8) ^ (u64::from(x.hold_retries[i]) << 32) ^ i as u64;
@@ -309,6 +312,7 @@ pub(super) fn replan_vehicle(x: &mut Exec, i: usize, why: &str) -> bool {
         vehicle: i,
         t0,
         p0,
+        heading,
         current: &x.fleet.vehicles[i].plan,
         others: &predictions,
         arrival_s: x.common_arrival_s,

@@ -6,8 +6,14 @@
 //! It is the follower problem of distributed AMP-PSO ([`VehicleProblem`], seed 004 eq. (9)–(12)
 //! restricted to one vehicle) solved by A-PSO (seed 004 eq. (7) parameters) under a wall-time
 //! budget, warm-started: the first particle is the current plan's remainder resampled onto the
-//! M waypoints, a few more are jittered copies of it, the rest are sampled as usual. The warm
-//! particle alone is already the answer when the change does not touch the vehicle's path.
+//! M waypoints (pushed out of new obstacles), the second a coarse way round the hard obstacles
+//! ([`super::detour`]) when there is one, a few more are jittered copies of these, the rest are
+//! sampled as usual. The first particle alone is already the answer when the change does not
+//! touch the vehicle's path.
+//!
+//! A vehicle under way cannot turn on the spot: the new path's first turn, from the course the
+//! vehicle is on to the first leg, is held to the same limit as every other turn
+//! ([`VehicleProblem::entering_along`]).
 
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::{Duration, Instant};
@@ -40,6 +46,8 @@ pub struct Request<'a> {
     pub t0: f64,
     /// Where the vehicle will be then.
     pub p0: Vec3,
+    /// The course it will be on then (`None`: stopped, e.g. holding).
+    pub heading: Option<Vec3>,
     /// The trajectory it follows now (mission-timed).
     pub current: &'a Trajectory,
     /// Every vehicle's predicted trajectory, mission-timed (this vehicle's is ignored).
@@ -120,6 +128,24 @@ pub fn warm_chromosome(
     genes
 }
 
+/// The polyline `points` flown from mission time `t0` at the one speed that takes `duration`.
+fn at_even_speed(points: &[Vec3], t0: f64, duration: f64) -> Trajectory {
+    let length: f64 = points.windows(2).map(|w| (w[1] - w[0]).norm()).sum();
+    let speed = (length / duration.max(1e-9)).max(1e-9);
+    let mut t = t0;
+    let mut times = Vec::with_capacity(points.len());
+    for (k, p) in points.iter().enumerate() {
+        if k > 0 {
+            t += (p - points[k - 1]).norm() / speed;
+        }
+        times.push(t);
+    }
+    Trajectory {
+        times,
+        points: points.to_vec(),
+    }
+}
+
 /// Moves every waypoint of `genes` (M waypoints, coordinates first) closer than
 /// [`PUSH_OUT`] × a hard obstacle's inflated radius to its centre sideways — perpendicular to
 /// the path there, horizontally when the path runs through the centre — to that distance: the
@@ -154,10 +180,10 @@ pub fn push_out_of_obstacles(genes: &mut [f64], scenario: &Scenario, m: usize) {
     }
 }
 
-/// A problem whose first samples are a warm start.
+/// A problem whose first samples are warm starts, then jittered copies of them.
 struct WarmStart<'a> {
     inner: &'a VehicleProblem<'a>,
-    warm: Vec<f64>,
+    warm: Vec<Vec<f64>>,
     drawn: AtomicUsize,
 }
 
@@ -183,10 +209,11 @@ impl Problem for WarmStart<'_> {
                 .map(|(d, v)| v.clamp(lo[d], hi[d]))
                 .collect()
         };
+        let n = self.warm.len();
         match k {
-            0 => clamp(self.warm.clone()),
-            k if k <= WARM_COPIES => clamp(
-                self.warm
+            k if k < n => clamp(self.warm[k].clone()),
+            k if k < n + WARM_COPIES => clamp(
+                self.warm[k % n]
                     .iter()
                     .enumerate()
                     .map(|(d, v)| v + 0.03 * (hi[d] - lo[d]) * rng.random_range(-1.0..=1.0))
@@ -205,16 +232,23 @@ pub fn replan(r: &Request) -> Replanned {
     let model = FleetModel::new(&scenario);
     let context: Vec<Trajectory> = r.others.iter().map(|t| rebase(t, r.t0)).collect();
     let arrival = (r.arrival_s - r.t0).max(1.0);
-    let problem = VehicleProblem::new(&model, r.vehicle, &context, arrival);
+    let mut problem = VehicleProblem::new(&model, r.vehicle, &context, arrival);
+    if let Some(h) = r.heading {
+        problem = problem.entering_along(h);
+    }
     let v = &scenario.vehicles[r.vehicle];
-    let mut warm = warm_chromosome(
-        r.current,
-        r.t0,
-        r.p0,
-        scenario.optimizer.waypoints,
-        (v.speed_min_mps, v.speed_max_mps),
-    );
-    push_out_of_obstacles(&mut warm, &scenario, scenario.optimizer.waypoints);
+    let m = scenario.optimizer.waypoints;
+    let speeds = (v.speed_min_mps, v.speed_max_mps);
+    let mut plan = warm_chromosome(r.current, r.t0, r.p0, m, speeds);
+    push_out_of_obstacles(&mut plan, &scenario, m);
+    let mut warm = vec![plan];
+    if let Some(way) = super::detour::detour(&scenario, r.p0, v.goal()) {
+        if way.len() > 2 {
+            // Timed for the arrival; `warm_chromosome` resamples it like a plan.
+            let way = at_even_speed(&way, r.t0, arrival);
+            warm.push(warm_chromosome(&way, r.t0, r.p0, m, speeds));
+        }
+    }
     let warm_problem = WarmStart {
         inner: &problem,
         warm,

@@ -1,0 +1,290 @@
+//! A coarse way round for a replan's warm start (issue 8): when a new obstacle closes the
+//! passage the current plan used, the plan's remainder — even with its waypoints pushed out of
+//! the obstacle — leaves the swarm stuck against it, and a 300 ms swarm does not find the long
+//! way round by itself. A* on a coarse 3-D grid over the scenario's bounds finds that way; the
+//! grid path, shortened by line of sight, becomes one more warm particle, and the swarm smooths
+//! it (turn and pitch limits, timing, the other vehicles).
+//!
+//! Cells whose centre is inside a hard obstacle's inflated sphere grown by [`GROW`] are
+//! blocked; so the line-of-sight shortcuts, which test segments against the spheres grown by
+//! [`SHORTCUT_GROW`], keep a little margin that resampling onto the swarm's waypoints (chords
+//! between points of the path) then spends. Climbing costs [`CLIMB_COST`] × its height: the
+//! vehicles' pitch limit (±20° in seed 004) makes a way over or under an obstacle far longer
+//! than its grid length says, so the search prefers going round it.
+
+use std::cmp::Ordering;
+use std::collections::BinaryHeap;
+
+use shoal_common::geometry::{segment_hits_sphere, Vec3};
+use shoal_common::scenario::Scenario;
+
+/// Blocked cells: centre within this × the inflated radius of a hard obstacle.
+const GROW: f64 = 1.15;
+/// Line-of-sight shortcuts keep out of the inflated spheres grown by this.
+const SHORTCUT_GROW: f64 = 1.08;
+/// Cost per metre of height gained or lost, against 1 per horizontal metre.
+const CLIMB_COST: f64 = 3.0;
+/// Cells along the longest side of the bounds.
+const CELLS: f64 = 40.0;
+
+/// An open-list entry: estimated total cost and cell index.
+#[derive(PartialEq)]
+struct Open(f64, usize);
+
+impl Eq for Open {}
+
+impl PartialOrd for Open {
+    fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
+        Some(self.cmp(other))
+    }
+}
+
+impl Ord for Open {
+    /// Smallest estimate first out of the max-heap.
+    fn cmp(&self, other: &Self) -> Ordering {
+        other.0.total_cmp(&self.0).then(other.1.cmp(&self.1))
+    }
+}
+
+/// The grid over the scenario's bounds.
+struct Grid {
+    min: Vec3,
+    cell: f64,
+    n: [usize; 3],
+    blocked: Vec<bool>,
+}
+
+impl Grid {
+    fn new(scenario: &Scenario) -> Grid {
+        let min = Vec3::from(scenario.bounds.min);
+        let extent = Vec3::from(scenario.bounds.max) - min;
+        let cell = (extent.max() / CELLS).max(1.0);
+        let n = [0, 1, 2].map(|k| ((extent[k] / cell).floor() as usize + 1).max(1));
+        let mut g = Grid {
+            min,
+            cell,
+            n,
+            blocked: vec![false; n[0] * n[1] * n[2]],
+        };
+        for k in 0..g.blocked.len() {
+            let c = g.centre(k);
+            g.blocked[k] = scenario
+                .hard_obstacles()
+                .any(|o| (c - o.centre()).norm() < GROW * o.inflated_radius());
+        }
+        g
+    }
+
+    fn index(&self, c: [usize; 3]) -> usize {
+        (c[2] * self.n[1] + c[1]) * self.n[0] + c[0]
+    }
+
+    fn coords(&self, k: usize) -> [usize; 3] {
+        [
+            k % self.n[0],
+            (k / self.n[0]) % self.n[1],
+            k / (self.n[0] * self.n[1]),
+        ]
+    }
+
+    fn centre(&self, k: usize) -> Vec3 {
+        let c = self.coords(k);
+        self.min + Vec3::new(c[0] as f64, c[1] as f64, c[2] as f64) * self.cell
+    }
+
+    /// The nearest grid node to `p` (clamped into the grid).
+    fn nearest(&self, p: Vec3) -> usize {
+        let c = [0, 1, 2].map(|a| {
+            let f = ((p[a] - self.min[a]) / self.cell).round();
+            (f.max(0.0) as usize).min(self.n[a] - 1)
+        });
+        self.index(c)
+    }
+
+    /// The step cost between two neighbouring nodes, and the admissible estimate to the goal.
+    fn cost(a: Vec3, b: Vec3) -> f64 {
+        let d = b - a;
+        d.x.hypot(d.y) + CLIMB_COST * d.z.abs()
+    }
+
+    /// A* from `from` to `to` over free nodes (the two end nodes are allowed even if blocked:
+    /// the vehicle is where it is), as node centres.
+    fn search(&self, from: usize, to: usize) -> Option<Vec<usize>> {
+        let total = self.blocked.len();
+        let mut best = vec![f64::INFINITY; total];
+        let mut came = vec![usize::MAX; total];
+        let mut open = BinaryHeap::new();
+        let goal = self.centre(to);
+        best[from] = 0.0;
+        open.push(Open(Grid::cost(self.centre(from), goal), from));
+        while let Some(Open(_, k)) = open.pop() {
+            if k == to {
+                let mut path = vec![to];
+                let mut at = to;
+                while at != from {
+                    at = came[at];
+                    path.push(at);
+                }
+                path.reverse();
+                return Some(path);
+            }
+            let c = self.coords(k);
+            let here = self.centre(k);
+            for dz in -1i64..=1 {
+                for dy in -1i64..=1 {
+                    for dx in -1i64..=1 {
+                        if (dx, dy, dz) == (0, 0, 0) {
+                            continue;
+                        }
+                        let step = [dx, dy, dz];
+                        let next: Option<Vec<usize>> = (0..3)
+                            .map(|a| {
+                                let v = c[a] as i64 + step[a];
+                                (v >= 0 && (v as usize) < self.n[a]).then_some(v as usize)
+                            })
+                            .collect();
+                        let Some(next) = next else { continue };
+                        let j = self.index([next[0], next[1], next[2]]);
+                        if self.blocked[j] && j != to {
+                            continue;
+                        }
+                        let there = self.centre(j);
+                        let g = best[k] + Grid::cost(here, there);
+                        if g < best[j] {
+                            best[j] = g;
+                            came[j] = k;
+                            open.push(Open(g + Grid::cost(there, goal), j));
+                        }
+                    }
+                }
+            }
+        }
+        None
+    }
+}
+
+/// Whether the segment `a`–`b` stays out of every hard obstacle grown by `grow`.
+fn clear(scenario: &Scenario, a: &Vec3, b: &Vec3, grow: f64) -> bool {
+    !scenario
+        .hard_obstacles()
+        .any(|o| segment_hits_sphere(a, b, &o.centre(), grow * o.inflated_radius()))
+}
+
+/// A way from `from` to `to` round the scenario's hard obstacles (see the module doc): the
+/// corners of the shortened grid path, from `from` to `to`. `None` when the grid has no way.
+pub fn detour(scenario: &Scenario, from: Vec3, to: Vec3) -> Option<Vec<Vec3>> {
+    if clear(scenario, &from, &to, SHORTCUT_GROW) {
+        return Some(vec![from, to]);
+    }
+    let grid = Grid::new(scenario);
+    let cells = grid.search(grid.nearest(from), grid.nearest(to))?;
+    let mut raw = vec![from];
+    // The end nodes stand for `from` and `to` themselves.
+    raw.extend(
+        cells[1..cells.len().saturating_sub(1)]
+            .iter()
+            .map(|&k| grid.centre(k)),
+    );
+    raw.push(to);
+    // Line of sight: from each corner, jump to the farthest point still in view.
+    let mut out = vec![from];
+    let mut i = 0;
+    while i + 1 < raw.len() {
+        let mut j = raw.len() - 1;
+        while j > i + 1 && !clear(scenario, &raw[i], &raw[j], SHORTCUT_GROW) {
+            j -= 1;
+        }
+        out.push(raw[j]);
+        i = j;
+    }
+    Some(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use shoal_common::scenario::{Obstacle, ObstacleKind};
+
+    fn scenario(obstacles: &[([f64; 3], f64)]) -> Result<Scenario, Box<dyn std::error::Error>> {
+        let file = concat!(env!("CARGO_MANIFEST_DIR"), "/../scenarios/amp-pso-1.toml");
+        let mut s = Scenario::load(std::path::Path::new(file))?;
+        s.bounds.min = [0.0, 0.0, 0.0];
+        s.bounds.max = [2000.0, 2000.0, 400.0];
+        s.obstacles = obstacles
+            .iter()
+            .enumerate()
+            .map(|(k, (c, r))| Obstacle {
+                id: format!("o{k}"),
+                kind: ObstacleKind::Hard,
+                centre: *c,
+                radius_m: *r,
+                inflation_m: 50.0,
+            })
+            .collect();
+        Ok(s)
+    }
+
+    fn length(p: &[Vec3]) -> f64 {
+        p.windows(2).map(|w| (w[1] - w[0]).norm()).sum()
+    }
+
+    #[test]
+    fn a_clear_line_is_its_own_detour() -> Result<(), Box<dyn std::error::Error>> {
+        let s = scenario(&[([1000.0, 1500.0, 200.0], 100.0)])?;
+        let (a, b) = (
+            Vec3::new(100.0, 500.0, 200.0),
+            Vec3::new(1900.0, 500.0, 200.0),
+        );
+        assert_eq!(detour(&s, a, b), Some(vec![a, b]));
+        Ok(())
+    }
+
+    #[test]
+    fn a_wall_of_spheres_is_gone_round_by_its_open_end() -> Result<(), Box<dyn std::error::Error>> {
+        // A wall across x = 1000 from y = 0 to about y = 1450 (spheres of 150 + 50 m every
+        // 250 m), floor to surface (400 m high column, the spheres reach both): the only way
+        // from (200, 500) to (1800, 500) is round its north end, past y ≈ 1450 + 200 × 1.15.
+        let wall: Vec<([f64; 3], f64)> = (0..6)
+            .flat_map(|k| {
+                let y = 250.0 * k as f64;
+                [([1000.0, y, 100.0], 150.0), ([1000.0, y, 300.0], 150.0)]
+            })
+            .collect();
+        let s = scenario(&wall)?;
+        let (a, b) = (
+            Vec3::new(200.0, 500.0, 200.0),
+            Vec3::new(1800.0, 500.0, 200.0),
+        );
+        let path = detour(&s, a, b).ok_or("no detour")?;
+        assert_eq!(path.first(), Some(&a));
+        assert_eq!(path.last(), Some(&b));
+        for w in path.windows(2) {
+            assert!(clear(&s, &w[0], &w[1], 1.0), "{path:?}");
+        }
+        let north = path.iter().map(|p| p.y).fold(f64::MIN, f64::max);
+        assert!(north > 1423.0, "{path:?}");
+        // Round the end: at least 2 × √(800² + 923²) ≈ 2443 m (two straight lines to the
+        // wall's end); the grid and the shortcuts' margin add a little, never much.
+        let l = length(&path);
+        assert!((2443.0..2900.0).contains(&l), "{l} m: {path:?}");
+        Ok(())
+    }
+
+    #[test]
+    fn no_way_through_a_closed_wall() -> Result<(), Box<dyn std::error::Error>> {
+        // Spheres every 200 m along x = 1000, at both heights, over the whole width.
+        let wall: Vec<([f64; 3], f64)> = (0..=10)
+            .flat_map(|k| {
+                let y = 200.0 * k as f64;
+                [([1000.0, y, 100.0], 150.0), ([1000.0, y, 300.0], 150.0)]
+            })
+            .collect();
+        let s = scenario(&wall)?;
+        let (a, b) = (
+            Vec3::new(200.0, 500.0, 200.0),
+            Vec3::new(1800.0, 500.0, 200.0),
+        );
+        assert_eq!(detour(&s, a, b), None);
+        Ok(())
+    }
+}

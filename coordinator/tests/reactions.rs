@@ -1,0 +1,180 @@
+//! The execution's reactions end to end (issue 8, item 3), on hand-built trajectories the
+//! planner would never give, so each reaction is certain to be needed: two vehicles timed to
+//! meet head-on mid-mission (a predicted loss of separation), and a hairpin sharper than the
+//! simulated vehicle's turning radius (a deviation beyond the tolerance). The agents are
+//! `shoal_agent::run` on threads driving simulated vehicles; the coordinator is
+//! `execute_trajectories` on external agents over loopback Zenoh.
+
+mod common;
+
+use std::path::Path;
+use std::sync::atomic::AtomicBool;
+use std::time::Duration;
+
+use common::{agent, finish, free_endpoint, TestResult};
+use serde_json::Value;
+use shoal_common::geometry::Vec3;
+use shoal_common::scenario::Scenario;
+use shoal_common::trajectory::Trajectory;
+use shoal_coordinator::distributed::{AgentsMode, DistributedOptions};
+use shoal_coordinator::execute::{execute_trajectories, ExecOptions, ExecutionReport};
+
+/// A 2 km × 2 km × 400 m box without obstacles, d_min 50 m, AUVs of 0.5–2.5 m/s.
+fn scenario(
+    vehicles: &[(&str, [f64; 3], [f64; 3])],
+) -> Result<Scenario, Box<dyn std::error::Error>> {
+    let mut text = String::from(
+        "name = \"reactions\"\n[bounds]\nmin = [0.0, 0.0, 0.0]\nmax = [2000.0, 2000.0, 400.0]\n\
+         [fleet]\nd_min_m = 50.0\nmission_time_s = 1200.0\n[optimizer]\nwaypoints = 8\n",
+    );
+    for (id, start, goal) in vehicles {
+        text.push_str(&format!(
+            "[[vehicles]]\nid = \"{id}\"\nkind = \"auv\"\nstart = {start:?}\ngoal = {goal:?}\n\
+             speed_min_mps = 0.5\nspeed_max_mps = 2.5\nmax_turn_deg = 35.0\nmax_pitch_deg = 20.0\n"
+        ));
+    }
+    Ok(Scenario::parse(&text, Path::new("reactions.toml"))?)
+}
+
+/// Through `points` at a steady `speed` from t = 0.
+fn steady(points: &[[f64; 3]], speed: f64) -> Trajectory {
+    let points: Vec<Vec3> = points.iter().map(|p| Vec3::from(*p)).collect();
+    let mut times = vec![0.0];
+    for w in points.windows(2) {
+        times.push(times[times.len() - 1] + (w[1] - w[0]).norm() / speed);
+    }
+    Trajectory { times, points }
+}
+
+/// Executes `plans` with one agent per vehicle at 40× real time; the report and the log's
+/// events.
+fn execute(
+    s: &Scenario,
+    plans: &[Trajectory],
+    deviation_m: f64,
+    dir: &Path,
+) -> Result<(ExecutionReport, Vec<Value>), Box<dyn std::error::Error>> {
+    let endpoint = free_endpoint()?;
+    let agents: Vec<_> = s.vehicles.iter().map(|v| agent(&v.id, &endpoint)).collect();
+    let arrival = plans.iter().map(Trajectory::arrival).fold(0.0, f64::max);
+    let distributed = DistributedOptions {
+        mission: format!("reactions-{}", s.vehicles.len()),
+        agents: AgentsMode::External,
+        listen: vec![endpoint.clone()],
+        routers: Vec::new(),
+        join_timeout: Duration::from_secs(30),
+        round_timeout: Duration::from_secs(10),
+        agent_bin: None,
+        log_dir: dir.to_path_buf(),
+        health_file: None,
+        agent_args: Vec::new(),
+    };
+    let options = ExecOptions {
+        time_scale: 40.0,
+        telemetry_hz: 2.0,
+        horizon_s: 180.0,
+        deviation_m,
+        lost_after: Duration::from_secs(10),
+        // A debug build's swarm is slow; the update still leads the vehicle by
+        // (1 s + 0.25 s) × 40 = 50 mission seconds.
+        replan_budget: Duration::from_secs(1),
+        arrival_window_s: 60.0,
+        log: dir.join("mission.ndjson"),
+        inject: Vec::new(),
+        quiet: true,
+        seed: 1,
+    };
+    let stop = AtomicBool::new(false);
+    let report = execute_trajectories(s, plans, arrival, &distributed, &options, &stop)?;
+    finish(agents)?;
+    let events = std::fs::read_to_string(dir.join("mission.ndjson"))?
+        .lines()
+        .filter_map(|l| serde_json::from_str::<Value>(l).ok())
+        .filter(|r| r["record"] == "event")
+        .collect();
+    Ok((report, events))
+}
+
+/// The events of `kind` naming `vehicle`.
+fn events<'a>(all: &'a [Value], kind: &str, vehicle: &str) -> Vec<&'a Value> {
+    all.iter()
+        .filter(|e| {
+            e["kind"] == kind
+                && e["vehicles"]
+                    .as_array()
+                    .is_some_and(|v| v.iter().any(|x| x == vehicle))
+        })
+        .collect()
+}
+
+#[test]
+fn a_predicted_conflict_replans_the_later_vehicle_and_separation_holds() -> TestResult {
+    // auv1 runs east, auv2 north; at 1.5 m/s both reach (1000, 1000) at t = 600 s.
+    let s = scenario(&[
+        ("auv1", [100.0, 1000.0, 200.0], [1900.0, 1000.0, 200.0]),
+        ("auv2", [1000.0, 100.0, 200.0], [1000.0, 1900.0, 200.0]),
+    ])?;
+    let plans: Vec<Trajectory> = s
+        .vehicles
+        .iter()
+        .map(|v| steady(&[v.start, v.goal], 1.5))
+        .collect();
+    let dir = tempfile::tempdir()?;
+    let (report, log) = execute(&s, &plans, 25.0, dir.path())?;
+    let f = &report.figures;
+    let conflicts = events(&log, "conflict_predicted", "auv1");
+    assert!(!conflicts.is_empty(), "no conflict predicted: {log:?}");
+    // Seen ahead of time: the 180 s horizon sees the meeting from t ≈ 420 s.
+    let first = conflicts[0]["t_s"].as_f64().ok_or("no t_s")?;
+    assert!((380.0..600.0).contains(&first), "predicted at {first} s");
+    // The later vehicle in scenario order gives way; the first keeps its plan.
+    let replans = events(&log, "replanned", "auv2");
+    assert!(!replans.is_empty(), "auv2 not replanned: {log:?}");
+    assert!(
+        replans[0]["detail"]
+            .as_str()
+            .is_some_and(|d| d.contains("predicted separation")),
+        "{}",
+        replans[0]
+    );
+    assert!(events(&log, "replanned", "auv1").is_empty(), "{log:?}");
+    assert_eq!(f.vehicles[0].revision, 0);
+    assert!(f.vehicles[1].revision >= 1);
+    let d = f.min_separation_m.ok_or("no separation figure")?;
+    assert!(d >= 50.0, "executed separation {d} m: {f:?}");
+    assert!(f.all_arrived_in_window, "{f:?}");
+    assert_eq!(report.holds, 0);
+    Ok(())
+}
+
+#[test]
+fn a_hairpin_the_vehicle_cannot_fly_is_a_deviation_and_is_replanned() -> TestResult {
+    // East 800 m, then straight back 15 m to the north: a 180° turn at a point, which an AUV
+    // with a 20 m turning radius overshoots by tens of metres.
+    let s = scenario(&[("auv1", [200.0, 1000.0, 200.0], [200.0, 1015.0, 200.0])])?;
+    let plans = vec![steady(
+        &[
+            [200.0, 1000.0, 200.0],
+            [1000.0, 1000.0, 200.0],
+            [1000.0, 1015.0, 200.0],
+            [200.0, 1015.0, 200.0],
+        ],
+        1.5,
+    )];
+    let dir = tempfile::tempdir()?;
+    let (report, log) = execute(&s, &plans, 10.0, dir.path())?;
+    let replans = events(&log, "replanned", "auv1");
+    assert!(
+        replans.iter().any(|e| e["detail"]
+            .as_str()
+            .is_some_and(|d| d.contains("cross-track error"))),
+        "no deviation replan: {log:?}"
+    );
+    // Not before the turn: the straight leg is flown within the tolerance.
+    let first = replans[0]["t_s"].as_f64().ok_or("no t_s")?;
+    assert!(first > 500.0, "replanned at {first} s");
+    let v = &report.figures.vehicles[0];
+    assert!(v.revision >= 1 && v.arrived_s.is_some(), "{v:?}");
+    assert_eq!(report.holds, 0);
+    Ok(())
+}
