@@ -169,6 +169,22 @@ impl Trajectory {
         self.points[k - 1] + (self.points[k] - self.points[k - 1]) * s
     }
 
+    /// This trajectory up to where `next` begins, then `next`: what a vehicle under way is sent
+    /// when its rest is replanned from a time ahead of now, so it keeps to its old course until
+    /// the new one starts instead of being pulled straight to the new start. The samples of
+    /// `self` strictly before `next`'s first time are kept; an empty `next` changes nothing.
+    pub fn followed_by(&self, next: &Trajectory) -> Trajectory {
+        let Some(&start) = next.times.first() else {
+            return self.clone();
+        };
+        let keep = self.times.partition_point(|&t| t < start);
+        let mut times = self.times[..keep].to_vec();
+        let mut points = self.points[..keep.min(self.points.len())].to_vec();
+        times.extend_from_slice(&next.times);
+        points.extend_from_slice(&next.points);
+        Trajectory { times, points }
+    }
+
     /// Speed on each leg, m/s (zero for a leg of zero duration and length).
     pub fn leg_speeds(&self) -> Vec<f64> {
         self.times
@@ -339,6 +355,39 @@ mod tests {
             max_turn_deg: 35.0,
             max_pitch_deg: 20.0,
         }
+    }
+
+    #[test]
+    fn a_replan_is_spliced_onto_the_course_flown_until_it_begins() {
+        let v = |x: f64| Vec3::new(x, 0.0, 0.0);
+        let old = Trajectory {
+            times: vec![0.0, 100.0, 200.0, 300.0],
+            points: vec![v(0.0), v(100.0), v(200.0), v(300.0)],
+        };
+        let new = Trajectory {
+            times: vec![150.0, 250.0],
+            points: vec![Vec3::new(150.0, 5.0, 0.0), Vec3::new(150.0, 105.0, 0.0)],
+        };
+        let s = old.followed_by(&new);
+        assert_eq!(s.times, vec![0.0, 100.0, 150.0, 250.0]);
+        assert_eq!(s.points[..2], old.points[..2]);
+        assert_eq!(s.points[2..], new.points[..]);
+        // Before the new start the vehicle is where the old plan had it; after, on the new one.
+        assert!((s.position_at(50.0) - v(50.0)).norm() < 1e-12);
+        assert!((s.position_at(200.0) - Vec3::new(150.0, 55.0, 0.0)).norm() < 1e-12);
+        // A sample at the very start time is replaced; an empty replan changes nothing.
+        let at = Trajectory {
+            times: vec![100.0, 200.0],
+            points: vec![v(100.0), v(0.0)],
+        };
+        assert_eq!(old.followed_by(&at).times, vec![0.0, 100.0, 200.0]);
+        assert_eq!(
+            old.followed_by(&Trajectory {
+                times: vec![],
+                points: vec![]
+            }),
+            old
+        );
     }
 
     #[test]

@@ -105,9 +105,9 @@ fn positive(flag: &str, v: f64) -> anyhow::Result<f64> {
 pub fn run_command(args: &RunArgs, shutdown: Arc<AtomicBool>) -> anyhow::Result<i32> {
     let p = &args.plan;
     let scenario = crate::load_scenario(p)?;
-    if scenario.coverage.is_some() || scenario.optimizer.algorithm.is_tour_planner() {
+    if scenario.coverage.is_some() {
         bail!(
-            "{}: `run` executes fleet plans of seed 004 (amp-pso, mp-pso, …); coverage and inspection-tour plans cannot be executed yet",
+            "{}: `run` executes timed trajectories (fleet plans, energy plans, inspection tours); a [coverage] mission's plan cannot be executed yet",
             p.scenario.display()
         );
     }

@@ -18,6 +18,7 @@ use shoal_common::wire::open::{FleetStatus, Telemetry, OPEN_VERSION};
 use shoal_common::wire::WireTrajectory;
 
 use super::log::Record;
+use super::repair;
 use super::replan::{self, Request};
 use super::Exec;
 
@@ -307,7 +308,7 @@ pub(super) fn replan_vehicle(x: &mut Exec, i: usize, why: &str) -> bool {
     // A retry must not repeat the swarm that just failed.
     let seed =
         o.seed ^ (u64::from(x.revision) << 8) ^ (u64::from(x.hold_retries[i]) << 32) ^ i as u64;
-    let result = replan::replan(&Request {
+    let request = Request {
         scenario: &x.scenario,
         vehicle: i,
         t0,
@@ -318,14 +319,27 @@ pub(super) fn replan_vehicle(x: &mut Exec, i: usize, why: &str) -> bool {
         arrival_s: x.common_arrival_s,
         budget,
         seed,
-    });
+    };
+    // A tour must still pass its remaining inspection points: it is repaired, not replanned.
+    let result = if x.scenario.optimizer.algorithm.is_tour_planner() {
+        repair::repair(&request)
+    } else {
+        replan::replan(&request)
+    };
     x.last_reaction[i] = Some(Instant::now());
     let id = x.fleet.vehicles[i].id.clone();
     if result.safe {
         x.hold_retries[i] = 0;
         x.revision += 1;
         let v = &mut x.fleet.vehicles[i];
-        v.plan = result.trajectory.clone();
+        // Under way, the vehicle keeps to its old course until the new one starts; holding, it
+        // waits where it is for it.
+        let plan = if v.holding {
+            result.trajectory.clone()
+        } else {
+            v.plan.followed_by(&result.trajectory)
+        };
+        v.plan = plan.clone();
         v.revision = x.revision;
         v.holding = false;
         x.send(
@@ -334,7 +348,7 @@ pub(super) fn replan_vehicle(x: &mut Exec, i: usize, why: &str) -> bool {
                 mission: x.mission.clone(),
                 vehicle: id.clone(),
                 revision: x.revision,
-                trajectory: WireTrajectory::new(&id, &result.trajectory),
+                trajectory: WireTrajectory::new(&id, &plan),
             },
         );
         x.pending[i] = Some((x.revision, Instant::now()));

@@ -76,7 +76,7 @@ pub struct Replanned {
 }
 
 /// `t` from mission time `t0` on, re-based so `t0` is time 0.
-fn rebase(t: &Trajectory, t0: f64) -> Trajectory {
+pub(super) fn rebase(t: &Trajectory, t0: f64) -> Trajectory {
     let mut times = vec![0.0];
     let mut points = vec![t.position_at(t0)];
     for (s, p) in t.times.iter().zip(&t.points) {
@@ -180,7 +180,8 @@ pub fn push_out_of_obstacles(genes: &mut [f64], scenario: &Scenario, m: usize) {
     }
 }
 
-/// A problem whose first samples are warm starts, then jittered copies of them.
+/// A problem whose first samples are warm starts (inside the bounds), then jittered copies of
+/// them.
 struct WarmStart<'a> {
     inner: &'a VehicleProblem<'a>,
     warm: Vec<Vec<f64>>,
@@ -211,7 +212,7 @@ impl Problem for WarmStart<'_> {
         };
         let n = self.warm.len();
         match k {
-            k if k < n => clamp(self.warm[k].clone()),
+            k if k < n => self.warm[k].clone(),
             k if k < n + WARM_COPIES => clamp(
                 self.warm[k % n]
                     .iter()
@@ -249,6 +250,13 @@ pub fn replan(r: &Request) -> Replanned {
             warm.push(warm_chromosome(&way, r.t0, r.p0, m, speeds));
         }
     }
+    // In the box, as every particle must be.
+    let (lo, hi) = (problem.lower(), problem.upper());
+    for w in &mut warm {
+        for (d, v) in w.iter_mut().enumerate() {
+            *v = v.clamp(lo[d], hi[d]);
+        }
+    }
     let warm_problem = WarmStart {
         inner: &problem,
         warm,
@@ -261,14 +269,33 @@ pub fn replan(r: &Request) -> Replanned {
     };
     let mut solver = Pso::adaptive(PARTICLES, r.seed);
     let out = executor.run(&warm_problem, &mut solver, |_| {});
-    let best = problem.evaluate(out.state.best_position());
+    // A safe answer beats a cheaper unsafe one: the swarm's best can trade a grazed obstacle
+    // for a shorter, on-time path (the penalties are finite), where a warm start — the long
+    // way round, say, arriving late — is safe. The swarm's best still wins among safe ones.
+    let d_min = scenario.fleet.d_min_m;
+    let safe = |e: &shoal_common::vehicle_problem::VehicleEvaluation| {
+        e.terms.hard_hits == 0 && e.min_separation >= d_min
+    };
+    let mut best = problem.evaluate(out.state.best_position());
+    if !safe(&best) {
+        let fallback = warm_problem
+            .warm
+            .iter()
+            .map(|w| problem.evaluate(w))
+            .filter(|e| safe(e))
+            .min_by(|a, b| a.total.total_cmp(&b.total));
+        if let Some(e) = fallback {
+            best = e;
+        }
+    }
+    let safe = safe(&best);
     let trajectory = Trajectory {
         times: best.trajectory.times.iter().map(|t| t + r.t0).collect(),
         points: best.trajectory.points,
     };
     Replanned {
         trajectory,
-        safe: best.terms.hard_hits == 0 && best.min_separation >= scenario.fleet.d_min_m,
+        safe,
         hard_hits: best.terms.hard_hits,
         min_separation_m: best.min_separation,
         elapsed: started.elapsed(),

@@ -1,0 +1,273 @@
+//! Repairing the rest of an inspection tour while the fleet drives (issue 8). A tour's path is
+//! not "any way to the goal": it must still pass every remaining inspection point in order, so
+//! the point-to-point replan of [`super::replan`] would be wrong for it. A repair keeps the
+//! rest of the tour and changes only what must change:
+//!
+//! - the vehicle goes from where it will be back onto its tour (directly: after a deviation or a
+//!   hold, it rejoins at the next point of the plan);
+//! - every run of legs that a hard obstacle now blocks is replaced by a way round it
+//!   ([`super::detour`]) from the last point before the run to the first point after it;
+//! - the result is re-timed to arrive when the plan did, each leg's speed scaled alike and kept
+//!   within the vehicle's range (a longer way than the top speed can make up arrives late).
+//!
+//! A repair that still meets a hard obstacle, or comes within d_min of another vehicle's
+//! predicted track, is not safe: the coordinator then holds the vehicle and retries, so a tour
+//! vehicle gives way by waiting, and carries on when the way is clear.
+
+use std::time::Instant;
+
+use shoal_common::geometry::{segment_hits_sphere, Vec3};
+use shoal_common::scenario::Scenario;
+use shoal_common::separation::{motion_separation, Motion};
+use shoal_common::trajectory::Trajectory;
+
+use super::replan::{rebase, Replanned, Request};
+
+/// Whether the leg `a`–`b` enters a hard obstacle's inflated sphere.
+fn blocked(scenario: &Scenario, a: &Vec3, b: &Vec3) -> bool {
+    scenario
+        .hard_obstacles()
+        .any(|o| segment_hits_sphere(a, b, &o.centre(), o.inflated_radius()))
+}
+
+/// The rest of the tour from `p0` as points and the plan's own speed on each leg; `None` for
+/// a way round a blocked run that the grid cannot find.
+fn repaired_path(r: &Request) -> Option<(Vec<Vec3>, Vec<f64>)> {
+    let scenario = r.scenario;
+    let rest = rebase(r.current, r.t0);
+    let mut pts = rest.points.clone();
+    pts[0] = r.p0;
+    let speeds: Vec<f64> = pts
+        .windows(2)
+        .zip(rest.times.windows(2))
+        .map(|(p, t)| (p[1] - p[0]).norm() / (t[1] - t[0]).max(1e-9))
+        .collect();
+    let mut out = vec![pts[0]];
+    let mut out_speeds = Vec::new();
+    let mut k = 0;
+    while k + 1 < pts.len() {
+        if !blocked(scenario, &pts[k], &pts[k + 1]) {
+            out.push(pts[k + 1]);
+            out_speeds.push(speeds[k]);
+            k += 1;
+            continue;
+        }
+        // The run of blocked legs k..=j, rejoined at its end point.
+        let mut j = k;
+        while j + 2 < pts.len() && blocked(scenario, &pts[j + 1], &pts[j + 2]) {
+            j += 1;
+        }
+        let way = super::detour::detour(scenario, pts[k], pts[j + 1])?;
+        let run_length: f64 = (k..=j).map(|i| (pts[i + 1] - pts[i]).norm()).sum();
+        let run_time: f64 = (k..=j)
+            .map(|i| (pts[i + 1] - pts[i]).norm() / speeds[i].max(1e-9))
+            .sum();
+        let speed = run_length / run_time.max(1e-9);
+        for p in &way[1..] {
+            out.push(*p);
+            out_speeds.push(speed);
+        }
+        k = j + 1;
+    }
+    Some((out, out_speeds))
+}
+
+/// `points` flown at `speeds` scaled alike to take `duration` from `t0`, each leg kept within
+/// `[v_min, v_max]`.
+fn timed(points: Vec<Vec3>, speeds: &[f64], t0: f64, duration: f64, v: (f64, f64)) -> Trajectory {
+    let lengths: Vec<f64> = points.windows(2).map(|w| (w[1] - w[0]).norm()).collect();
+    let natural: f64 = lengths
+        .iter()
+        .zip(speeds)
+        .map(|(l, s)| l / s.max(1e-9))
+        .sum();
+    let scale = if duration > 0.0 {
+        natural / duration
+    } else {
+        1.0
+    };
+    let mut times = vec![t0];
+    for (l, s) in lengths.iter().zip(speeds) {
+        let speed = (s * scale).clamp(v.0, v.1);
+        times.push(times[times.len() - 1] + l / speed);
+    }
+    Trajectory { times, points }
+}
+
+/// Repairs the vehicle's tour (see the module doc).
+pub fn repair(r: &Request) -> Replanned {
+    let started = Instant::now();
+    let v = &r.scenario.vehicles[r.vehicle];
+    let d_min = r.scenario.fleet.d_min_m;
+    let Some((points, speeds)) = repaired_path(r) else {
+        return Replanned {
+            trajectory: r.current.clone(),
+            safe: false,
+            hard_hits: 1,
+            min_separation_m: f64::INFINITY,
+            elapsed: started.elapsed(),
+        };
+    };
+    let duration = r.current.arrival() - r.t0;
+    let trajectory = timed(
+        points,
+        &speeds,
+        r.t0,
+        duration,
+        (v.speed_min_mps, v.speed_max_mps),
+    );
+    let hard_hits = trajectory
+        .points
+        .windows(2)
+        .filter(|w| blocked(r.scenario, &w[0], &w[1]))
+        .count();
+    let mine = rebase(&trajectory, r.t0);
+    let min_separation_m = r
+        .others
+        .iter()
+        .enumerate()
+        .filter(|(j, _)| *j != r.vehicle)
+        .map(|(_, o)| {
+            let o = rebase(o, r.t0);
+            motion_separation(&Motion::new(&mine), &Motion::new(&o), d_min, false).min_distance
+        })
+        .fold(f64::INFINITY, f64::min);
+    Replanned {
+        trajectory,
+        safe: hard_hits == 0 && min_separation_m >= d_min,
+        hard_hits,
+        min_separation_m,
+        elapsed: started.elapsed(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use shoal_common::scenario::{Obstacle, ObstacleKind};
+    use std::time::Duration;
+
+    fn scenario() -> Result<Scenario, Box<dyn std::error::Error>> {
+        let file = concat!(env!("CARGO_MANIFEST_DIR"), "/../scenarios/amp-pso-1.toml");
+        let mut s = Scenario::load(std::path::Path::new(file))?;
+        s.bounds.min = [0.0, 0.0, 0.0];
+        s.bounds.max = [2000.0, 2000.0, 400.0];
+        s.obstacles.clear();
+        s.vehicles.truncate(2);
+        for v in &mut s.vehicles {
+            v.speed_min_mps = 0.5;
+            v.speed_max_mps = 2.0;
+        }
+        Ok(s)
+    }
+
+    /// A square tour from (200, 200): east 1000 m, north 1000 m, back west and south, 1 m/s.
+    fn tour() -> Trajectory {
+        let p = |x: f64, y: f64| Vec3::new(x, y, 200.0);
+        Trajectory {
+            times: vec![0.0, 1000.0, 2000.0, 3000.0, 4000.0],
+            points: vec![
+                p(200.0, 200.0),
+                p(1200.0, 200.0),
+                p(1200.0, 1200.0),
+                p(200.0, 1200.0),
+                p(200.0, 200.0),
+            ],
+        }
+    }
+
+    fn request<'a>(
+        s: &'a Scenario,
+        current: &'a Trajectory,
+        others: &'a [Trajectory],
+    ) -> Request<'a> {
+        Request {
+            scenario: s,
+            vehicle: 0,
+            t0: 500.0,
+            p0: Vec3::new(700.0, 200.0, 200.0),
+            heading: Some(Vec3::new(1.0, 0.0, 0.0)),
+            current,
+            others,
+            arrival_s: 4000.0,
+            budget: Duration::from_millis(100),
+            seed: 1,
+        }
+    }
+
+    #[test]
+    fn an_unblocked_tour_is_kept_as_it_is() -> Result<(), Box<dyn std::error::Error>> {
+        let s = scenario()?;
+        let plan = tour();
+        let r = repair(&request(&s, &plan, &[]));
+        assert!(r.safe && r.hard_hits == 0);
+        // From (700, 200) at t = 500 on: the same corners at the same times.
+        assert_eq!(r.trajectory.points[1..], plan.points[1..]);
+        for (a, b) in r
+            .trajectory
+            .times
+            .iter()
+            .zip([500.0, 1000.0, 2000.0, 3000.0, 4000.0])
+        {
+            assert!((a - b).abs() < 1e-9, "{:?}", r.trajectory.times);
+        }
+        Ok(())
+    }
+
+    #[test]
+    fn a_blocked_leg_is_gone_round_and_every_later_corner_kept(
+    ) -> Result<(), Box<dyn std::error::Error>> {
+        let mut s = scenario()?;
+        // On the north-bound leg, floor to surface: the way round is east or west of it.
+        for z in [100.0, 300.0] {
+            s.obstacles.push(Obstacle {
+                id: format!("new{z}"),
+                kind: ObstacleKind::Hard,
+                centre: [1200.0, 700.0, z],
+                radius_m: 100.0,
+                inflation_m: 50.0,
+            });
+        }
+        let plan = tour();
+        let r = repair(&request(&s, &plan, &[]));
+        assert!(r.safe, "{r:?}");
+        for w in r.trajectory.points.windows(2) {
+            assert!(!blocked(&s, &w[0], &w[1]));
+        }
+        // The inspection corners are all still there, in order, after the detour.
+        let corners = &plan.points[1..];
+        let mut at = 0;
+        for p in &r.trajectory.points {
+            if at < corners.len() && (p - corners[at]).norm() < 1e-9 {
+                at += 1;
+            }
+        }
+        assert_eq!(at, corners.len(), "{:?}", r.trajectory.points);
+        // Longer than the plan's 3500 m from (700, 200), flown faster to keep the arrival.
+        let length: f64 = r
+            .trajectory
+            .points
+            .windows(2)
+            .map(|w| (w[1] - w[0]).norm())
+            .sum();
+        assert!(length > 3500.0 + 10.0, "{length}");
+        assert!((r.trajectory.arrival() - 4000.0).abs() < 1e-6);
+        Ok(())
+    }
+
+    #[test]
+    fn a_repair_that_meets_another_vehicle_is_not_safe() -> Result<(), Box<dyn std::error::Error>> {
+        let s = scenario()?;
+        let plan = tour();
+        // The other vehicle waits at the first corner.
+        let p = Vec3::new(1200.0, 200.0, 200.0);
+        let other = Trajectory {
+            times: vec![0.0, 5000.0],
+            points: vec![p, p],
+        };
+        let others = [plan.clone(), other];
+        let r = repair(&request(&s, &plan, &others));
+        assert!(!r.safe && r.min_separation_m < 1.0, "{r:?}");
+        Ok(())
+    }
+}
