@@ -169,6 +169,23 @@ impl Trajectory {
         self.points[k - 1] + (self.points[k] - self.points[k - 1]) * s
     }
 
+    /// The trajectory from mission time `t` on: the position at `t`, then every later sample
+    /// (times unchanged). Empty stays empty.
+    pub fn since(&self, t: f64) -> Trajectory {
+        if self.times.is_empty() {
+            return self.clone();
+        }
+        let mut times = vec![t];
+        let mut points = vec![self.position_at(t)];
+        for (s, p) in self.times.iter().zip(&self.points) {
+            if *s > t {
+                times.push(*s);
+                points.push(*p);
+            }
+        }
+        Trajectory { times, points }
+    }
+
     /// This trajectory up to where `next` begins, then `next`: what a vehicle under way is sent
     /// when its rest is replanned from a time ahead of now, so it keeps to its old course until
     /// the new one starts instead of being pulled straight to the new start. The samples of
@@ -355,6 +372,26 @@ mod tests {
             max_turn_deg: 35.0,
             max_pitch_deg: 20.0,
         }
+    }
+
+    #[test]
+    fn the_rest_since_a_time_starts_where_the_trajectory_is_then() {
+        let v = |x: f64| Vec3::new(x, 0.0, 0.0);
+        let t = Trajectory {
+            times: vec![0.0, 100.0, 200.0],
+            points: vec![v(0.0), v(100.0), v(300.0)],
+        };
+        let r = t.since(150.0);
+        assert_eq!(r.times, vec![150.0, 200.0]);
+        assert_eq!(r.points, vec![v(200.0), v(300.0)]);
+        // Before the start: the start and every sample; after the end: the end alone.
+        assert_eq!(t.since(-10.0).times, vec![-10.0, 0.0, 100.0, 200.0]);
+        assert_eq!(t.since(500.0).points, vec![v(300.0)]);
+        let empty = Trajectory {
+            times: vec![],
+            points: vec![],
+        };
+        assert_eq!(empty.since(1.0), empty);
     }
 
     #[test]

@@ -16,6 +16,10 @@ use serde_json::Value;
 
 const LIMIT: Duration = Duration::from_secs(240);
 
+/// An obstacle of 15 m (+ d_min 20 m) where auv1's tour of `cages-fleet` (planned with the test's
+/// flags) has it 150 s after t = 500 s.
+const INJECT_ON_TOUR: &str = "500:auv1,15";
+
 fn num(v: &Value, path: &str) -> f64 {
     let mut x = v;
     for k in path.split('.') {
@@ -27,26 +31,31 @@ fn num(v: &Value, path: &str) -> f64 {
     }
 }
 
-/// `shoal-coordinator run scenarios/amp-pso-2.toml`, planned in process with 40 iterations, at
+/// `shoal-coordinator run scenarios/<name>.toml`, planned in process with `planning` flags, at
 /// `time_scale` × real time, writing into `out`, with `extra` flags.
-fn run_scenario_2(out: &Path, time_scale: &str, extra: &[&str]) -> Command {
+fn run_scenario(
+    name: &str,
+    planning: &[&str],
+    out: &Path,
+    time_scale: &str,
+    extra: &[&str],
+) -> Command {
     let mut cmd = Command::new(coordinator());
     without_shoal_env(&mut cmd);
     cmd.current_dir(root())
         .arg("run")
-        .arg(scenario("amp-pso-2"))
-        .args([
-            "--in-process",
-            "--iterations",
-            "40",
-            "-q",
-            "--time-scale",
-            time_scale,
-        ])
+        .arg(scenario(name))
+        .args(["--in-process", "-q", "--time-scale", time_scale])
+        .args(planning)
         .args(extra)
         .arg("--out")
         .arg(out);
     cmd
+}
+
+/// [`run_scenario`] on scenario 2 with 40 iterations.
+fn run_scenario_2(out: &Path, time_scale: &str, extra: &[&str]) -> Command {
+    run_scenario("amp-pso-2", &["--iterations", "40"], out, time_scale, extra)
 }
 
 /// `<out>/execution.json`.
@@ -219,6 +228,95 @@ fn a_vehicle_with_no_safe_replan_is_told_to_hold() -> TestResult {
             .any(|l| l.contains("\"kind\":\"hold\"") && l.contains("auv2")),
         "no hold event for auv2"
     );
+    fleet.passed();
+    Ok(())
+}
+
+#[test]
+fn an_inspection_tour_is_run_and_repaired_round_a_new_obstacle_keeping_its_points() -> TestResult {
+    let mut fleet = Fleet::new();
+    let out = fleet.dir().join("out");
+    let cmd = run_scenario(
+        "cages-fleet",
+        &[
+            "--iterations",
+            "60",
+            "--particles",
+            "30",
+            "--algorithm",
+            "ldiw-pso",
+        ],
+        &out,
+        "100",
+        &["--inject-obstacle", INJECT_ON_TOUR],
+    );
+    let c = fleet.spawn("coordinator", cmd);
+    let r = fleet.wait(c, Instant::now() + LIMIT);
+    assert!(
+        matches!(r.code(), Some(0 | 3)),
+        "{}\n{}",
+        r.stdout,
+        r.stderr
+    );
+    let plan: Value = serde_json::from_str(&std::fs::read_to_string(out.join("plan.json"))?)?;
+    let report = execution_report(&out)?;
+    let f = &report["figures"];
+    assert!(num(f, "min_separation_m") >= 20.0, "{f}");
+    for v in f["vehicles"].as_array().into_iter().flatten() {
+        assert!(num(v, "min_obstacle_clearance_m") > 0.0, "{v}");
+    }
+    let log: Vec<Value> = std::fs::read_to_string(out.join("mission.ndjson"))?
+        .lines()
+        .filter_map(|l| serde_json::from_str::<Value>(l).ok())
+        .collect();
+    let blocked = log.iter().any(|r| {
+        r["record"] == "event"
+            && r["kind"] == "obstacle"
+            && r["vehicles"]
+                .as_array()
+                .is_some_and(|v| v.iter().any(|x| x == "auv1"))
+    });
+    assert!(blocked, "the obstacle did not block auv1");
+    let repaired = log.iter().any(|r| {
+        r["record"] == "event"
+            && r["kind"] == "replanned"
+            && r["detail"]
+                .as_str()
+                .is_some_and(|d| d.starts_with("auv1") && d.contains("obstacle"))
+    });
+    assert!(repaired, "auv1 was not repaired round the obstacle");
+    // auv1's last revision still passes every one of its inspection points: exactly where the
+    // repair kept the tour, within a few metres where the record holds the predicted track that
+    // joins the old plan to the new one.
+    let last = log
+        .iter()
+        .filter(|r| r["record"] == "plan")
+        .filter_map(|r| {
+            r["trajectories"]
+                .as_array()?
+                .iter()
+                .find(|t| t[0] == "auv1")
+                .map(|t| t[1].clone())
+        })
+        .last()
+        .ok_or("no plan record for auv1")?;
+    let samples = last.as_array().ok_or("samples")?;
+    for p in plan["vehicles"][0]["tour"]["points"]
+        .as_array()
+        .into_iter()
+        .flatten()
+    {
+        let hit = samples.iter().any(|s| {
+            let d2: f64 = (1..4)
+                .map(|k| match (s[k].as_f64(), p[k - 1].as_f64()) {
+                    (Some(a), Some(b)) => (a - b).powi(2),
+                    _ => f64::INFINITY,
+                })
+                .sum();
+            d2.sqrt() < 10.0
+        });
+        assert!(hit, "inspection point {p} is not on auv1's last revision");
+    }
     fleet.passed();
     Ok(())
 }

@@ -8,9 +8,12 @@
 //! Cells whose centre is inside a hard obstacle's inflated sphere grown by [`GROW`] are
 //! blocked; so the line-of-sight shortcuts, which test segments against the spheres grown by
 //! [`SHORTCUT_GROW`], keep a little margin that resampling onto the swarm's waypoints (chords
-//! between points of the path) then spends. Climbing costs [`CLIMB_COST`] × its height: the
-//! vehicles' pitch limit (±20° in seed 004) makes a way over or under an obstacle far longer
-//! than its grid length says, so the search prefers going round it.
+//! between points of the path) then spends.
+//!
+//! The way must be one the vehicle can fly: its pitch limit (±20° in seed 004) is built into
+//! the grid. Layers are `cell · tan(φ_max)` apart (a little less), every move goes one cell
+//! sideways and at most one layer up or down, so no grid move is steeper than the limit; a
+//! shortcut is taken only when it is no steeper either.
 
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;
@@ -22,10 +25,10 @@ use shoal_common::scenario::Scenario;
 const GROW: f64 = 1.15;
 /// Line-of-sight shortcuts keep out of the inflated spheres grown by this.
 const SHORTCUT_GROW: f64 = 1.08;
-/// Cost per metre of height gained or lost, against 1 per horizontal metre.
-const CLIMB_COST: f64 = 3.0;
-/// Cells along the longest side of the bounds.
+/// Cells along the longer horizontal side of the bounds.
 const CELLS: f64 = 40.0;
+/// Layers are this fraction of the height a one-cell move may climb.
+const LAYER_FRACTION: f64 = 0.95;
 
 /// An open-list entry: estimated total cost and cell index.
 #[derive(PartialEq)]
@@ -46,23 +49,25 @@ impl Ord for Open {
     }
 }
 
-/// The grid over the scenario's bounds.
+/// The grid over the scenario's bounds: node spacing per axis, `[cell, cell, layer]`.
 struct Grid {
     min: Vec3,
-    cell: f64,
+    step: [f64; 3],
     n: [usize; 3],
     blocked: Vec<bool>,
 }
 
 impl Grid {
-    fn new(scenario: &Scenario) -> Grid {
+    fn new(scenario: &Scenario, max_pitch: f64) -> Grid {
         let min = Vec3::from(scenario.bounds.min);
         let extent = Vec3::from(scenario.bounds.max) - min;
-        let cell = (extent.max() / CELLS).max(1.0);
-        let n = [0, 1, 2].map(|k| ((extent[k] / cell).floor() as usize + 1).max(1));
+        let cell = (extent.x.max(extent.y) / CELLS).max(1.0);
+        let layer = (cell * LAYER_FRACTION * max_pitch.tan()).max(0.1);
+        let step = [cell, cell, layer];
+        let n = [0, 1, 2].map(|k| ((extent[k] / step[k]).floor() as usize + 1).max(1));
         let mut g = Grid {
             min,
-            cell,
+            step,
             n,
             blocked: vec![false; n[0] * n[1] * n[2]],
         };
@@ -89,22 +94,27 @@ impl Grid {
 
     fn centre(&self, k: usize) -> Vec3 {
         let c = self.coords(k);
-        self.min + Vec3::new(c[0] as f64, c[1] as f64, c[2] as f64) * self.cell
+        self.min
+            + Vec3::new(
+                c[0] as f64 * self.step[0],
+                c[1] as f64 * self.step[1],
+                c[2] as f64 * self.step[2],
+            )
     }
 
     /// The nearest grid node to `p` (clamped into the grid).
     fn nearest(&self, p: Vec3) -> usize {
         let c = [0, 1, 2].map(|a| {
-            let f = ((p[a] - self.min[a]) / self.cell).round();
+            let f = ((p[a] - self.min[a]) / self.step[a]).round();
             (f.max(0.0) as usize).min(self.n[a] - 1)
         });
         self.index(c)
     }
 
-    /// The step cost between two neighbouring nodes, and the admissible estimate to the goal.
+    /// The step cost between two neighbouring nodes, and the admissible estimate to the goal:
+    /// the distance.
     fn cost(a: Vec3, b: Vec3) -> f64 {
-        let d = b - a;
-        d.x.hypot(d.y) + CLIMB_COST * d.z.abs()
+        (b - a).norm()
     }
 
     /// A* from `from` to `to` over free nodes (the two end nodes are allowed even if blocked:
@@ -133,7 +143,8 @@ impl Grid {
             for dz in -1i64..=1 {
                 for dy in -1i64..=1 {
                     for dx in -1i64..=1 {
-                        if (dx, dy, dz) == (0, 0, 0) {
+                        // Always sideways: straight up or down is past any pitch limit.
+                        if (dx, dy) == (0, 0) {
                             continue;
                         }
                         let step = [dx, dy, dz];
@@ -170,13 +181,22 @@ fn clear(scenario: &Scenario, a: &Vec3, b: &Vec3, grow: f64) -> bool {
         .any(|o| segment_hits_sphere(a, b, &o.centre(), grow * o.inflated_radius()))
 }
 
-/// A way from `from` to `to` round the scenario's hard obstacles (see the module doc): the
-/// corners of the shortened grid path, from `from` to `to`. `None` when the grid has no way.
-pub fn detour(scenario: &Scenario, from: Vec3, to: Vec3) -> Option<Vec<Vec3>> {
-    if clear(scenario, &from, &to, SHORTCUT_GROW) {
+/// Whether the segment `a`–`b` is flyable as one leg: clear (with the shortcut margin) and no
+/// steeper than `max_pitch` radians.
+fn flyable(scenario: &Scenario, a: &Vec3, b: &Vec3, max_pitch: f64) -> bool {
+    let d = b - a;
+    d.z.abs() <= max_pitch.tan() * d.x.hypot(d.y) + 1e-9 && clear(scenario, a, b, SHORTCUT_GROW)
+}
+
+/// A way from `from` to `to` round the scenario's hard obstacles, no steeper than
+/// `max_pitch_deg` (see the module doc): the corners of the shortened grid path, from `from` to
+/// `to`. `None` when the grid has no way.
+pub fn detour(scenario: &Scenario, from: Vec3, to: Vec3, max_pitch_deg: f64) -> Option<Vec<Vec3>> {
+    let max_pitch = max_pitch_deg.to_radians();
+    if flyable(scenario, &from, &to, max_pitch) {
         return Some(vec![from, to]);
     }
-    let grid = Grid::new(scenario);
+    let grid = Grid::new(scenario, max_pitch);
     let cells = grid.search(grid.nearest(from), grid.nearest(to))?;
     let mut raw = vec![from];
     // The end nodes stand for `from` and `to` themselves.
@@ -191,7 +211,7 @@ pub fn detour(scenario: &Scenario, from: Vec3, to: Vec3) -> Option<Vec<Vec3>> {
     let mut i = 0;
     while i + 1 < raw.len() {
         let mut j = raw.len() - 1;
-        while j > i + 1 && !clear(scenario, &raw[i], &raw[j], SHORTCUT_GROW) {
+        while j > i + 1 && !flyable(scenario, &raw[i], &raw[j], max_pitch) {
             j -= 1;
         }
         out.push(raw[j]);
@@ -235,7 +255,7 @@ mod tests {
             Vec3::new(100.0, 500.0, 200.0),
             Vec3::new(1900.0, 500.0, 200.0),
         );
-        assert_eq!(detour(&s, a, b), Some(vec![a, b]));
+        assert_eq!(detour(&s, a, b, 20.0), Some(vec![a, b]));
         Ok(())
     }
 
@@ -255,7 +275,7 @@ mod tests {
             Vec3::new(200.0, 500.0, 200.0),
             Vec3::new(1800.0, 500.0, 200.0),
         );
-        let path = detour(&s, a, b).ok_or("no detour")?;
+        let path = detour(&s, a, b, 20.0).ok_or("no detour")?;
         assert_eq!(path.first(), Some(&a));
         assert_eq!(path.last(), Some(&b));
         for w in path.windows(2) {
@@ -284,7 +304,33 @@ mod tests {
             Vec3::new(200.0, 500.0, 200.0),
             Vec3::new(1800.0, 500.0, 200.0),
         );
-        assert_eq!(detour(&s, a, b), None);
+        assert_eq!(detour(&s, a, b, 20.0), None);
+        Ok(())
+    }
+
+    #[test]
+    fn a_climb_too_steep_for_the_pitch_limit_winds_up_within_it(
+    ) -> Result<(), Box<dyn std::error::Error>> {
+        // 400 m up over 200 m: 63°. At 20° the way needs ≥ 400 / tan 20° ≈ 1099 m of
+        // horizontal travel, ≥ 400 / sin 20° ≈ 1170 m in all.
+        let s = scenario(&[])?;
+        let (a, b) = (
+            Vec3::new(100.0, 1000.0, 0.0),
+            Vec3::new(300.0, 1000.0, 400.0),
+        );
+        let path = detour(&s, a, b, 20.0).ok_or("no way up")?;
+        assert_eq!((path.first(), path.last()), (Some(&a), Some(&b)));
+        let legs = path.len() - 1;
+        for (k, w) in path.windows(2).enumerate() {
+            let d = w[1] - w[0];
+            let pitch = d.z.abs().atan2(d.x.hypot(d.y)).to_degrees();
+            // The two legs joining the ends to the grid may be a few metres steep.
+            if k > 0 && k + 1 < legs {
+                assert!(pitch <= 20.0 + 1e-6, "leg {k}: {pitch}° in {path:?}");
+            }
+        }
+        let l = length(&path);
+        assert!(l >= 1150.0 && l < 2500.0, "{l} m: {path:?}");
         Ok(())
     }
 }

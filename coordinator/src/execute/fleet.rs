@@ -169,8 +169,8 @@ impl Fleet {
     }
 
     /// Each vehicle's predicted trajectory from `now` over `horizon_s`: along its plan from its
-    /// latest fix (from where its plan has it, before its first report); a lost or holding
-    /// vehicle stays where it was last seen.
+    /// latest fix, from the fix's time (from where its plan has it, before its first report); a
+    /// lost or holding vehicle stays where it was last seen.
     pub fn predictions_over(&self, now: f64, horizon_s: f64) -> Vec<Trajectory> {
         self.vehicles
             .iter()
@@ -182,12 +182,15 @@ impl Fleet {
                         points: vec![p, p],
                     };
                 }
-                let p = match &v.last {
-                    Some(_) => v.position(),
-                    None => v.plan.position_at(now),
+                // From the latest fix at its own time (up to a report interval ago, 25 mission
+                // seconds at 2 Hz and 50×), carried forward to now: starting the prediction at
+                // the fix's position now would put it behind the vehicle.
+                let (p, at) = match &v.last {
+                    Some(t) => (v.position(), t.state.t_s.min(now)),
+                    None => (v.plan.position_at(now), now),
                 };
-                let pr = picture::progress(&v.plan, p, now, PROGRESS_WINDOW_S);
-                picture::predict(&v.plan, p, &pr, now, horizon_s, CONVERGE_S)
+                let pr = picture::progress(&v.plan, p, at, PROGRESS_WINDOW_S);
+                picture::predict(&v.plan, p, &pr, at, horizon_s + (now - at), CONVERGE_S).since(now)
             })
             .collect()
     }
@@ -478,5 +481,26 @@ mod tests {
         let c = f.conflicts(10.0);
         assert_eq!(c.len(), 1);
         assert!((c[0].min_distance_m - 10.0).abs() < 1e-6, "{c:?}");
+    }
+
+    #[test]
+    fn a_prediction_starts_from_the_fix_carried_forward_to_now() {
+        let ids = vec!["a".to_string()];
+        let mut f = Fleet::new(&ids, &[straight(0.0)], 50.0, 60.0);
+        // On its plan at x = 40 at t = 40; at t = 65 it is predicted at x = 65, not left at 40.
+        f.report(
+            report("a", 0, 40.0, [40.0, 0.0, 0.0], VehicleStatus::Underway),
+            1_000_000,
+        );
+        let p = &f.predictions_over(65.0, 20.0)[0];
+        assert_eq!(p.times.first(), Some(&65.0));
+        assert!(
+            (p.position_at(65.0) - Vec3::new(65.0, 0.0, 0.0)).norm() < 1e-9,
+            "{p:?}"
+        );
+        assert!(
+            (p.position_at(85.0) - Vec3::new(85.0, 0.0, 0.0)).norm() < 1e-9,
+            "{p:?}"
+        );
     }
 }

@@ -332,12 +332,14 @@ pub(super) fn replan_vehicle(x: &mut Exec, i: usize, why: &str) -> bool {
         x.hold_retries[i] = 0;
         x.revision += 1;
         let v = &mut x.fleet.vehicles[i];
-        // Under way, the vehicle keeps to its old course until the new one starts; holding, it
-        // waits where it is for it.
+        // Under way, the vehicle goes on as predicted (its old course, its lag included) until
+        // the new one starts at the predicted point; holding, it waits where it is for it. The
+        // plan before now stays, for the record.
         let plan = if v.holding {
             result.trajectory.clone()
         } else {
-            v.plan.followed_by(&result.trajectory)
+            v.plan
+                .followed_by(&predictions[i].followed_by(&result.trajectory))
         };
         v.plan = plan.clone();
         v.revision = x.revision;

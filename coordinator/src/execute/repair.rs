@@ -57,7 +57,12 @@ fn repaired_path(r: &Request) -> Option<(Vec<Vec3>, Vec<f64>)> {
         while j + 2 < pts.len() && blocked(scenario, &pts[j + 1], &pts[j + 2]) {
             j += 1;
         }
-        let way = super::detour::detour(scenario, pts[k], pts[j + 1])?;
+        let way = super::detour::detour(
+            scenario,
+            pts[k],
+            pts[j + 1],
+            scenario.vehicles[r.vehicle].max_pitch_deg,
+        )?;
         let run_length: f64 = (k..=j).map(|i| (pts[i + 1] - pts[i]).norm()).sum();
         let run_time: f64 = (k..=j)
             .map(|i| (pts[i + 1] - pts[i]).norm() / speeds[i].max(1e-9))

@@ -77,15 +77,11 @@ pub struct Replanned {
 
 /// `t` from mission time `t0` on, re-based so `t0` is time 0.
 pub(super) fn rebase(t: &Trajectory, t0: f64) -> Trajectory {
-    let mut times = vec![0.0];
-    let mut points = vec![t.position_at(t0)];
-    for (s, p) in t.times.iter().zip(&t.points) {
-        if *s > t0 {
-            times.push(s - t0);
-            points.push(*p);
-        }
+    let rest = t.since(t0);
+    Trajectory {
+        times: rest.times.iter().map(|s| s - t0).collect(),
+        points: rest.points,
     }
-    Trajectory { times, points }
 }
 
 /// The remainder of `current` after `t0`, from `p0`, as a chromosome of `m` waypoints (evenly
@@ -243,7 +239,7 @@ pub fn replan(r: &Request) -> Replanned {
     let mut plan = warm_chromosome(r.current, r.t0, r.p0, m, speeds);
     push_out_of_obstacles(&mut plan, &scenario, m);
     let mut warm = vec![plan];
-    if let Some(way) = super::detour::detour(&scenario, r.p0, v.goal()) {
+    if let Some(way) = super::detour::detour(&scenario, r.p0, v.goal(), v.max_pitch_deg) {
         if way.len() > 2 {
             // Timed for the arrival; `warm_chromosome` resamples it like a plan.
             let way = at_even_speed(&way, r.t0, arrival);
