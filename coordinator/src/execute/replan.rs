@@ -26,12 +26,15 @@ use shoal_common::scenario::Scenario;
 use shoal_common::swarm::pso::Pso;
 use shoal_common::swarm::{Executor, Problem, SolverState};
 use shoal_common::trajectory::Trajectory;
-use shoal_common::vehicle_problem::VehicleProblem;
+use shoal_common::vehicle_problem::{VehicleEvaluation, VehicleProblem};
 
 /// Jittered copies of the warm particle in the first swarm.
 const WARM_COPIES: usize = 8;
 /// How far out [`push_out_of_obstacles`] moves a waypoint, in inflated radii.
 const PUSH_OUT: f64 = 1.4;
+/// The straight run along the vehicle's course a way round begins with, metres (a few
+/// turning radii of the simulated AUV, 20 m).
+const LEAD_IN_M: f64 = 60.0;
 /// Particles of the replanning swarm.
 const PARTICLES: usize = 30;
 
@@ -221,6 +224,41 @@ impl Problem for WarmStart<'_> {
     }
 }
 
+/// No hard-obstacle intrusion and every other vehicle kept at `d_min` or more.
+fn is_safe(e: &VehicleEvaluation, d_min: f64) -> bool {
+    e.terms.hard_hits == 0 && e.min_separation >= d_min
+}
+
+/// How much more turn and pitch penalty than the cleanest safe candidate a safe candidate may
+/// carry and still be chosen for its lower cost: 2 is about one clear violation (each costs
+/// `1 + excess / limit`).
+const MOTION_SLACK: f64 = 2.0;
+
+/// The answer among the swarm's best and the warm starts. The swarm's best is the cheapest
+/// (the warm starts were in its swarm), but the penalties are finite, so in a short budget it
+/// can trade a grazed obstacle or a string of reversals for a shorter, on-time path where a
+/// warm start — the long way round, arriving late — is safe and flyable. So: a safe candidate
+/// beats an unsafe one; among safe ones, one that breaks the turn and pitch limits by more
+/// than [`MOTION_SLACK`] over the cleanest gives way; then the cheapest wins.
+fn choose(
+    swarm: VehicleEvaluation,
+    warm: impl Iterator<Item = VehicleEvaluation>,
+    d_min: f64,
+) -> VehicleEvaluation {
+    let safe: Vec<VehicleEvaluation> = std::iter::once(swarm.clone())
+        .chain(warm)
+        .filter(|e| is_safe(e, d_min))
+        .collect();
+    let cleanest = safe
+        .iter()
+        .map(|e| e.terms.motion)
+        .fold(f64::INFINITY, f64::min);
+    safe.into_iter()
+        .filter(|e| e.terms.motion <= cleanest + MOTION_SLACK)
+        .min_by(|a, b| a.total.total_cmp(&b.total))
+        .unwrap_or(swarm)
+}
+
 /// Replans (see the module doc).
 pub fn replan(r: &Request) -> Replanned {
     let started = Instant::now();
@@ -239,7 +277,22 @@ pub fn replan(r: &Request) -> Replanned {
     let mut plan = warm_chromosome(r.current, r.t0, r.p0, m, speeds);
     push_out_of_obstacles(&mut plan, &scenario, m);
     let mut warm = vec![plan];
-    if let Some(way) = super::detour::detour(&scenario, r.p0, v.goal(), v.max_pitch_deg) {
+    // The way round starts with a straight run along the vehicle's course, so its first turn
+    // comes after the vehicle has had room for it.
+    let lead = r
+        .heading
+        .and_then(|h| Vec3::new(h.x, h.y, 0.0).try_normalize(1e-9))
+        .map(|h| r.p0 + h * LEAD_IN_M)
+        .filter(|q| {
+            scenario
+                .hard_obstacles()
+                .all(|o| (q - o.centre()).norm() > o.inflated_radius())
+        });
+    let from = lead.unwrap_or(r.p0);
+    if let Some(mut way) = super::detour::detour(&scenario, from, v.goal(), v.max_pitch_deg) {
+        if lead.is_some() {
+            way.insert(0, r.p0);
+        }
         if way.len() > 2 {
             // Timed for the arrival; `warm_chromosome` resamples it like a plan.
             let way = at_even_speed(&way, r.t0, arrival);
@@ -265,26 +318,12 @@ pub fn replan(r: &Request) -> Replanned {
     };
     let mut solver = Pso::adaptive(PARTICLES, r.seed);
     let out = executor.run(&warm_problem, &mut solver, |_| {});
-    // A safe answer beats a cheaper unsafe one: the swarm's best can trade a grazed obstacle
-    // for a shorter, on-time path (the penalties are finite), where a warm start — the long
-    // way round, say, arriving late — is safe. The swarm's best still wins among safe ones.
-    let d_min = scenario.fleet.d_min_m;
-    let safe = |e: &shoal_common::vehicle_problem::VehicleEvaluation| {
-        e.terms.hard_hits == 0 && e.min_separation >= d_min
-    };
-    let mut best = problem.evaluate(out.state.best_position());
-    if !safe(&best) {
-        let fallback = warm_problem
-            .warm
-            .iter()
-            .map(|w| problem.evaluate(w))
-            .filter(|e| safe(e))
-            .min_by(|a, b| a.total.total_cmp(&b.total));
-        if let Some(e) = fallback {
-            best = e;
-        }
-    }
-    let safe = safe(&best);
+    let best = choose(
+        problem.evaluate(out.state.best_position()),
+        warm_problem.warm.iter().map(|w| problem.evaluate(w)),
+        scenario.fleet.d_min_m,
+    );
+    let safe = is_safe(&best, scenario.fleet.d_min_m);
     let trajectory = Trajectory {
         times: best.trajectory.times.iter().map(|t| t + r.t0).collect(),
         points: best.trajectory.points,
@@ -358,5 +397,71 @@ mod tests {
         assert_eq!(&g[0..3], &[250.0, 0.0, 100.0]);
         assert_eq!(&g[6..9], &[750.0, 0.0, 100.0]);
         Ok(())
+    }
+
+    fn candidate(hits: usize, separation: f64, motion: f64, total: f64) -> VehicleEvaluation {
+        VehicleEvaluation {
+            trajectory: line(0.0, 1.0),
+            terms: shoal_common::cost::VehicleTerms {
+                hard_hits: hits,
+                motion,
+                ..Default::default()
+            },
+            min_separation: separation,
+            total,
+        }
+    }
+
+    #[test]
+    fn the_answer_is_safe_then_flyable_then_cheapest() {
+        let pick =
+            |swarm, warm: Vec<VehicleEvaluation>| choose(swarm, warm.into_iter(), 50.0).total;
+        // The swarm's best is safe and clean: it is the answer.
+        assert_eq!(
+            pick(
+                candidate(0, 80.0, 0.0, 1.0),
+                vec![candidate(0, 80.0, 0.0, 3.0)]
+            ),
+            1.0
+        );
+        // It grazes an obstacle, or comes within d_min: the safe warm start wins.
+        assert_eq!(
+            pick(
+                candidate(1, 80.0, 0.0, 1.0),
+                vec![candidate(0, 80.0, 0.0, 3.0)]
+            ),
+            3.0
+        );
+        assert_eq!(
+            pick(
+                candidate(0, 49.0, 0.0, 1.0),
+                vec![candidate(0, 80.0, 0.0, 3.0)]
+            ),
+            3.0
+        );
+        // Safe with one slight turn violation (1.1): still within the slack of the clean one.
+        assert_eq!(
+            pick(
+                candidate(0, 80.0, 1.1, 1.0),
+                vec![candidate(0, 80.0, 0.0, 3.0)]
+            ),
+            1.0
+        );
+        // Safe but a string of reversals (9.0): the clean warm start wins.
+        assert_eq!(
+            pick(
+                candidate(0, 80.0, 9.0, 1.0),
+                vec![candidate(0, 80.0, 0.0, 3.0)]
+            ),
+            3.0
+        );
+        // Nothing safe: the swarm's best, reported unsafe by the caller.
+        assert_eq!(
+            pick(
+                candidate(2, 80.0, 0.0, 1.0),
+                vec![candidate(1, 80.0, 0.0, 3.0)]
+            ),
+            1.0
+        );
     }
 }
