@@ -371,6 +371,7 @@ mod tests {
             speed_max_mps: 1.5,
             max_turn_deg: 35.0,
             max_pitch_deg: 20.0,
+            turn_radius_m: None,
         }
     }
 

@@ -100,8 +100,8 @@ fn positive(flag: &str, v: f64) -> anyhow::Result<f64> {
     }
 }
 
-/// Plans, then executes; exit 0 when the execution kept d_min and every vehicle arrived in the
-/// window, 3 otherwise.
+/// Plans, then executes; exit 0 when the execution kept d_min, stayed out of every hard
+/// obstacle and every vehicle arrived in the window, 3 otherwise.
 pub fn run_command(args: &RunArgs, shutdown: Arc<AtomicBool>) -> anyhow::Result<i32> {
     let p = &args.plan;
     let scenario = crate::load_scenario(p)?;
@@ -228,10 +228,16 @@ pub fn run_command(args: &RunArgs, shutdown: Arc<AtomicBool>) -> anyhow::Result<
     })
 }
 
-/// Whether the execution kept d_min and had every vehicle arrive in the window.
+/// Whether the execution kept d_min, kept every executed track out of every hard obstacle
+/// (its physical sphere: the inflation is the planner's margin) and had every vehicle arrive in
+/// the window.
 pub fn execution_ok(r: &ExecutionReport) -> bool {
     let f = &r.figures;
-    f.min_separation_m.is_none_or(|d| d >= f.d_min_m) && f.all_arrived_in_window
+    f.min_separation_m.is_none_or(|d| d >= f.d_min_m)
+        && f.vehicles
+            .iter()
+            .all(|v| v.min_obstacle_clearance_m.is_none_or(|c| c > 0.0))
+        && f.all_arrived_in_window
 }
 
 /// The human summary of an execution.

@@ -5,8 +5,9 @@
 mod common;
 
 use std::path::PathBuf;
-use std::sync::atomic::AtomicBool;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc;
+use std::sync::Arc;
 use std::time::Duration;
 
 use common::{agent, finish, free_endpoint, Agent, TestResult};

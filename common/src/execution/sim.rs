@@ -398,6 +398,7 @@ mod tests {
             speed_max_mps,
             max_turn_deg,
             max_pitch_deg,
+            turn_radius_m: None,
         }
     }
 

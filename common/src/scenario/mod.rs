@@ -171,6 +171,10 @@ pub struct Vehicle {
     pub max_turn_deg: f64,
     /// Largest |pitch| of a leg, degrees (seed 004: 20°).
     pub max_pitch_deg: f64,
+    /// Turning radius when executing, metres (the simulated vehicle's; none of the seeds'
+    /// planners uses one). Absent: the simulator's default of 20 m, a mid-size survey AUV.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub turn_radius_m: Option<f64>,
 }
 
 impl Vehicle {
@@ -350,6 +354,15 @@ impl Scenario {
                     v.max_pitch_deg.to_string(),
                     "must be in (0, 90] degrees",
                 ));
+            }
+            if let Some(r) = v.turn_radius_m {
+                if !(r.is_finite() && r > 0.0) {
+                    return Err(bad(
+                        format!("vehicles[{i}].turn_radius_m"),
+                        r.to_string(),
+                        "must be a positive number of metres",
+                    ));
+                }
             }
         }
         if !(self.fleet.d_min_m.is_finite() && self.fleet.d_min_m >= 0.0) {

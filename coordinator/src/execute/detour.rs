@@ -11,9 +11,9 @@
 //! between points of the path) then spends.
 //!
 //! The way must be one the vehicle can fly: its pitch limit (±20° in seed 004) is built into
-//! the grid. Layers are `cell · tan(φ_max)` apart (a little less), every move goes one cell
-//! sideways and at most one layer up or down, so no grid move is steeper than the limit; a
-//! shortcut is taken only when it is no steeper either.
+//! the grid. Layers are `cell · tan(φ_max)` apart (a little less; a cell at most), every move
+//! goes one cell sideways and at most one layer up or down, so no grid move is steeper than the
+//! limit; a shortcut is taken only when it is no steeper either.
 
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;
@@ -62,7 +62,8 @@ impl Grid {
         let min = Vec3::from(scenario.bounds.min);
         let extent = Vec3::from(scenario.bounds.max) - min;
         let cell = (extent.x.max(extent.y) / CELLS).max(1.0);
-        let layer = (cell * LAYER_FRACTION * max_pitch.tan()).max(0.1);
+        // Steeper than 45° allowed: layers as far apart as cells (moves of up to 45°).
+        let layer = (cell * LAYER_FRACTION * max_pitch.tan()).clamp(0.1, cell);
         let step = [cell, cell, layer];
         let n = [0, 1, 2].map(|k| ((extent[k] / step[k]).floor() as usize + 1).max(1));
         let mut g = Grid {
@@ -330,7 +331,7 @@ mod tests {
             }
         }
         let l = length(&path);
-        assert!(l >= 1150.0 && l < 2500.0, "{l} m: {path:?}");
+        assert!((1150.0..2500.0).contains(&l), "{l} m: {path:?}");
         Ok(())
     }
 }

@@ -50,10 +50,12 @@ impl SimLink {
                 }
             }
         };
+        let defaults = SimSettings::default();
         let settings = SimSettings {
             position_noise_m,
             seed,
-            ..SimSettings::default()
+            turn_radius_m: vehicle.turn_radius_m.unwrap_or(defaults.turn_radius_m),
+            ..defaults
         };
         Ok(SimLink {
             sim: Simulator::new(vehicle, model, settings),
