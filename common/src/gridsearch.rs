@@ -9,8 +9,9 @@
 //! hazard grown by `clearance` and no sub-step is steeper than `max_slope_deg` — the same rules
 //! the crawler cost applies to the smoothed path.
 
-use std::cmp::Ordering;
 use std::collections::BinaryHeap;
+
+use crate::queue::Cheapest;
 
 use crate::terrain::{Hazard, Terrain};
 
@@ -60,20 +61,6 @@ pub struct GridPath {
     pub points: Vec<[f64; 2]>,
     /// 3D length on the draped terrain, metres.
     pub length_m: f64,
-}
-
-#[derive(PartialEq)]
-struct Entry(f64, usize);
-impl Eq for Entry {}
-impl PartialOrd for Entry {
-    fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
-        Some(self.cmp(other))
-    }
-}
-impl Ord for Entry {
-    fn cmp(&self, other: &Self) -> Ordering {
-        other.0.total_cmp(&self.0)
-    }
 }
 
 impl GridSearch<'_> {
@@ -137,9 +124,9 @@ impl GridSearch<'_> {
         let mut from = vec![usize::MAX; n];
         let mut heap = BinaryHeap::new();
         dist[s] = 0.0;
-        heap.push(Entry(0.0, s));
+        heap.push(Cheapest(0.0, s));
         let offsets = moves();
-        while let Some(Entry(d, u)) = heap.pop() {
+        while let Some(Cheapest(d, u)) = heap.pop() {
             if u == g {
                 break;
             }
@@ -159,7 +146,7 @@ impl GridSearch<'_> {
                 if d + w < dist[v] {
                     dist[v] = d + w;
                     from[v] = u;
-                    heap.push(Entry(d + w, v));
+                    heap.push(Cheapest(d + w, v));
                 }
             }
         }

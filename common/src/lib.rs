@@ -18,6 +18,7 @@ pub mod geometry;
 pub mod gridsearch;
 pub mod health;
 pub mod plan;
+pub mod queue;
 pub mod scenario;
 pub mod separation;
 pub mod stats;

@@ -228,16 +228,38 @@ pub fn run_command(args: &RunArgs, shutdown: Arc<AtomicBool>) -> anyhow::Result<
     })
 }
 
-/// Whether the execution kept d_min, kept every executed track out of every hard obstacle
-/// (its physical sphere: the inflation is the planner's margin) and had every vehicle arrive in
-/// the window.
-pub fn execution_ok(r: &ExecutionReport) -> bool {
+/// Why the execution falls short, in plain words: d_min broken, an executed track inside a hard
+/// obstacle (its physical sphere: the inflation is the planner's margin), a vehicle that did
+/// not arrive in the window. Empty when it met all three.
+pub fn execution_failures(r: &ExecutionReport) -> Vec<String> {
     let f = &r.figures;
-    f.min_separation_m.is_none_or(|d| d >= f.d_min_m)
-        && f.vehicles
-            .iter()
-            .all(|v| v.min_obstacle_clearance_m.is_none_or(|c| c > 0.0))
-        && f.all_arrived_in_window
+    let mut out = Vec::new();
+    if let Some(d) = f.min_separation_m.filter(|d| *d < f.d_min_m) {
+        out.push(format!(
+            "separation fell to {d:.1} m, under d_min {:.0} m",
+            f.d_min_m
+        ));
+    }
+    for v in &f.vehicles {
+        if let Some(c) = v.min_obstacle_clearance_m.filter(|c| *c <= 0.0) {
+            out.push(format!(
+                "{}'s track entered a hard obstacle ({:.1} m inside its surface)",
+                v.vehicle, -c
+            ));
+        }
+        if !v.in_window {
+            out.push(match v.arrived_s {
+                Some(t) => format!("{} arrived at {t:.0} s, outside the window", v.vehicle),
+                None => format!("{} never arrived", v.vehicle),
+            });
+        }
+    }
+    out
+}
+
+/// Whether the execution met everything [`execution_failures`] checks.
+pub fn execution_ok(r: &ExecutionReport) -> bool {
+    execution_failures(r).is_empty()
 }
 
 /// The human summary of an execution.
@@ -288,6 +310,12 @@ pub fn execution_summary(r: &ExecutionReport) -> String {
                 .map(|v| v.round())
                 .collect::<Vec<_>>()
         ));
+    }
+    let failures = execution_failures(r);
+    if failures.is_empty() {
+        s.push_str("  MET: d_min kept, no hard obstacle entered, every vehicle in the window\n");
+    } else {
+        s.push_str(&format!("  NOT MET: {}\n", failures.join("; ")));
     }
     s
 }

@@ -115,6 +115,7 @@ fn a_fleet_executes_its_plan_replans_around_a_new_obstacle_and_replays() -> Test
     }
     let r = fleet.wait(c, Instant::now() + LIMIT);
     assert_eq!(r.code(), Some(0), "{}\n{}", r.stdout, r.stderr);
+    assert!(r.stdout.contains("  MET: "), "{}", r.stdout);
     let report = execution_report(&out)?;
     let f = &report["figures"];
     assert!(num(f, "min_separation_m") >= 50.0, "{f}");
@@ -199,6 +200,11 @@ fn a_vehicle_that_stops_reporting_is_declared_lost_and_the_rest_arrive() -> Test
     let r = fleet.wait(c, Instant::now() + LIMIT);
     // auv3 never arrives: the execution is reported as not met (exit 3), with everything else.
     assert_eq!(r.code(), Some(3), "{}\n{}", r.stdout, r.stderr);
+    assert!(
+        r.stdout.contains("NOT MET: auv3 never arrived"),
+        "{}",
+        r.stdout
+    );
     let report = execution_report(&out)?;
     let f = &report["figures"];
     assert_eq!(f["vehicles"][2]["lost"], Value::Bool(true), "{f}");
@@ -273,6 +279,9 @@ fn an_inspection_tour_is_run_and_repaired_round_a_new_obstacle_keeping_its_point
         r.stdout,
         r.stderr
     );
+    if r.code() == Some(3) {
+        assert!(r.stdout.contains("NOT MET: "), "{}", r.stdout);
+    }
     let plan: Value = serde_json::from_str(&std::fs::read_to_string(out.join("plan.json"))?)?;
     let report = execution_report(&out)?;
     let f = &report["figures"];

@@ -7,8 +7,9 @@
 //! free cells) and the second by a Dijkstra distance from the goal over free cells, used as the
 //! search's guide (Dolgov et al.'s obstacle-aware heuristic).
 
-use std::cmp::Ordering;
 use std::collections::BinaryHeap;
+
+use crate::queue::Cheapest;
 
 use super::boxes::Rect;
 
@@ -24,24 +25,6 @@ pub struct ReachGrid {
     ny: usize,
     /// Region label per cell; `u32::MAX` = not free.
     label: Vec<u32>,
-}
-
-/// Dijkstra queue entry (min-heap on distance, then index for a total order).
-#[derive(PartialEq)]
-struct Entry(f64, usize);
-
-impl Eq for Entry {}
-
-impl Ord for Entry {
-    fn cmp(&self, other: &Self) -> Ordering {
-        other.0.total_cmp(&self.0).then(other.1.cmp(&self.1))
-    }
-}
-
-impl PartialOrd for Entry {
-    fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
-        Some(self.cmp(other))
-    }
 }
 
 /// The 8 neighbour offsets and their step lengths in cells.
@@ -160,9 +143,9 @@ impl ReachGrid {
             .filter(|&k| self.label[k] != u32::MAX)
         {
             dist[g] = 0.0;
-            heap.push(Entry(0.0, g));
+            heap.push(Cheapest(0.0, g));
         }
-        while let Some(Entry(d, k)) = heap.pop() {
+        while let Some(Cheapest(d, k)) = heap.pop() {
             if d > dist[k] || d > limit {
                 continue;
             }
@@ -179,7 +162,7 @@ impl ReachGrid {
                 let nd = d + len * self.cell;
                 if self.label[n] != u32::MAX && nd < dist[n] && nd <= limit {
                     dist[n] = nd;
-                    heap.push(Entry(nd, n));
+                    heap.push(Cheapest(nd, n));
                 }
             }
         }

@@ -15,10 +15,10 @@
 //! goes one cell sideways and at most one layer up or down, so no grid move is steeper than the
 //! limit; a shortcut is taken only when it is no steeper either.
 
-use std::cmp::Ordering;
 use std::collections::BinaryHeap;
 
 use shoal_common::geometry::{segment_hits_sphere, Vec3};
+use shoal_common::queue::Cheapest;
 use shoal_common::scenario::Scenario;
 
 /// Blocked cells: centre within this × the inflated radius of a hard obstacle.
@@ -29,25 +29,6 @@ const SHORTCUT_GROW: f64 = 1.08;
 const CELLS: f64 = 40.0;
 /// Layers are this fraction of the height a one-cell move may climb.
 const LAYER_FRACTION: f64 = 0.95;
-
-/// An open-list entry: estimated total cost and cell index.
-#[derive(PartialEq)]
-struct Open(f64, usize);
-
-impl Eq for Open {}
-
-impl PartialOrd for Open {
-    fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
-        Some(self.cmp(other))
-    }
-}
-
-impl Ord for Open {
-    /// Smallest estimate first out of the max-heap.
-    fn cmp(&self, other: &Self) -> Ordering {
-        other.0.total_cmp(&self.0).then(other.1.cmp(&self.1))
-    }
-}
 
 /// The grid over the scenario's bounds: node spacing per axis, `[cell, cell, layer]`.
 struct Grid {
@@ -127,8 +108,8 @@ impl Grid {
         let mut open = BinaryHeap::new();
         let goal = self.centre(to);
         best[from] = 0.0;
-        open.push(Open(Grid::cost(self.centre(from), goal), from));
-        while let Some(Open(_, k)) = open.pop() {
+        open.push(Cheapest(Grid::cost(self.centre(from), goal), from));
+        while let Some(Cheapest(_, k)) = open.pop() {
             if k == to {
                 let mut path = vec![to];
                 let mut at = to;
@@ -165,7 +146,7 @@ impl Grid {
                         if g < best[j] {
                             best[j] = g;
                             came[j] = k;
-                            open.push(Open(g + Grid::cost(there, goal), j));
+                            open.push(Cheapest(g + Grid::cost(there, goal), j));
                         }
                     }
                 }

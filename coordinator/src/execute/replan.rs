@@ -313,7 +313,8 @@ pub fn replan(r: &Request) -> Replanned {
     };
     let executor = Executor {
         max_iterations: 10_000,
-        time_limit: Some(r.budget),
+        // The warm starts (the A* way round) came out of the same budget.
+        time_limit: Some(r.budget.saturating_sub(started.elapsed())),
         ..Executor::default()
     };
     let mut solver = Pso::adaptive(PARTICLES, r.seed);
