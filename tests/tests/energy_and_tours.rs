@@ -117,18 +117,7 @@ fn de_pso_tours_inspect_every_cage_without_touching_one() -> TestResult {
 #[test]
 fn a_fleet_shares_the_inspection_points_and_keeps_apart() -> TestResult {
     let dir = tempfile::tempdir()?;
-    let json = plan_and_check(
-        "cages-fleet",
-        dir.path(),
-        &[
-            "--iterations",
-            "60",
-            "--particles",
-            "30",
-            "--algorithm",
-            "ldiw-pso",
-        ],
-    )?;
+    let json = plan_and_check("cages-fleet", dir.path(), &common::CAGES_FLEET_QUICK)?;
     assert_eq!(key(&json, "feasible").as_bool(), Some(true));
     let mut labels: Vec<String> = Vec::new();
     let mut lengths = Vec::new();

@@ -259,14 +259,7 @@ fn an_inspection_tour_is_run_and_repaired_round_a_new_obstacle_keeping_its_point
     let out = fleet.dir().join("out");
     let cmd = run_scenario(
         "cages-fleet",
-        &[
-            "--iterations",
-            "60",
-            "--particles",
-            "30",
-            "--algorithm",
-            "ldiw-pso",
-        ],
+        &common::CAGES_FLEET_QUICK,
         &out,
         "100",
         &["--inject-obstacle", INJECT_ON_TOUR],

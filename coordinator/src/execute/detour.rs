@@ -226,6 +226,25 @@ mod tests {
         Ok(s)
     }
 
+    /// `count` pairs of spheres (150 m, at z = 100 and 300) along x = 1000 from y = 0, `step`
+    /// apart.
+    fn wall(count: usize, step: f64) -> Vec<([f64; 3], f64)> {
+        (0..count)
+            .flat_map(|k| {
+                let y = step * k as f64;
+                [([1000.0, y, 100.0], 150.0), ([1000.0, y, 300.0], 150.0)]
+            })
+            .collect()
+    }
+
+    /// From one side of the wall to the other, at mid-height.
+    fn across() -> (Vec3, Vec3) {
+        (
+            Vec3::new(200.0, 500.0, 200.0),
+            Vec3::new(1800.0, 500.0, 200.0),
+        )
+    }
+
     fn length(p: &[Vec3]) -> f64 {
         p.windows(2).map(|w| (w[1] - w[0]).norm()).sum()
     }
@@ -243,20 +262,12 @@ mod tests {
 
     #[test]
     fn a_wall_of_spheres_is_gone_round_by_its_open_end() -> Result<(), Box<dyn std::error::Error>> {
-        // A wall across x = 1000 from y = 0 to about y = 1450 (spheres of 150 + 50 m every
-        // 250 m), floor to surface (400 m high column, the spheres reach both): the only way
-        // from (200, 500) to (1800, 500) is round its north end, past y ≈ 1450 + 200 × 1.15.
-        let wall: Vec<([f64; 3], f64)> = (0..6)
-            .flat_map(|k| {
-                let y = 250.0 * k as f64;
-                [([1000.0, y, 100.0], 150.0), ([1000.0, y, 300.0], 150.0)]
-            })
-            .collect();
-        let s = scenario(&wall)?;
-        let (a, b) = (
-            Vec3::new(200.0, 500.0, 200.0),
-            Vec3::new(1800.0, 500.0, 200.0),
-        );
+        // A wall across x = 1000 from y = 0 to y = 1250 (spheres of 150 + 50 m every 250 m),
+        // floor to surface (400 m high column, the spheres reach both): the only way from
+        // (200, 500) to (1800, 500) is round its north end. At z = 200, between the two
+        // spheres' centres, the inflated wall ends at y = 1250 + √(200² − 100²) ≈ 1423.
+        let s = scenario(&wall(6, 250.0))?;
+        let (a, b) = across();
         let path = detour(&s, a, b, 20.0).ok_or("no detour")?;
         assert_eq!(path.first(), Some(&a));
         assert_eq!(path.last(), Some(&b));
@@ -275,17 +286,8 @@ mod tests {
     #[test]
     fn no_way_through_a_closed_wall() -> Result<(), Box<dyn std::error::Error>> {
         // Spheres every 200 m along x = 1000, at both heights, over the whole width.
-        let wall: Vec<([f64; 3], f64)> = (0..=10)
-            .flat_map(|k| {
-                let y = 200.0 * k as f64;
-                [([1000.0, y, 100.0], 150.0), ([1000.0, y, 300.0], 150.0)]
-            })
-            .collect();
-        let s = scenario(&wall)?;
-        let (a, b) = (
-            Vec3::new(200.0, 500.0, 200.0),
-            Vec3::new(1800.0, 500.0, 200.0),
-        );
+        let s = scenario(&wall(11, 200.0))?;
+        let (a, b) = across();
         assert_eq!(detour(&s, a, b, 20.0), None);
         Ok(())
     }

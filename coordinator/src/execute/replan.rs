@@ -415,54 +415,25 @@ mod tests {
 
     #[test]
     fn the_answer_is_safe_then_flyable_then_cheapest() {
-        let pick =
-            |swarm, warm: Vec<VehicleEvaluation>| choose(swarm, warm.into_iter(), 50.0).total;
-        // The swarm's best is safe and clean: it is the answer.
-        assert_eq!(
-            pick(
-                candidate(0, 80.0, 0.0, 1.0),
-                vec![candidate(0, 80.0, 0.0, 3.0)]
-            ),
-            1.0
-        );
-        // It grazes an obstacle, or comes within d_min: the safe warm start wins.
-        assert_eq!(
-            pick(
-                candidate(1, 80.0, 0.0, 1.0),
-                vec![candidate(0, 80.0, 0.0, 3.0)]
-            ),
-            3.0
-        );
-        assert_eq!(
-            pick(
-                candidate(0, 49.0, 0.0, 1.0),
-                vec![candidate(0, 80.0, 0.0, 3.0)]
-            ),
-            3.0
-        );
-        // Safe with one slight turn violation (1.1): still within the slack of the clean one.
-        assert_eq!(
-            pick(
-                candidate(0, 80.0, 1.1, 1.0),
-                vec![candidate(0, 80.0, 0.0, 3.0)]
-            ),
-            1.0
-        );
-        // Safe but a string of reversals (9.0): the clean warm start wins.
-        assert_eq!(
-            pick(
-                candidate(0, 80.0, 9.0, 1.0),
-                vec![candidate(0, 80.0, 0.0, 3.0)]
-            ),
-            3.0
-        );
-        // Nothing safe: the swarm's best, reported unsafe by the caller.
-        assert_eq!(
-            pick(
-                candidate(2, 80.0, 0.0, 1.0),
-                vec![candidate(1, 80.0, 0.0, 3.0)]
-            ),
-            1.0
-        );
+        // (swarm's best, the one warm start, which wins), each as (hits, separation, motion
+        // penalty, cost); d_min 50 m.
+        let cases = [
+            // The swarm's best is safe and clean: it is the answer.
+            ((0, 80.0, 0.0, 1.0), (0, 80.0, 0.0, 3.0), 1.0),
+            // It grazes an obstacle, or comes within d_min: the safe warm start wins.
+            ((1, 80.0, 0.0, 1.0), (0, 80.0, 0.0, 3.0), 3.0),
+            ((0, 49.0, 0.0, 1.0), (0, 80.0, 0.0, 3.0), 3.0),
+            // Safe with one slight turn violation (1.1): within the slack of the clean one.
+            ((0, 80.0, 1.1, 1.0), (0, 80.0, 0.0, 3.0), 1.0),
+            // Safe but a string of reversals (9.0): the clean warm start wins.
+            ((0, 80.0, 9.0, 1.0), (0, 80.0, 0.0, 3.0), 3.0),
+            // Nothing safe: the swarm's best, reported unsafe by the caller.
+            ((2, 80.0, 0.0, 1.0), (1, 80.0, 0.0, 3.0), 1.0),
+        ];
+        for (swarm, warm, expected) in cases {
+            let c = |(h, s, m, t)| candidate(h, s, m, t);
+            let got = choose(c(swarm), std::iter::once(c(warm)), 50.0).total;
+            assert_eq!(got, expected, "swarm {swarm:?}, warm {warm:?}");
+        }
     }
 }

@@ -26,6 +26,16 @@ use process::{run, RUN_TIMEOUT};
 
 pub type TestResult = Result<(), Box<dyn Error>>;
 
+/// A small budget that plans `cages-fleet`'s two tours quickly and safely (LDIW-PSO legs).
+pub const CAGES_FLEET_QUICK: [&str; 6] = [
+    "--iterations",
+    "60",
+    "--particles",
+    "30",
+    "--algorithm",
+    "ldiw-pso",
+];
+
 /// `scenarios/<name>.toml`.
 pub fn scenario(name: &str) -> PathBuf {
     let p = root().join("scenarios").join(format!("{name}.toml"));
