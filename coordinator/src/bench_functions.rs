@@ -24,7 +24,7 @@ use shoal_common::swarm::ldiwpso::LdiwPso;
 use shoal_common::swarm::multi::MultiPso;
 use shoal_common::swarm::nspso::Nspso;
 use shoal_common::swarm::pso::Pso;
-use shoal_common::swarm::{Executor, Solver, SolverState};
+use shoal_common::swarm::{Executor, Solver, SolverState, VelocityCapped};
 
 mod markdown;
 pub use markdown::{markdown, number, HIT_TOLERANCE};
@@ -57,6 +57,10 @@ pub struct BenchFunctionsArgs {
     /// Particles M per run (Table 4: 30); multi-population solvers split them (see the legend).
     #[arg(long, env = "SHOAL_PARTICLES", default_value_t = 30)]
     pub particles: usize,
+    /// Velocity cap of every solver, as a fraction of each dimension's range (no seed gives
+    /// one). Default: each solver's own — 0.1 for seed 004's, 0.2 for the others.
+    #[arg(long, env = "SHOAL_MAX_VELOCITY_FRACTION")]
+    pub max_velocity_fraction: Option<f64>,
     /// Worker threads (default: all cores); the results do not depend on it.
     #[arg(long, env = "SHOAL_THREADS")]
     pub threads: Option<usize>,
@@ -69,12 +73,14 @@ pub struct BenchFunctionsArgs {
 }
 
 /// What one run needs besides the function and the seed.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RunSettings {
     /// Particles M.
     pub particles: usize,
     /// Iterations t_max.
     pub iterations: usize,
+    /// Velocity cap for every solver (a fraction of each range); `None`: each solver's own.
+    pub velocity_cap: Option<f64>,
 }
 
 /// What one run gives.
@@ -106,67 +112,67 @@ pub fn solvers() -> Vec<Algorithm> {
         a(
             "ipso",
             "seed 000 IPSO, Table 4: c1, c2 2 → 0.5, ω ∈ [0.4, 0.9] by fitness, p = 5 %",
-            |f, s, seed| run(f, s.iterations, Ipso::table8(s.particles, seed)),
+            |f, s, seed| run(f, s, Ipso::table8(s.particles, seed)),
         ),
         a(
             "spso",
             "seed 000 SPSO, Table 4: ω = 0.5, c1 = c2 = 2",
-            |f, s, seed| run(f, s.iterations, Pso::spso(s.particles, seed)),
+            |f, s, seed| run(f, s, Pso::spso(s.particles, seed)),
         ),
         a(
             "cbpso",
             "seed 000 CBPSO, Table 4: chaotic start (μ = 4), ω 0.9 → 0.4, c1 = c2 = 2",
-            |f, s, seed| run(f, s.iterations, Cbpso::table8(s.particles, seed)),
+            |f, s, seed| run(f, s, Cbpso::table8(s.particles, seed)),
         ),
         a(
             "nspso",
             "seed 000 NSPSO, Table 4: ω 0.9 → 0.4, c1 = c2 = 2, one objective",
-            |f, s, seed| run(f, s.iterations, Nspso::table8(s.particles, seed)),
+            |f, s, seed| run(f, s, Nspso::table8(s.particles, seed)),
         ),
         a(
             "aco-pso",
             "seed 000 ACO-PSO, Table 4: SPSO + continuous ant colony (α = 1, β = 5, ρ = 0.5)",
-            |f, s, seed| run(f, s.iterations, AcoPso::table8(s.particles, seed)),
+            |f, s, seed| run(f, s, AcoPso::table8(s.particles, seed)),
         ),
         a(
             "pso",
             "seed 004 PSO, Table 5 coefficients: ω = 0.15, c1 = c2 = 1.5",
-            |f, s, seed| run(f, s.iterations, Pso::classic(s.particles, seed)),
+            |f, s, seed| run(f, s, Pso::classic(s.particles, seed)),
         ),
         a(
             "a-pso",
             "seed 004 A-PSO: eq. (7) adaptive coefficients, one population",
-            |f, s, seed| run(f, s.iterations, Pso::adaptive(s.particles, seed)),
+            |f, s, seed| run(f, s, Pso::adaptive(s.particles, seed)),
         ),
         a(
             "mp-pso",
             "seed 004 MP-PSO: Table 5 coefficients, M split as below",
-            |f, s, seed| run(f, s.iterations, split(MultiPso::mp(seed), s.particles)),
+            |f, s, seed| run(f, s, split(MultiPso::mp(seed), s.particles)),
         ),
         a(
             "amp-pso",
             "seed 004 AMP-PSO: eq. (7)–(8), M split as below",
-            |f, s, seed| run(f, s.iterations, split(MultiPso::amp(seed), s.particles)),
+            |f, s, seed| run(f, s, split(MultiPso::amp(seed), s.particles)),
         ),
         a(
             "epa-pso",
             "seed 001 EPA-PSO, Table 2: velocity jump, eq. (16) schedule, eq. (17) restarts",
-            |f, s, seed| run(f, s.iterations, EpaPso::table2(s.particles, seed)),
+            |f, s, seed| run(f, s, EpaPso::table2(s.particles, seed)),
         ),
         a(
             "ldiw-pso",
             "seed 003 LDIW-PSO, Table 5: ω 0.9 → 0.4, c1 = 2, c2 = 1.5",
-            |f, s, seed| run(f, s.iterations, LdiwPso::table5(s.particles, seed)),
+            |f, s, seed| run(f, s, LdiwPso::table5(s.particles, seed)),
         ),
         a(
             "lcpso",
             "seed 003 LCPSO, Table 5: logistic-chaos inertia (eq. 4–10)",
-            |f, s, seed| run(f, s.iterations, Lcpso::table5(s.particles, seed)),
+            |f, s, seed| run(f, s, Lcpso::table5(s.particles, seed)),
         ),
         a(
             "de-pso",
             "seed 003 DE-PSO, Table 5: PSO move + DE/best/1/bin (F = 0.8, CR = 0.6); 2 evaluations per particle per iteration",
-            |f, s, seed| run(f, s.iterations, DePso::table5(s.particles, seed)),
+            |f, s, seed| run(f, s, DePso::table5(s.particles, seed)),
         ),
     ]
 }
@@ -189,13 +195,14 @@ pub fn split(mut m: MultiPso, particles: usize) -> MultiPso {
     m
 }
 
-/// One run of `solver` on `f` for `iterations` iterations.
-fn run<'a, S: Solver<&'a dyn Benchmark>>(
+/// One run of `solver` on `f` with the suite's budget and velocity cap.
+fn run<'a, S: Solver<&'a dyn Benchmark> + VelocityCapped>(
     f: &'a dyn Benchmark,
-    iterations: usize,
-    mut solver: S,
+    settings: RunSettings,
+    solver: S,
 ) -> RunResult {
-    let out = Executor::new(iterations).run(&f, &mut solver, |_| {});
+    let mut solver = solver.capped(settings.velocity_cap);
+    let out = Executor::new(settings.iterations).run(&f, &mut solver, |_| {});
     RunResult {
         best: out.state.best_cost(),
         evaluations: out.state.evaluations(),
@@ -267,6 +274,8 @@ pub struct Report {
     pub iterations: usize,
     /// Base seed.
     pub seed: u64,
+    /// Velocity cap given to every solver (`None`: each solver's own).
+    pub velocity_cap: Option<f64>,
     /// Functions, in table order.
     pub functions: Vec<FunctionInfo>,
     /// Algorithm names, in table order.
@@ -314,10 +323,19 @@ pub fn bench_functions(
     };
     let functions = pick_functions(&args.functions, args.dim)?;
     let algorithms = pick_algorithms(&args.algorithms)?;
+    if let Some(cap) = args.max_velocity_fraction {
+        if !(cap > 0.0 && cap <= 1.0) {
+            bail!("--max-velocity-fraction = {cap}: must be in (0, 1]");
+        }
+    }
     let settings = RunSettings {
         particles: args.particles,
         iterations: args.iterations,
+        velocity_cap: args.max_velocity_fraction,
     };
+    // Seeds follow a function's place in the whole table, not in the selection, so
+    // `--functions kowalik` repeats exactly the Kowalik runs of the full suite.
+    let table_index: Vec<usize> = functions.iter().map(|f| table_position(f.key())).collect();
     let (nf, na, nr) = (functions.len(), algorithms.len(), args.runs);
     let total = nf * na * nr;
     let next = AtomicUsize::new(0);
@@ -339,7 +357,7 @@ pub fn bench_functions(
                 break;
             }
             let (fi, ai, r) = (k / (na * nr), (k / nr) % na, k % nr);
-            let seed = run_seed(args.seed, fi, r);
+            let seed = run_seed(args.seed, table_index[fi], r);
             let result = (algorithms[ai].run)(functions[fi].as_ref(), settings, seed);
             progress(&RunReport {
                 done: done.fetch_add(1, Ordering::Relaxed) + 1,
@@ -376,6 +394,7 @@ pub fn bench_functions(
         particles: args.particles,
         iterations: args.iterations,
         seed: args.seed,
+        velocity_cap: args.max_velocity_fraction,
         functions: functions
             .iter()
             .map(|f| FunctionInfo {
@@ -411,8 +430,16 @@ fn pick_functions(keys: &[String], dim: usize) -> anyhow::Result<Vec<Box<dyn Ben
         }
     }
     // Table order, whatever the order on the command line.
-    picked.sort_by_key(|f| benchfns::KEYS.iter().position(|k| *k == f.key()));
+    picked.sort_by_key(|f| table_position(f.key()));
     Ok(picked)
+}
+
+/// Place of the function `key` in the whole suite (table order).
+fn table_position(key: &str) -> usize {
+    benchfns::KEYS
+        .iter()
+        .position(|k| *k == key)
+        .unwrap_or(benchfns::KEYS.len())
 }
 
 fn pick_algorithms(names: &[String]) -> anyhow::Result<Vec<Algorithm>> {

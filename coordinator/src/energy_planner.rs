@@ -11,7 +11,7 @@ use shoal_common::scenario::{Algorithm, Scenario};
 use shoal_common::swarm::epapso::EpaPso;
 use shoal_common::swarm::population::{Coefficients, Schedule};
 use shoal_common::swarm::pso::Pso;
-use shoal_common::swarm::{Executor, IterationReport, Termination};
+use shoal_common::swarm::{Executor, IterationReport, Termination, VelocityCapped};
 use shoal_common::trajectory::Trajectory;
 
 use crate::planner::{run_solver, RunResult};
@@ -60,13 +60,13 @@ pub fn plan(
     let run = match o.algorithm {
         Algorithm::EpaPso => run_solver(
             &problem,
-            EpaPso::table2(o.particles, o.seed),
+            EpaPso::table2(o.particles, o.seed).capped(o.max_velocity_fraction),
             &executor,
             observe,
         ),
         _ => run_solver(
             &problem,
-            baseline_pso(o.particles, o.seed),
+            baseline_pso(o.particles, o.seed).capped(o.max_velocity_fraction),
             &executor,
             observe,
         ),

@@ -9,11 +9,13 @@ use shoal_common::scenario::{Algorithm, Scenario};
 use shoal_common::swarm::acopso::AcoPso;
 use shoal_common::swarm::cbpso::Cbpso;
 use shoal_common::swarm::ipso::Ipso;
-use shoal_common::swarm::multi::MultiPso;
+use shoal_common::swarm::multi::{MultiPso, SEED004_VELOCITY_CAP};
 use shoal_common::swarm::nspso::Nspso;
 use shoal_common::swarm::population::Schedule;
 use shoal_common::swarm::pso::Pso;
-use shoal_common::swarm::{Executor, IterationReport, Problem, Solver, SolverState, Termination};
+use shoal_common::swarm::{
+    Executor, IterationReport, Problem, Solver, SolverState, Termination, VelocityCapped,
+};
 
 /// What an optimizer run leaves behind, whatever the algorithm and the mode.
 pub struct RunResult {
@@ -66,16 +68,18 @@ pub fn plan_in_process(
         leader_particles: o.leader_particles,
         exchange_every: o.exchange_every,
         schedule,
-        max_velocity_fraction: o.max_velocity_fraction,
+        max_velocity_fraction: o.velocity_cap(SEED004_VELOCITY_CAP),
         threads: o.threads,
         seed: o.seed,
     };
     let single = |schedule| Pso {
         particles: o.particles,
         schedule,
-        max_velocity_fraction: o.max_velocity_fraction,
+        max_velocity_fraction: o.velocity_cap(SEED004_VELOCITY_CAP),
         seed: o.seed,
     };
+    // Seed 000's solvers keep their own cap unless the scenario sets one.
+    let (cap, m, seed) = (o.max_velocity_fraction, o.particles, o.seed);
     let run = match o.algorithm {
         Algorithm::AmpPso => run_solver(&model, multi(Schedule::Adaptive), &executor, observe),
         Algorithm::MpPso => run_solver(&model, multi(Schedule::TABLE5_FIXED), &executor, observe),
@@ -83,26 +87,26 @@ pub fn plan_in_process(
         Algorithm::Pso => run_solver(&model, single(Schedule::TABLE5_FIXED), &executor, observe),
         Algorithm::Ipso => run_solver(
             &model,
-            Ipso::table8(o.particles, o.seed),
+            Ipso::table8(m, seed).capped(cap),
             &executor,
             observe,
         ),
-        Algorithm::Spso => run_solver(&model, Pso::spso(o.particles, o.seed), &executor, observe),
+        Algorithm::Spso => run_solver(&model, Pso::spso(m, seed).capped(cap), &executor, observe),
         Algorithm::Cbpso => run_solver(
             &model,
-            Cbpso::table8(o.particles, o.seed),
+            Cbpso::table8(m, seed).capped(cap),
             &executor,
             observe,
         ),
         Algorithm::Nspso => run_solver(
             &model,
-            Nspso::table8(o.particles, o.seed),
+            Nspso::table8(m, seed).capped(cap),
             &executor,
             observe,
         ),
         Algorithm::AcoPso => run_solver(
             &model,
-            AcoPso::table8(o.particles, o.seed),
+            AcoPso::table8(m, seed).capped(cap),
             &executor,
             observe,
         ),
@@ -153,5 +157,40 @@ pub fn to_plan(scenario: &Scenario, model: &FleetModel, run: RunResult, mode: &s
         fleet: assessment.fleet,
         convergence: run.convergence,
         distributed: None,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::path::Path;
+
+    fn dsmv(cap: Option<f64>) -> Scenario {
+        let file = concat!(env!("CARGO_MANIFEST_DIR"), "/../scenarios/ipso-dsmv.toml");
+        let mut s = Scenario::load(Path::new(file)).unwrap_or_else(|e| panic!("{e}"));
+        s.optimizer.iterations = 15;
+        s.optimizer.particles = 20;
+        s.optimizer.max_velocity_fraction = cap;
+        s
+    }
+
+    fn fitness(s: &Scenario) -> f64 {
+        plan_in_process(s, None, &mut |_| {}).fitness
+    }
+
+    #[test]
+    fn a_seed000_solver_runs_with_the_scenarios_velocity_cap_when_it_sets_one() {
+        for algorithm in [Algorithm::Ipso, Algorithm::Spso, Algorithm::Cbpso] {
+            let with = |cap| {
+                let mut s = dsmv(cap);
+                s.optimizer.algorithm = algorithm;
+                fitness(&s)
+            };
+            let own = with(None);
+            // Unset keeps the solver's own cap (Table 4's solvers: 0.2) ...
+            assert_eq!(own, with(Some(0.2)), "{algorithm:?}");
+            // ... and a set cap is the one the swarm moves under.
+            assert_ne!(own, with(Some(0.02)), "{algorithm:?}");
+        }
     }
 }

@@ -88,6 +88,51 @@ fn results_do_not_depend_on_the_thread_count() {
     }
 }
 
+#[test]
+fn one_function_alone_repeats_its_runs_of_the_larger_suite() {
+    let both = bench_functions(&args(&["--threads", "2"]), &AtomicBool::new(false), &|_| {});
+    let mut a = args(&["--threads", "2"]);
+    a.functions = vec!["branin".into()];
+    let alone = bench_functions(&a, &AtomicBool::new(false), &|_| {});
+    match (both, alone) {
+        (Ok(both), Ok(alone)) => {
+            for algorithm in ["ipso", "spso"] {
+                assert_eq!(
+                    both.cell("branin", algorithm),
+                    alone.cell("branin", algorithm),
+                    "{algorithm}: Branin alone must give the suite's Branin runs"
+                );
+            }
+        }
+        (a, b) => panic!("suite failed: {a:?} {b:?}"),
+    }
+}
+
+#[test]
+fn the_velocity_cap_flag_reaches_every_solver() {
+    // Few iterations, so the runs stop short of the optimum and show how the swarm moved.
+    let suite = |extra: &[&str]| {
+        let mut a = args(extra);
+        a.iterations = 5;
+        bench_functions(&a, &AtomicBool::new(false), &|_| {})
+            .unwrap_or_else(|e| panic!("suite failed: {e:#}"))
+    };
+    let own = suite(&[]);
+    // IPSO's and SPSO's own cap is 0.2: naming it changes nothing; another cap changes the runs.
+    let named = suite(&["--max-velocity-fraction", "0.2"]);
+    assert_eq!(own.cells, named.cells);
+    assert!(markdown(&own).contains("velocity cap each solver's own"));
+    assert!(markdown(&named).contains("velocity cap 0.2 of each range for every solver"));
+    let tight = suite(&["--max-velocity-fraction", "0.01"]);
+    for algorithm in ["ipso", "spso"] {
+        assert_ne!(
+            own.cell("branin", algorithm),
+            tight.cell("branin", algorithm),
+            "{algorithm} ignored the cap"
+        );
+    }
+}
+
 fn error(a: &BenchFunctionsArgs) -> String {
     match bench_functions(a, &AtomicBool::new(false), &|_| {}) {
         Ok(_) => panic!("{a:?} should be refused"),
@@ -109,6 +154,9 @@ fn bad_names_and_settings_are_errors_not_panics() {
     let mut a = args(&[]);
     a.threads = Some(0);
     assert!(error(&a).contains("--threads"));
+    let mut a = args(&[]);
+    a.max_velocity_fraction = Some(0.0);
+    assert!(error(&a).contains("--max-velocity-fraction = 0"));
     // Stopped before it starts: an empty, incomplete report.
     let r = bench_functions(&args(&[]), &AtomicBool::new(true), &|_| {})
         .unwrap_or_else(|e| panic!("{e:#}"));

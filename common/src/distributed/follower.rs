@@ -11,7 +11,7 @@ use std::sync::Arc;
 use super::{Chromosome, Context};
 use crate::cost::FleetModel;
 use crate::scenario::{Algorithm, OptimizerSettings};
-use crate::swarm::multi::stream_seed;
+use crate::swarm::multi::{stream_seed, SEED004_VELOCITY_CAP};
 use crate::swarm::parallel;
 use crate::swarm::population::{Limits, Particle, Population, Schedule};
 use crate::swarm::{Problem, Progress};
@@ -45,7 +45,7 @@ impl FollowerSettings {
                 Algorithm::AmpPso | Algorithm::APso => Schedule::Adaptive,
                 _ => Schedule::TABLE5_FIXED,
             },
-            max_velocity_fraction: o.max_velocity_fraction,
+            max_velocity_fraction: o.velocity_cap(SEED004_VELOCITY_CAP),
             threads: o.threads,
             seed: o.seed,
         }

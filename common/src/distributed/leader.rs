@@ -13,7 +13,7 @@ use std::sync::Arc;
 use super::{Chromosome, Context};
 use crate::cost::FleetModel;
 use crate::scenario::OptimizerSettings;
-use crate::swarm::multi::stream_seed;
+use crate::swarm::multi::{stream_seed, SEED004_VELOCITY_CAP};
 use crate::swarm::parallel;
 use crate::swarm::population::{trusted_best, update, Limits, Particle, Population, Schedule};
 use crate::swarm::{Problem, Progress};
@@ -44,7 +44,7 @@ impl Leader {
             o.leader_particles.max(1),
             stream_seed(o.seed, o.populations as u64),
         );
-        let limits = Limits::of(model.as_ref(), o.max_velocity_fraction);
+        let limits = Limits::of(model.as_ref(), o.velocity_cap(SEED004_VELOCITY_CAP));
         Leader {
             evaluations: leader.evaluations,
             best_x: leader.elite_x.clone(),

@@ -144,9 +144,11 @@ pub struct OptimizerSettings {
     /// Weight of the constraint penalties (hard obstacles, turn, pitch, separation) that turn the
     /// constrained problem into an unconstrained one (§3.3.1, ref. [30]).
     pub penalty_weight: f64,
-    /// Velocity limit per dimension as a fraction of that dimension's range. Eq. (7) starts ω at 2,
-    /// which diverges without a limit; 0.1 is the common PSO choice.
-    pub max_velocity_fraction: f64,
+    /// Velocity limit per dimension as a fraction of that dimension's range, for whichever
+    /// algorithm plans. Unset, each algorithm keeps its own ([`OptimizerSettings::velocity_cap`]):
+    /// 0.1 for seed 004's (eq. (7) starts ω at 2, which diverges without a limit), 0.2 for
+    /// seeds 000, 001 and 003's.
+    pub max_velocity_fraction: Option<f64>,
     /// Worker threads for population steps (results do not depend on it).
     pub threads: usize,
     /// How the multi-population algorithms split over vehicle agents (distributed mode only).
@@ -201,7 +203,7 @@ impl Default for OptimizerSettings {
             seed: 1,
             weights: [0.2, 0.1, 0.3, 0.1, 0.3],
             penalty_weight: 10.0,
-            max_velocity_fraction: 0.1,
+            max_velocity_fraction: None,
             threads: 2,
             distributed: DistributedSettings::default(),
         }
@@ -250,13 +252,21 @@ impl OptimizerSettings {
                 "must be positive",
             ));
         }
-        if !(o.max_velocity_fraction > 0.0 && o.max_velocity_fraction <= 1.0) {
-            return Err(bad(
-                "optimizer.max_velocity_fraction".into(),
-                o.max_velocity_fraction.to_string(),
-                "must be in (0, 1]",
-            ));
+        if let Some(cap) = o.max_velocity_fraction {
+            if !(cap > 0.0 && cap <= 1.0) {
+                return Err(bad(
+                    "optimizer.max_velocity_fraction".into(),
+                    cap.to_string(),
+                    "must be in (0, 1]",
+                ));
+            }
         }
         Ok(())
+    }
+
+    /// The velocity cap an algorithm whose own cap is `own` runs with: the scenario's when it
+    /// sets one, else `own`.
+    pub fn velocity_cap(&self, own: f64) -> f64 {
+        self.max_velocity_fraction.unwrap_or(own)
     }
 }

@@ -132,3 +132,27 @@ fn algorithm_names_round_trip() {
     }
     assert!("ga".parse::<Algorithm>().is_err());
 }
+
+#[test]
+fn the_velocity_cap_is_the_algorithms_own_unless_the_file_sets_one() -> Result<(), ScenarioError> {
+    let unset = parse(GOOD)?;
+    assert_eq!(unset.optimizer.max_velocity_fraction, None);
+    assert_eq!(unset.optimizer.velocity_cap(0.2), 0.2);
+    assert_eq!(unset.optimizer.velocity_cap(0.1), 0.1);
+    let set = parse(&(GOOD.to_string() + "[optimizer]\nmax_velocity_fraction = 0.05\n"))?;
+    assert_eq!(set.optimizer.velocity_cap(0.2), 0.05);
+    assert_eq!(set.optimizer.velocity_cap(0.1), 0.05);
+    for bad in ["0.0", "1.5", "-0.1"] {
+        let text = GOOD.to_string() + &format!("[optimizer]\nmax_velocity_fraction = {bad}\n");
+        let msg = parse(&text)
+            .err()
+            .map(|e| e.to_string())
+            .unwrap_or_default();
+        assert!(
+            msg.contains("optimizer.max_velocity_fraction")
+                && msg.contains(bad.trim_end_matches(".0")),
+            "{bad}: {msg}"
+        );
+    }
+    Ok(())
+}

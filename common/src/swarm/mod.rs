@@ -124,6 +124,46 @@ pub trait Solver<P: Problem> {
     fn step(&mut self, problem: &P, state: Self::State, progress: Progress) -> Self::State;
 }
 
+/// A solver whose moves are capped at a fraction of each dimension's range. None of the seeds
+/// gives the cap, so each solver carries its own default and a scenario (or a command) may set
+/// one for all.
+pub trait VelocityCapped: Sized {
+    /// The cap, as a fraction of each dimension's range.
+    fn velocity_cap_mut(&mut self) -> &mut f64;
+
+    /// This solver with its cap set to `cap`, or left as it is for `None`.
+    fn capped(mut self, cap: Option<f64>) -> Self {
+        if let Some(c) = cap {
+            *self.velocity_cap_mut() = c;
+        }
+        self
+    }
+}
+
+/// Implements [`VelocityCapped`] for solvers with a `max_velocity_fraction` field.
+macro_rules! velocity_capped {
+    ($($solver:ty),+) => {$(
+        impl VelocityCapped for $solver {
+            fn velocity_cap_mut(&mut self) -> &mut f64 {
+                &mut self.max_velocity_fraction
+            }
+        }
+    )+};
+}
+
+velocity_capped!(
+    ipso::Ipso,
+    pso::Pso,
+    cbpso::Cbpso,
+    nspso::Nspso,
+    acopso::AcoPso,
+    multi::MultiPso,
+    epapso::EpaPso,
+    ldiwpso::LdiwPso,
+    lcpso::Lcpso,
+    depso::DePso
+);
+
 /// Why a run ended.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
 #[serde(rename_all = "kebab-case")]

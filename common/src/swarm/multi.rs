@@ -10,6 +10,10 @@
 use super::population::{trusted_best, update, Limits, Particle, Population, Schedule};
 use super::{parallel, Problem, Progress, Solver, SolverState};
 
+/// Velocity cap of seed 004's solvers, as a fraction of each dimension's range: eq. (7) starts
+/// ω at 2, which diverges without a limit; 0.1 is the common PSO choice (docs/AMP-PSO.md).
+pub const SEED004_VELOCITY_CAP: f64 = 0.1;
+
 /// Multi-population PSO with a leader.
 #[derive(Debug, Clone)]
 pub struct MultiPso {
@@ -40,7 +44,7 @@ impl MultiPso {
             leader_particles: 20,
             exchange_every: 1,
             schedule: Schedule::Adaptive,
-            max_velocity_fraction: 0.1,
+            max_velocity_fraction: SEED004_VELOCITY_CAP,
             threads: 2,
             seed,
         }

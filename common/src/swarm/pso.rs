@@ -23,7 +23,7 @@ impl Pso {
         Pso {
             particles,
             schedule: Schedule::TABLE5_FIXED,
-            max_velocity_fraction: 0.1,
+            max_velocity_fraction: super::multi::SEED004_VELOCITY_CAP,
             seed,
         }
     }

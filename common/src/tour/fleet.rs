@@ -106,6 +106,7 @@ impl FleetTours {
                     iterations: o.iterations,
                     waypoints: o.waypoints,
                     clearance_m: 0.0,
+                    velocity_cap: o.max_velocity_fraction,
                 },
             },
             seed: o.seed,

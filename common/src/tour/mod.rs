@@ -37,7 +37,7 @@ use crate::swarm::depso::DePso;
 use crate::swarm::lcpso::Lcpso;
 use crate::swarm::ldiwpso::LdiwPso;
 use crate::swarm::multi::stream_seed;
-use crate::swarm::{Executor, SolverState};
+use crate::swarm::{Executor, SolverState, VelocityCapped};
 
 /// Clearance the leg planner keeps from a cage's surface, metres. The seed treats the AUV as a
 /// point and the cage sphere itself as the obstacle; 1 m of margin stays well inside the 5 m
@@ -78,6 +78,9 @@ pub struct LegSettings {
     pub waypoints: usize,
     /// Margin added to every cage radius, metres ([`LEG_CLEARANCE_M`]).
     pub clearance_m: f64,
+    /// Velocity cap for the leg's swarm (a fraction of each range); `None` keeps the
+    /// algorithm's own (Table 5's solvers: 0.2).
+    pub velocity_cap: Option<f64>,
 }
 
 impl LegSettings {
@@ -88,6 +91,7 @@ impl LegSettings {
             iterations: 400,
             waypoints: 29,
             clearance_m: LEG_CLEARANCE_M,
+            velocity_cap: None,
         }
     }
 }
@@ -150,19 +154,20 @@ pub fn plan_leg(
     }
     let ex = Executor::new(settings.iterations);
     let m = settings.particles;
+    let cap = settings.velocity_cap;
     let best = match algorithm {
         LegAlgorithm::DePso => ex
-            .run(problem, &mut DePso::table5(m, seed), |_| {})
+            .run(problem, &mut DePso::table5(m, seed).capped(cap), |_| {})
             .state
             .best_position()
             .to_vec(),
         LegAlgorithm::LdiwPso => ex
-            .run(problem, &mut LdiwPso::table5(m, seed), |_| {})
+            .run(problem, &mut LdiwPso::table5(m, seed).capped(cap), |_| {})
             .state
             .best_position()
             .to_vec(),
         LegAlgorithm::Lcpso => ex
-            .run(problem, &mut Lcpso::table5(m, seed), |_| {})
+            .run(problem, &mut Lcpso::table5(m, seed).capped(cap), |_| {})
             .state
             .best_position()
             .to_vec(),
@@ -261,6 +266,7 @@ mod tests {
                 iterations: 150,
                 waypoints: 9,
                 clearance_m: LEG_CLEARANCE_M,
+                velocity_cap: None,
             },
         }
     }

@@ -59,12 +59,16 @@ fn write_markdown(s: &mut String, r: &Report) -> std::fmt::Result {
     )?;
     writeln!(
         s,
-        "M = {} particles, t_max = {} iterations{}, base seed {}. Lower is better; f* is the \
-         function's known minimum. Bold: the lowest best and mean of the row.\n",
+        "M = {} particles, t_max = {} iterations{}, base seed {}, velocity cap {}. Lower is \
+         better; f* is the function's known minimum. Bold: the lowest best and mean of the row.\n",
         r.particles,
         r.iterations,
         scalable_dim.map_or(String::new(), |d| format!(", D = {d} for f1–f8")),
-        r.seed
+        r.seed,
+        r.velocity_cap.map_or_else(
+            || "each solver's own (seed 004's 0.1, the others' 0.2 of each range)".to_string(),
+            |c| format!("{c} of each range for every solver")
+        ),
     )?;
     if !r.complete {
         writeln!(
@@ -285,6 +289,7 @@ mod tests {
             particles: 30,
             iterations: 300,
             seed: 1,
+            velocity_cap: None,
             functions: vec![FunctionInfo {
                 key: "sphere".into(),
                 label: "f1".into(),
