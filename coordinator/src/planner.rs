@@ -166,8 +166,12 @@ mod tests {
     use std::path::Path;
 
     fn dsmv(cap: Option<f64>) -> Scenario {
-        let file = concat!(env!("CARGO_MANIFEST_DIR"), "/../scenarios/ipso-dsmv.toml");
-        let mut s = Scenario::load(Path::new(file)).unwrap_or_else(|e| panic!("{e}"));
+        small("ipso-dsmv", cap)
+    }
+
+    fn small(name: &str, cap: Option<f64>) -> Scenario {
+        let file = format!("{}/../scenarios/{name}.toml", env!("CARGO_MANIFEST_DIR"));
+        let mut s = Scenario::load(Path::new(&file)).unwrap_or_else(|e| panic!("{e}"));
         s.optimizer.iterations = 15;
         s.optimizer.particles = 20;
         s.optimizer.max_velocity_fraction = cap;
@@ -190,6 +194,20 @@ mod tests {
             // Unset keeps the solver's own cap (Table 4's solvers: 0.2) ...
             assert_eq!(own, with(Some(0.2)), "{algorithm:?}");
             // ... and a set cap is the one the swarm moves under.
+            assert_ne!(own, with(Some(0.02)), "{algorithm:?}");
+        }
+    }
+
+    #[test]
+    fn seed001s_planners_run_with_the_scenarios_velocity_cap_when_it_sets_one() {
+        for algorithm in [Algorithm::EpaPso, Algorithm::MPso] {
+            let with = |cap| {
+                let mut s = small("epa-pso", cap);
+                s.optimizer.algorithm = algorithm;
+                fitness(&s)
+            };
+            let own = with(None);
+            assert_eq!(own, with(Some(0.2)), "{algorithm:?}");
             assert_ne!(own, with(Some(0.02)), "{algorithm:?}");
         }
     }

@@ -400,4 +400,40 @@ mod tests {
         assert_eq!(leg, vec![p.start, p.end]);
         assert_eq!(LegAlgorithm::Lcpso.name(), "lcpso");
     }
+
+    #[test]
+    fn a_legs_swarm_moves_under_the_settings_velocity_cap() {
+        // The cage sits on the straight line, so the swarm has to plan.
+        let s = safety_spheres(&[Cage::new("X", 50.0, 0.0, 0.0, 10.0)], 1.0);
+        let p = LegProblem::new(
+            Vec3::zeros(),
+            Vec3::new(100.0, 0.0, 0.0),
+            s,
+            paper_bounds(),
+            5,
+        );
+        for algorithm in [
+            LegAlgorithm::DePso,
+            LegAlgorithm::LdiwPso,
+            LegAlgorithm::Lcpso,
+        ] {
+            let with = |cap| {
+                let settings = LegSettings {
+                    iterations: 10,
+                    velocity_cap: cap,
+                    ..small().leg
+                };
+                plan_leg(&p, algorithm, &settings, 3)
+            };
+            let own = with(None);
+            assert_ne!(
+                own,
+                vec![p.start, p.end],
+                "{algorithm:?} kept a blocked leg"
+            );
+            // Table 5's solvers' own cap is 0.2: naming it changes nothing, another cap does.
+            assert_eq!(own, with(Some(0.2)), "{algorithm:?}");
+            assert_ne!(own, with(Some(0.005)), "{algorithm:?}");
+        }
+    }
 }
