@@ -324,7 +324,7 @@ pub fn bench_functions(
     let functions = pick_functions(&args.functions, args.dim)?;
     let algorithms = pick_algorithms(&args.algorithms)?;
     if let Some(cap) = args.max_velocity_fraction {
-        if !(cap > 0.0 && cap <= 1.0) {
+        if !shoal_common::swarm::is_valid_velocity_cap(cap) {
             bail!("--max-velocity-fraction = {cap}: must be in (0, 1]");
         }
     }

@@ -253,7 +253,7 @@ impl OptimizerSettings {
             ));
         }
         if let Some(cap) = o.max_velocity_fraction {
-            if !(cap > 0.0 && cap <= 1.0) {
+            if !crate::swarm::is_valid_velocity_cap(cap) {
                 return Err(bad(
                     "optimizer.max_velocity_fraction".into(),
                     cap.to_string(),

@@ -124,6 +124,12 @@ pub trait Solver<P: Problem> {
     fn step(&mut self, problem: &P, state: Self::State, progress: Progress) -> Self::State;
 }
 
+/// Whether `cap` is a usable velocity cap: a fraction of each dimension's range in (0, 1]
+/// (NaN is not).
+pub fn is_valid_velocity_cap(cap: f64) -> bool {
+    cap > 0.0 && cap <= 1.0
+}
+
 /// A solver whose moves are capped at a fraction of each dimension's range. None of the seeds
 /// gives the cap, so each solver carries its own default and a scenario (or a command) may set
 /// one for all.
@@ -288,6 +294,16 @@ mod tests {
     use super::pso::Pso;
     use super::testfns::{Rastrigin, ShiftedSphere};
     use super::*;
+
+    #[test]
+    fn a_velocity_cap_is_a_fraction_in_zero_to_one() {
+        for ok in [1e-9, 0.1, 1.0] {
+            assert!(is_valid_velocity_cap(ok), "{ok}");
+        }
+        for bad in [0.0, -0.1, 1.0 + 1e-12, f64::NAN, f64::INFINITY] {
+            assert!(!is_valid_velocity_cap(bad), "{bad}");
+        }
+    }
 
     fn small_multi(mut m: MultiPso) -> MultiPso {
         m.populations = 6;
