@@ -147,6 +147,9 @@ mod tests {
         // rank 0.99 × 4 = 3.96: 4 + 0.96 × (5 − 4)
         assert!((quantile(&x, 0.99) - 4.96).abs() < 1e-12);
         assert!(quantile(&[], 0.5).is_nan());
+        // The median of an even sample is the mean of the middle two, in any order.
+        assert!((quantile(&[4.0, 1.0, 3.0, 2.0], 0.5) - 2.5).abs() < 1e-12);
+        assert!((quantile(&[3.0, 1.0, 2.0], 0.5) - 2.0).abs() < 1e-12);
     }
     use approx::{assert_abs_diff_eq, assert_relative_eq};
 

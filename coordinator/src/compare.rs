@@ -7,6 +7,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 
 use shoal_common::plan::Plan;
 use shoal_common::scenario::{Algorithm, Scenario};
+use shoal_common::stats;
 
 use std::time::Instant;
 
@@ -30,10 +31,8 @@ pub struct Cell {
     pub collision_free: usize,
     /// Plans whose minimum separation is at least d_min.
     pub separated: usize,
-    /// Median fitness.
-    pub median_fitness: f64,
-    /// Best and worst fitness.
-    pub fitness_range: (f64, f64),
+    /// Fitness of each run, in seed order.
+    pub fitness: Vec<f64>,
     /// Median planning time (plan.json's runtime_s), seconds.
     pub median_runtime_s: f64,
     /// Median wall time of the whole call (for distributed runs: router, agent processes,
@@ -49,15 +48,15 @@ pub struct Cell {
     pub crawler: Option<crate::crawler_table::CrawlerStats>,
 }
 
-fn median(v: &mut [f64]) -> f64 {
-    v.sort_by(f64::total_cmp);
-    let n = v.len();
-    if n == 0 {
-        f64::NAN
-    } else if n % 2 == 1 {
-        v[n / 2]
-    } else {
-        0.5 * (v[n / 2 - 1] + v[n / 2])
+impl Cell {
+    /// Median fitness over the seeds.
+    pub fn median_fitness(&self) -> f64 {
+        stats::quantile(&self.fitness, 0.5)
+    }
+
+    /// Best and worst fitness over the seeds.
+    pub fn fitness_range(&self) -> (f64, f64) {
+        (stats::min(&self.fitness), stats::max(&self.fitness))
     }
 }
 
@@ -69,9 +68,7 @@ pub fn cell(
     walls: &[f64],
     d_min: f64,
 ) -> Cell {
-    let mut fitness: Vec<f64> = plans.iter().map(|p| p.fitness).collect();
-    let mut walls = walls.to_vec();
-    let mut runtime: Vec<f64> = plans.iter().map(|p| p.runtime_s).collect();
+    let runtime: Vec<f64> = plans.iter().map(|p| p.runtime_s).collect();
     let evals: u64 = plans.iter().map(|p| p.evaluations).sum();
     let time: f64 = runtime.iter().sum();
     let sep = |p: &Plan| p.fleet.min_separation_m.unwrap_or(f64::INFINITY);
@@ -88,13 +85,9 @@ pub fn cell(
             .filter(|p| p.fleet.hard_collisions == 0)
             .count(),
         separated: plans.iter().filter(|p| sep(p) >= d_min).count(),
-        fitness_range: (
-            fitness.iter().copied().fold(f64::INFINITY, f64::min),
-            fitness.iter().copied().fold(f64::NEG_INFINITY, f64::max),
-        ),
-        median_fitness: median(&mut fitness),
-        median_runtime_s: median(&mut runtime),
-        median_wall_s: median(&mut walls),
+        fitness: plans.iter().map(|p| p.fitness).collect(),
+        median_runtime_s: stats::quantile(&runtime, 0.5),
+        median_wall_s: stats::quantile(walls, 0.5),
         mean_collisions: plans
             .iter()
             .map(|p| p.fleet.hard_collisions as f64)
@@ -174,9 +167,9 @@ pub fn markdown(cells: &[Cell]) -> String {
             c.separated,
             c.mean_collisions,
             c.worst_separation_m,
-            c.median_fitness,
-            c.fitness_range.0,
-            c.fitness_range.1,
+            c.median_fitness(),
+            c.fitness_range().0,
+            c.fitness_range().1,
             c.median_runtime_s,
             c.median_wall_s,
             c.evals_per_s
@@ -215,4 +208,81 @@ pub struct CompareArgs {
     /// Crawler scenarios: grid spacing of the reference shortest admissible path, metres.
     #[arg(long, default_value_t = 0.5, env = "SHOAL_REFERENCE_CELL")]
     pub reference_cell: f64,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::path::Path;
+
+    /// Two AUVs crossing a 1 km box, on a tiny budget.
+    fn two_auvs() -> Scenario {
+        let auv = |id: &str, start: [f64; 3], goal: [f64; 3]| {
+            format!(
+                "[[vehicles]]\nid = \"{id}\"\nkind = \"auv\"\nstart = {start:?}\ngoal = {goal:?}\n\
+                 speed_min_mps = 0.5\nspeed_max_mps = 1.5\nmax_turn_deg = 35.0\nmax_pitch_deg = 20.0\n"
+            )
+        };
+        let text = format!(
+            "name = \"pair\"\n[bounds]\nmin = [0.0, 0.0, 0.0]\nmax = [1000.0, 1000.0, 500.0]\n{}{}\
+             [fleet]\nd_min_m = 50.0\nmission_time_s = 1000.0\n\
+             [optimizer]\nwaypoints = 4\nparticles = 10\niterations = 5\n",
+            auv("a", [100.0, 100.0, 100.0], [900.0, 900.0, 100.0]),
+            auv("b", [100.0, 900.0, 100.0], [900.0, 100.0, 100.0]),
+        );
+        match Scenario::parse(&text, Path::new("pair.toml")) {
+            Ok(s) => s,
+            Err(e) => panic!("fixture does not parse: {e}"),
+        }
+    }
+
+    #[test]
+    fn cells_hold_every_seeds_fitness_in_seed_order_and_their_median_and_range() {
+        let scenario = two_auvs();
+        let mut seen: Vec<(String, u64, f64)> = Vec::new();
+        let cells = compare(
+            std::slice::from_ref(&scenario),
+            &[Algorithm::Pso, Algorithm::APso],
+            1..4,
+            None,
+            &AtomicBool::new(false),
+            &mut |p| seen.push((p.algorithm.clone(), p.seed, p.fitness)),
+        )
+        .unwrap_or_else(|e| panic!("compare failed: {e}"));
+        assert_eq!(cells.len(), 2);
+        assert_eq!(seen.len(), 6);
+        for (c, name) in cells.iter().zip(["pso", "a-pso"]) {
+            let own: Vec<&(String, u64, f64)> = seen.iter().filter(|s| s.0 == name).collect();
+            assert_eq!(own.iter().map(|s| s.1).collect::<Vec<_>>(), [1, 2, 3]);
+            let fitness: Vec<f64> = own.iter().map(|s| s.2).collect();
+            assert_eq!(c.fitness, fitness);
+            assert_eq!((c.runs, c.mode.as_str()), (3, "in-process"));
+            let mut sorted = fitness.clone();
+            sorted.sort_by(f64::total_cmp);
+            assert_eq!(c.median_fitness(), sorted[1]);
+            assert_eq!(c.fitness_range(), (sorted[0], sorted[2]));
+        }
+        // The first algorithm named is the reference of the significance rows.
+        let rows = crate::significance::significance(&cells);
+        assert_eq!(rows.len(), 1);
+        assert_eq!(
+            (rows[0].reference, rows[0].other),
+            (Algorithm::Pso, Algorithm::APso)
+        );
+    }
+
+    #[test]
+    fn a_raised_stop_returns_the_cells_completed_so_far() {
+        let scenario = two_auvs();
+        let cells = compare(
+            &[scenario],
+            &[Algorithm::Pso],
+            1..3,
+            None,
+            &AtomicBool::new(true),
+            &mut |_| {},
+        )
+        .unwrap_or_else(|e| panic!("compare failed: {e}"));
+        assert!(cells.is_empty());
+    }
 }

@@ -19,6 +19,7 @@ pub mod planner;
 pub mod replay;
 pub mod run_cmd;
 pub mod serve;
+pub mod significance;
 pub mod status_cmd;
 pub mod summary;
 pub mod svg;
@@ -136,6 +137,7 @@ fn compare_command(args: &compare::CompareArgs, stop: &AtomicBool) -> anyhow::Re
         eprintln!("interrupted: the table has only the cells completed before Ctrl-C");
     }
     let mut table = compare::markdown(&cells);
+    table.push_str(&significance::markdown(&significance::significance(&cells)));
     if cells.iter().any(|c| c.crawler.is_some()) {
         eprintln!(
             "computing the reference crawler paths (grid {} m)…",
