@@ -30,6 +30,12 @@ pub struct VehicleFigures {
     pub hard_collisions: usize,
     /// Metres of path inside inflated soft obstacles, summed over obstacles.
     pub soft_exposure_m: f64,
+    /// `soft_exposure_m` with every inflated soft sphere shrunk, then grown, by [`TOL`]: the
+    /// figure a plan may report. A chord's length is ill-conditioned where a leg grazes a sphere
+    /// (`2·√(r² − d²)` has an infinite slope at `d = r`, and the planner's cost drives legs onto
+    /// soft spheres' surfaces), so two correct computations can differ by micrometres there; a
+    /// leg within [`TOL`] of tangency may count anything from 0 to `2·√(2·r·TOL)`.
+    pub soft_exposure_range_m: [f64; 2],
     /// True when every sample lies inside the scenario bounds (± [`TOL`]).
     pub inside_bounds: bool,
     /// `(leg index, speed m/s)` of every leg of non-zero length (infinite for a jump in no time).
@@ -47,6 +53,10 @@ pub struct FleetFigures {
     pub min_separation_time_s: Option<f64>,
     /// Total time pairs spend closer than d_min, seconds.
     pub separation_breach_s: f64,
+    /// `separation_breach_s` with d_min lowered, then raised, by [`TOL`]: the figure a plan may
+    /// report. Like a chord of a grazed sphere, the time a pair spends inside d_min is
+    /// ill-conditioned when its closest approach is d_min itself.
+    pub separation_breach_range_s: [f64; 2],
     /// Sum of hard collisions.
     pub hard_collisions: usize,
     /// Latest minus earliest arrival, seconds.
@@ -91,6 +101,7 @@ pub fn vehicle_figures(id: &str, traj: &[[f64; 4]], scenario: &Scenario) -> Vehi
     let mut min_clearance_m: Option<f64> = None;
     let mut hard_collisions = 0;
     let mut soft_exposure_m = 0.0;
+    let mut soft_exposure_range_m = [0.0, 0.0];
     for o in &scenario.obstacles {
         let inflated = o.radius_m + o.inflation_m;
         match o.kind {
@@ -110,10 +121,14 @@ pub fn vehicle_figures(id: &str, traj: &[[f64; 4]], scenario: &Scenario) -> Vehi
                 min_clearance_m = Some(min_clearance_m.map_or(c, |m| m.min(c)));
             }
             ObstacleKind::Soft => {
-                soft_exposure_m += pts
-                    .windows(2)
-                    .map(|w| geometry::chord_inside_sphere(&w[0], &w[1], &o.centre, inflated))
-                    .sum::<f64>();
+                let exposure = |r: f64| -> f64 {
+                    pts.windows(2)
+                        .map(|w| geometry::chord_inside_sphere(&w[0], &w[1], &o.centre, r))
+                        .sum()
+                };
+                soft_exposure_m += exposure(inflated);
+                soft_exposure_range_m[0] += exposure((inflated - TOL).max(0.0));
+                soft_exposure_range_m[1] += exposure(inflated + TOL);
             }
         }
     }
@@ -132,6 +147,7 @@ pub fn vehicle_figures(id: &str, traj: &[[f64; 4]], scenario: &Scenario) -> Vehi
         min_clearance_m,
         hard_collisions,
         soft_exposure_m,
+        soft_exposure_range_m,
         inside_bounds,
         leg_speeds_mps,
     }
@@ -148,6 +164,7 @@ pub fn fleet_figures(
         min_separation_pair: None,
         min_separation_time_s: None,
         separation_breach_s: 0.0,
+        separation_breach_range_s: [0.0, 0.0],
         hard_collisions,
         arrival_spread_s: 0.0,
     };
@@ -155,6 +172,8 @@ pub fn fleet_figures(
         for (idb, b) in &trajectories[i + 1..] {
             let m = geometry::min_separation(a, b);
             out.separation_breach_s += geometry::breach_time(a, b, d_min);
+            out.separation_breach_range_s[0] += geometry::breach_time(a, b, (d_min - TOL).max(0.0));
+            out.separation_breach_range_s[1] += geometry::breach_time(a, b, d_min + TOL);
             if out.min_separation_m.is_none_or(|best| m.distance < best) {
                 out.min_separation_m = Some(m.distance);
                 out.min_separation_pair = Some([ida.to_string(), idb.to_string()]);
