@@ -85,6 +85,7 @@ pub fn command(args: &BenchTelemetryArgs, stop: &AtomicBool) -> anyhow::Result<i
         telemetry_hz: args.hz,
         horizon_s: 180.0,
         deviation_m: 25.0,
+        separation_buffer_m: 10.0,
         lost_after: Duration::from_secs(5),
         replan_budget: Duration::from_millis(300),
         arrival_window_s: 60.0,

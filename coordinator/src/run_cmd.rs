@@ -33,6 +33,10 @@ pub struct RunArgs {
     /// Cross-track error that triggers a replan, metres (default: d_min / 2).
     #[arg(long, env = "SHOAL_DEVIATION")]
     pub deviation: Option<f64>,
+    /// Metres over d_min a replan keeps from the other vehicles, for their tracking error and
+    /// fix noise (default: d_min / 5).
+    #[arg(long, env = "SHOAL_SEPARATION_BUFFER")]
+    pub separation_buffer: Option<f64>,
     /// Wall seconds without telemetry after which a vehicle is lost.
     #[arg(long, env = "SHOAL_LOST_AFTER", default_value_t = 3.0)]
     pub lost_after: f64,
@@ -130,6 +134,10 @@ pub fn run_command(args: &RunArgs, shutdown: Arc<AtomicBool>) -> anyhow::Result<
         "--deviation (SHOAL_DEVIATION)",
         args.deviation.unwrap_or(d_min / 2.0),
     )?;
+    let buffer = args.separation_buffer.unwrap_or(d_min / 5.0);
+    if !(buffer.is_finite() && buffer >= 0.0) {
+        bail!("--separation-buffer (SHOAL_SEPARATION_BUFFER) = {buffer}: must be ≥ 0");
+    }
     std::fs::create_dir_all(&p.out)
         .with_context(|| format!("cannot create output directory {}", p.out.display()))?;
     let mut options = crate::distributed_options(p, &scenario)?;
@@ -166,6 +174,7 @@ pub fn run_command(args: &RunArgs, shutdown: Arc<AtomicBool>) -> anyhow::Result<
         telemetry_hz: args.telemetry_hz,
         horizon_s: args.horizon,
         deviation_m: deviation,
+        separation_buffer_m: buffer,
         lost_after: Duration::from_secs_f64(args.lost_after),
         replan_budget: Duration::from_millis(args.replan_budget_ms),
         arrival_window_s: args.arrival_window,

@@ -74,6 +74,7 @@ fn execute(
         telemetry_hz: 2.0,
         horizon_s: 180.0,
         deviation_m,
+        separation_buffer_m: 10.0,
         lost_after: Duration::from_secs(10),
         // A debug build's swarm is slow; the update still leads the vehicle by
         // (1 s + 0.25 s) × 40 = 50 mission seconds.

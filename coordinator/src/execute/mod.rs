@@ -45,6 +45,9 @@ pub struct ExecOptions {
     pub horizon_s: f64,
     /// Cross-track error beyond which a vehicle is replanned, metres.
     pub deviation_m: f64,
+    /// Metres over d_min a replan keeps from the other vehicles' predicted trajectories, for
+    /// the tracking error and fix noise of both (a conflict is still predicted at d_min).
+    pub separation_buffer_m: f64,
     /// Wall time without a report after which a vehicle is lost.
     pub lost_after: Duration,
     /// Wall-time budget of one replan.

@@ -318,6 +318,7 @@ pub(super) fn replan_vehicle(x: &mut Exec, i: usize, why: &str) -> bool {
         others: &predictions,
         arrival_s: x.common_arrival_s,
         budget,
+        separation_buffer_m: o.separation_buffer_m,
         seed,
     };
     // A tour must still pass its remaining inspection points: it is repaired, not replanned.

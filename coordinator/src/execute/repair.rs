@@ -196,6 +196,7 @@ mod tests {
             others,
             arrival_s: 4000.0,
             budget: Duration::from_millis(100),
+            separation_buffer_m: 0.0,
             seed: 1,
         }
     }

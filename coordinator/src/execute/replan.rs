@@ -59,6 +59,10 @@ pub struct Request<'a> {
     pub arrival_s: f64,
     /// Wall-time budget.
     pub budget: Duration,
+    /// Metres over d_min the new trajectory is planned to keep from the others: the vehicles
+    /// fly their trajectories only to within their tracking error (and their fixes carry
+    /// noise), so a trajectory that grazes d_min is executed a few metres inside it.
+    pub separation_buffer_m: f64,
     /// RNG seed.
     pub seed: u64,
 }
@@ -240,30 +244,41 @@ const MOTION_SLACK: f64 = 2.0;
 /// warm start — the long way round, arriving late — is safe and flyable. So: a safe candidate
 /// beats an unsafe one; among safe ones, one that breaks the turn and pitch limits by more
 /// than [`MOTION_SLACK`] over the cleanest gives way; then the cheapest wins.
+///
+/// "Safe" is tried at each separation of `separations` in turn (d_min plus the tracking
+/// buffer, then d_min itself): a candidate that keeps the buffer beats one that only keeps
+/// d_min, and one that keeps d_min still beats an unsafe one.
 fn choose(
     swarm: VehicleEvaluation,
     warm: impl Iterator<Item = VehicleEvaluation>,
-    d_min: f64,
+    separations: &[f64],
 ) -> VehicleEvaluation {
-    let safe: Vec<VehicleEvaluation> = std::iter::once(swarm.clone())
-        .chain(warm)
-        .filter(|e| is_safe(e, d_min))
-        .collect();
-    let cleanest = safe
-        .iter()
-        .map(|e| e.terms.motion)
-        .fold(f64::INFINITY, f64::min);
-    safe.into_iter()
-        .filter(|e| e.terms.motion <= cleanest + MOTION_SLACK)
-        .min_by(|a, b| a.total.total_cmp(&b.total))
-        .unwrap_or(swarm)
+    let all: Vec<VehicleEvaluation> = std::iter::once(swarm.clone()).chain(warm).collect();
+    for &d in separations {
+        let safe: Vec<&VehicleEvaluation> = all.iter().filter(|e| is_safe(e, d)).collect();
+        let cleanest = safe
+            .iter()
+            .map(|e| e.terms.motion)
+            .fold(f64::INFINITY, f64::min);
+        if let Some(best) = safe
+            .into_iter()
+            .filter(|e| e.terms.motion <= cleanest + MOTION_SLACK)
+            .min_by(|a, b| a.total.total_cmp(&b.total))
+        {
+            return best.clone();
+        }
+    }
+    swarm
 }
 
 /// Replans (see the module doc).
 pub fn replan(r: &Request) -> Replanned {
     let started = Instant::now();
+    let d_min = r.scenario.fleet.d_min_m;
     let mut scenario = r.scenario.clone();
     scenario.vehicles[r.vehicle].start = [r.p0.x, r.p0.y, r.p0.z];
+    // The swarm's separation penalty (seed 004 eq. (11)) starts at d_min plus the buffer.
+    scenario.fleet.d_min_m = d_min + r.separation_buffer_m.max(0.0);
     let model = FleetModel::new(&scenario);
     let context: Vec<Trajectory> = r.others.iter().map(|t| rebase(t, r.t0)).collect();
     let arrival = (r.arrival_s - r.t0).max(1.0);
@@ -322,9 +337,9 @@ pub fn replan(r: &Request) -> Replanned {
     let best = choose(
         problem.evaluate(out.state.best_position()),
         warm_problem.warm.iter().map(|w| problem.evaluate(w)),
-        scenario.fleet.d_min_m,
+        &[scenario.fleet.d_min_m, d_min],
     );
-    let safe = is_safe(&best, scenario.fleet.d_min_m);
+    let safe = is_safe(&best, d_min);
     let trajectory = Trajectory {
         times: best.trajectory.times.iter().map(|t| t + r.t0).collect(),
         points: best.trajectory.points,
@@ -432,8 +447,30 @@ mod tests {
         ];
         for (swarm, warm, expected) in cases {
             let c = |(h, s, m, t)| candidate(h, s, m, t);
-            let got = choose(c(swarm), std::iter::once(c(warm)), 50.0).total;
+            let got = choose(c(swarm), std::iter::once(c(warm)), &[50.0]).total;
             assert_eq!(got, expected, "swarm {swarm:?}, warm {warm:?}");
         }
+    }
+
+    #[test]
+    fn a_candidate_that_keeps_the_buffer_beats_one_that_only_keeps_d_min() {
+        // d_min 50 m, buffer 10 m: (swarm's best, warm start) as (separation, cost).
+        let c = |s: f64, t: f64| candidate(0, s, 0.0, t);
+        let pick = |swarm: (f64, f64), warm: (f64, f64)| {
+            choose(
+                c(swarm.0, swarm.1),
+                std::iter::once(c(warm.0, warm.1)),
+                &[60.0, 50.0],
+            )
+            .total
+        };
+        // The cheaper answer grazes d_min (52 m); the dearer one keeps 61 m: it wins.
+        assert_eq!(pick((52.0, 1.0), (61.0, 3.0)), 3.0);
+        // Both keep the buffer: the cheaper wins.
+        assert_eq!(pick((65.0, 1.0), (61.0, 3.0)), 1.0);
+        // Neither keeps it; both keep d_min: the cheaper wins rather than nothing.
+        assert_eq!(pick((52.0, 1.0), (55.0, 3.0)), 1.0);
+        // Only one keeps d_min: it wins.
+        assert_eq!(pick((49.0, 1.0), (55.0, 3.0)), 3.0);
     }
 }
