@@ -104,6 +104,16 @@ fn positive(flag: &str, v: f64) -> anyhow::Result<f64> {
     }
 }
 
+/// `--separation-buffer`, or d_min / 5: the simulated AUV tracks its trajectory to within
+/// 2–5 m (p95 about 2.5 m, fix noise included), and two of them may err towards each other.
+fn separation_buffer(flag: Option<f64>, d_min: f64) -> anyhow::Result<f64> {
+    let buffer = flag.unwrap_or(d_min / 5.0);
+    if !(buffer.is_finite() && buffer >= 0.0) {
+        bail!("--separation-buffer (SHOAL_SEPARATION_BUFFER) = {buffer}: must be ≥ 0");
+    }
+    Ok(buffer)
+}
+
 /// Plans, then executes; exit 0 when the execution kept d_min, stayed out of every hard
 /// obstacle and every vehicle arrived in the window, 3 otherwise.
 pub fn run_command(args: &RunArgs, shutdown: Arc<AtomicBool>) -> anyhow::Result<i32> {
@@ -134,10 +144,7 @@ pub fn run_command(args: &RunArgs, shutdown: Arc<AtomicBool>) -> anyhow::Result<
         "--deviation (SHOAL_DEVIATION)",
         args.deviation.unwrap_or(d_min / 2.0),
     )?;
-    let buffer = args.separation_buffer.unwrap_or(d_min / 5.0);
-    if !(buffer.is_finite() && buffer >= 0.0) {
-        bail!("--separation-buffer (SHOAL_SEPARATION_BUFFER) = {buffer}: must be ≥ 0");
-    }
+    let buffer = separation_buffer(args.separation_buffer, d_min)?;
     std::fs::create_dir_all(&p.out)
         .with_context(|| format!("cannot create output directory {}", p.out.display()))?;
     let mut options = crate::distributed_options(p, &scenario)?;
@@ -332,6 +339,23 @@ pub fn execution_summary(r: &ExecutionReport) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_separation_buffer_defaults_to_a_fifth_of_d_min_and_bad_ones_are_named() {
+        assert!((separation_buffer(None, 50.0).unwrap_or(f64::NAN) - 10.0).abs() < 1e-12);
+        assert_eq!(separation_buffer(Some(0.0), 50.0).ok(), Some(0.0));
+        assert_eq!(separation_buffer(Some(7.5), 50.0).ok(), Some(7.5));
+        for bad in [-1.0, f64::NAN, f64::INFINITY] {
+            let e = separation_buffer(Some(bad), 50.0)
+                .err()
+                .map(|e| e.to_string())
+                .unwrap_or_default();
+            assert!(
+                e.contains("--separation-buffer") && e.contains(&bad.to_string()),
+                "{bad}: {e:?}"
+            );
+        }
+    }
 
     #[test]
     fn injections_are_read_and_bad_ones_named() {
