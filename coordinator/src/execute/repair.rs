@@ -10,9 +10,13 @@
 //! - the result is re-timed to arrive when the plan did, each leg's speed scaled alike and kept
 //!   within the vehicle's range (a longer way than the top speed can make up arrives late).
 //!
+//! The path is fixed, but not its timing: when the on-time repair comes within d_min plus the
+//! separation buffer of another vehicle's predicted track, it is re-timed a little later or
+//! earlier ([`RETIMINGS`]) and the first timing that keeps the buffer is taken, else the first
+//! that keeps d_min (as [`super::replan`] prefers the buffer but never holds for it alone).
 //! A repair that still meets a hard obstacle, or comes within d_min of another vehicle's
-//! predicted track, is not safe: the coordinator then holds the vehicle and retries, so a tour
-//! vehicle gives way by waiting, and carries on when the way is clear.
+//! predicted track at every timing, is not safe: the coordinator then holds the vehicle and
+//! retries, so a tour vehicle gives way by waiting, and carries on when the way is clear.
 
 use std::time::Instant;
 
@@ -99,6 +103,11 @@ fn timed(points: Vec<Vec3>, speeds: &[f64], t0: f64, duration: f64, v: (f64, f64
     Trajectory { times, points }
 }
 
+/// Durations tried for the repaired tour, as fractions of the time left to the plan's arrival:
+/// on time first, then a little later or earlier. Each leg's speed stays within the vehicle's
+/// range, so a timing the range cannot fly comes out as the nearest it can.
+pub const RETIMINGS: [f64; 7] = [1.0, 1.05, 0.95, 1.1, 0.9, 1.2, 0.8];
+
 /// Repairs the vehicle's tour (see the module doc).
 pub fn repair(r: &Request) -> Replanned {
     let started = Instant::now();
@@ -113,30 +122,41 @@ pub fn repair(r: &Request) -> Replanned {
             elapsed: started.elapsed(),
         };
     };
-    let duration = r.current.arrival() - r.t0;
-    let trajectory = timed(
-        points,
-        &speeds,
-        r.t0,
-        duration,
-        (v.speed_min_mps, v.speed_max_mps),
-    );
-    let hard_hits = trajectory
-        .points
+    // The path, hence its obstacle intrusions, is the same at every timing.
+    let hard_hits = points
         .windows(2)
         .filter(|w| blocked(r.scenario, &w[0], &w[1]))
         .count();
-    let mine = rebase(&trajectory, r.t0);
-    let min_separation_m = r
-        .others
+    let duration = r.current.arrival() - r.t0;
+    let candidates: Vec<(Trajectory, f64)> = RETIMINGS
         .iter()
-        .enumerate()
-        .filter(|(j, _)| *j != r.vehicle)
-        .map(|(_, o)| {
-            let o = rebase(o, r.t0);
-            motion_separation(&Motion::new(&mine), &Motion::new(&o), d_min, false).min_distance
+        .map(|f| {
+            let trajectory = timed(
+                points.clone(),
+                &speeds,
+                r.t0,
+                duration * f,
+                (v.speed_min_mps, v.speed_max_mps),
+            );
+            let separation = closest_vehicle(r, &trajectory, d_min);
+            (trajectory, separation)
         })
-        .fold(f64::INFINITY, f64::min);
+        .collect();
+    let wanted = [d_min + r.separation_buffer_m.max(0.0), d_min];
+    let pick = wanted
+        .iter()
+        .find_map(|d| candidates.iter().position(|(_, s)| *s >= *d))
+        .unwrap_or(0);
+    let Some((trajectory, min_separation_m)) = candidates.into_iter().nth(pick) else {
+        // RETIMINGS is not empty, so this is not reached; a hold is the safe answer anyway.
+        return Replanned {
+            trajectory: r.current.clone(),
+            safe: false,
+            hard_hits,
+            min_separation_m: 0.0,
+            elapsed: started.elapsed(),
+        };
+    };
     Replanned {
         trajectory,
         safe: hard_hits == 0 && min_separation_m >= d_min,
@@ -144,6 +164,20 @@ pub fn repair(r: &Request) -> Replanned {
         min_separation_m,
         elapsed: started.elapsed(),
     }
+}
+
+/// The smallest predicted distance from `trajectory` to any other vehicle, metres.
+fn closest_vehicle(r: &Request, trajectory: &Trajectory, d_min: f64) -> f64 {
+    let mine = rebase(trajectory, r.t0);
+    r.others
+        .iter()
+        .enumerate()
+        .filter(|(j, _)| *j != r.vehicle)
+        .map(|(_, o)| {
+            let o = rebase(o, r.t0);
+            motion_separation(&Motion::new(&mine), &Motion::new(&o), d_min, false).min_distance
+        })
+        .fold(f64::INFINITY, f64::min)
 }
 
 #[cfg(test)]
@@ -274,6 +308,44 @@ mod tests {
         let others = [plan.clone(), other];
         let r = repair(&request(&s, &plan, &others));
         assert!(!r.safe && r.min_separation_m < 1.0, "{r:?}");
+        Ok(())
+    }
+
+    #[test]
+    fn a_repair_that_only_keeps_d_min_is_retimed_to_keep_the_buffer(
+    ) -> Result<(), Box<dyn std::error::Error>> {
+        let s = scenario()?;
+        let plan = tour();
+        // The other vehicle drives north at 1 m/s along x = 950 and crosses the first leg
+        // (y = 200) 55·√2 s after this vehicle does (t = 750): perpendicular at equal speeds,
+        // they pass 55 m apart. 5 % faster, this vehicle crosses at 737.5 s and they pass
+        // 65.45 m apart; 5 % slower, 45.02 m (both by hand, sampled every 0.01 s).
+        let crossing = 750.0 + 55.0 * 2f64.sqrt();
+        let other = Trajectory {
+            times: vec![0.0, 5000.0],
+            points: vec![
+                Vec3::new(950.0, 200.0 - crossing, 200.0),
+                Vec3::new(950.0, 200.0 + 5000.0 - crossing, 200.0),
+            ],
+        };
+        let others = [plan.clone(), other];
+        // Without a buffer the on-time repair (55 m) is kept.
+        let r = repair(&request(&s, &plan, &others));
+        assert!(r.safe, "{r:?}");
+        assert!((r.min_separation_m - 55.0).abs() < 0.05, "{r:?}");
+        assert!((r.trajectory.arrival() - 4000.0).abs() < 1e-6);
+        // With a 10 m buffer, the first timing that keeps 60 m: 5 % early (arrival 500 + 0.95 ×
+        // 3500 = 3825 s), not 5 % late (45 m).
+        let mut req = request(&s, &plan, &others);
+        req.separation_buffer_m = 10.0;
+        let r = repair(&req);
+        assert!(r.safe, "{r:?}");
+        assert!((r.min_separation_m - 65.45).abs() < 0.05, "{r:?}");
+        assert!((r.trajectory.arrival() - 3825.0).abs() < 1e-6, "{r:?}");
+        // A buffer no timing keeps falls back to the on-time repair, which keeps d_min.
+        req.separation_buffer_m = 60.0;
+        let r = repair(&req);
+        assert!(r.safe && (r.min_separation_m - 55.0).abs() < 0.05, "{r:?}");
         Ok(())
     }
 }
