@@ -11,9 +11,10 @@
 //!   within the vehicle's range (a longer way than the top speed can make up arrives late).
 //!
 //! The path is fixed, but not its timing: when the on-time repair comes within d_min plus the
-//! separation buffer of another vehicle's predicted track, it is re-timed a little later or
-//! earlier ([`RETIMINGS`]) and the first timing that keeps the buffer is taken, else the first
-//! that keeps d_min (as [`super::replan`] prefers the buffer but never holds for it alone).
+//! separation buffer of another vehicle's predicted track, the legs up to that closest
+//! approach are flown a little slower or faster ([`RETIMINGS`]), the later ones making up the
+//! difference, and the first timing that keeps the buffer is taken, else the first that keeps
+//! d_min (as [`super::replan`] prefers the buffer but never holds for it alone).
 //! A repair that still meets a hard obstacle, or comes within d_min of another vehicle's
 //! predicted track at every timing, is not safe: the coordinator then holds the vehicle and
 //! retries, so a tour vehicle gives way by waiting, and carries on when the way is clear.
@@ -103,10 +104,55 @@ fn timed(points: Vec<Vec3>, speeds: &[f64], t0: f64, duration: f64, v: (f64, f64
     Trajectory { times, points }
 }
 
-/// Durations tried for the repaired tour, as fractions of the time left to the plan's arrival:
-/// on time first, then a little later or earlier. Each leg's speed stays within the vehicle's
-/// range, so a timing the range cannot fly comes out as the nearest it can.
+/// Factors tried on the time the repaired tour takes to reach its closest approach to another
+/// vehicle: as planned first, then a little slower or faster. The legs after it take up the
+/// difference, so the arrival stays as planned where the speed range allows.
 pub const RETIMINGS: [f64; 7] = [1.0, 1.05, 0.95, 1.1, 0.9, 1.2, 0.8];
+
+/// `base` with the legs that start before mission time `at` flown in `factor` times their
+/// planned time and the later legs re-timed to keep `base`'s arrival; every leg's speed stays
+/// within `[v_min, v_max]`, so the arrival moves only when the range cannot make up the
+/// difference.
+fn retimed(base: &Trajectory, at: f64, factor: f64, v: (f64, f64)) -> Trajectory {
+    let legs: Vec<(f64, f64)> = base
+        .points
+        .windows(2)
+        .zip(base.times.windows(2))
+        .map(|(p, t)| ((p[1] - p[0]).norm(), t[1] - t[0]))
+        .collect();
+    let fly = |length: f64, time: f64| time.clamp(length / v.1, length / v.0.max(1e-9));
+    // At least the first leg, at most every leg.
+    let prefix = base.times[..base.times.len() - 1]
+        .iter()
+        .filter(|t| **t < at)
+        .count()
+        .clamp(1, legs.len().max(1));
+    let mut durations: Vec<f64> = legs[..prefix.min(legs.len())]
+        .iter()
+        .map(|(l, t)| fly(*l, t * factor))
+        .collect();
+    let used: f64 = durations.iter().sum();
+    let rest: f64 = legs[durations.len()..].iter().map(|(_, t)| t).sum();
+    let left = base.arrival() - base.times[0] - used;
+    let scale = if rest > 0.0 && left > 0.0 {
+        left / rest
+    } else {
+        0.0
+    };
+    durations.extend(
+        legs[durations.len()..]
+            .iter()
+            .map(|(l, t)| fly(*l, t * scale)),
+    );
+    let mut times = vec![base.times[0]];
+    for d in durations {
+        times.push(times[times.len() - 1] + d);
+    }
+    Trajectory {
+        times,
+        points: base.points.clone(),
+    }
+}
 
 /// Repairs the vehicle's tour (see the module doc).
 pub fn repair(r: &Request) -> Replanned {
@@ -127,36 +173,23 @@ pub fn repair(r: &Request) -> Replanned {
         .windows(2)
         .filter(|w| blocked(r.scenario, &w[0], &w[1]))
         .count();
-    let duration = r.current.arrival() - r.t0;
-    let candidates: Vec<(Trajectory, f64)> = RETIMINGS
-        .iter()
-        .map(|f| {
-            let trajectory = timed(
-                points.clone(),
-                &speeds,
-                r.t0,
-                duration * f,
-                (v.speed_min_mps, v.speed_max_mps),
-            );
-            let separation = closest_vehicle(r, &trajectory, d_min);
-            (trajectory, separation)
-        })
-        .collect();
+    let range = (v.speed_min_mps, v.speed_max_mps);
+    let on_time = timed(points, &speeds, r.t0, r.current.arrival() - r.t0, range);
+    let (separation, closest_at) = closest_vehicle(r, &on_time, d_min);
+    let mut candidates = vec![(on_time.clone(), separation)];
+    if separation < d_min + r.separation_buffer_m {
+        for f in &RETIMINGS[1..] {
+            let t = retimed(&on_time, closest_at, *f, range);
+            let (s, _) = closest_vehicle(r, &t, d_min);
+            candidates.push((t, s));
+        }
+    }
     let wanted = [d_min + r.separation_buffer_m.max(0.0), d_min];
     let pick = wanted
         .iter()
         .find_map(|d| candidates.iter().position(|(_, s)| *s >= *d))
         .unwrap_or(0);
-    let Some((trajectory, min_separation_m)) = candidates.into_iter().nth(pick) else {
-        // RETIMINGS is not empty, so this is not reached; a hold is the safe answer anyway.
-        return Replanned {
-            trajectory: r.current.clone(),
-            safe: false,
-            hard_hits,
-            min_separation_m: 0.0,
-            elapsed: started.elapsed(),
-        };
-    };
+    let (trajectory, min_separation_m) = candidates.swap_remove(pick);
     Replanned {
         trajectory,
         safe: hard_hits == 0 && min_separation_m >= d_min,
@@ -166,8 +199,9 @@ pub fn repair(r: &Request) -> Replanned {
     }
 }
 
-/// The smallest predicted distance from `trajectory` to any other vehicle, metres.
-fn closest_vehicle(r: &Request, trajectory: &Trajectory, d_min: f64) -> f64 {
+/// The smallest predicted distance from `trajectory` to any other vehicle, metres, and the
+/// mission time it comes at (`t0` when there is no other vehicle).
+fn closest_vehicle(r: &Request, trajectory: &Trajectory, d_min: f64) -> (f64, f64) {
     let mine = rebase(trajectory, r.t0);
     r.others
         .iter()
@@ -175,9 +209,10 @@ fn closest_vehicle(r: &Request, trajectory: &Trajectory, d_min: f64) -> f64 {
         .filter(|(j, _)| *j != r.vehicle)
         .map(|(_, o)| {
             let o = rebase(o, r.t0);
-            motion_separation(&Motion::new(&mine), &Motion::new(&o), d_min, false).min_distance
+            let pair = motion_separation(&Motion::new(&mine), &Motion::new(&o), d_min, false);
+            (pair.min_distance, r.t0 + pair.min_time)
         })
-        .fold(f64::INFINITY, f64::min)
+        .fold((f64::INFINITY, r.t0), |a, b| if b.0 < a.0 { b } else { a })
 }
 
 #[cfg(test)]
@@ -334,18 +369,53 @@ mod tests {
         assert!(r.safe, "{r:?}");
         assert!((r.min_separation_m - 55.0).abs() < 0.05, "{r:?}");
         assert!((r.trajectory.arrival() - 4000.0).abs() < 1e-6);
-        // With a 10 m buffer, the first timing that keeps 60 m: 5 % early (arrival 500 + 0.95 ×
-        // 3500 = 3825 s), not 5 % late (45 m).
+        // With a 10 m buffer, the first timing that keeps 60 m: the first leg (the closest
+        // approach is on it) in 0.95 × 500 s, not 1.05 × (45 m); the three later legs take
+        // 3025 s in all, so the arrival stays at 4000 s.
         let mut req = request(&s, &plan, &others);
         req.separation_buffer_m = 10.0;
         let r = repair(&req);
         assert!(r.safe, "{r:?}");
         assert!((r.min_separation_m - 65.45).abs() < 0.05, "{r:?}");
-        assert!((r.trajectory.arrival() - 3825.0).abs() < 1e-6, "{r:?}");
+        assert!((r.trajectory.times[1] - 975.0).abs() < 1e-6, "{r:?}");
+        assert!((r.trajectory.arrival() - 4000.0).abs() < 1e-6, "{r:?}");
+        for (w, t) in r
+            .trajectory
+            .points
+            .windows(2)
+            .zip(r.trajectory.times.windows(2))
+        {
+            let speed = (w[1] - w[0]).norm() / (t[1] - t[0]);
+            assert!((0.5..=2.0).contains(&speed), "{speed}");
+        }
         // A buffer no timing keeps falls back to the on-time repair, which keeps d_min.
         req.separation_buffer_m = 60.0;
         let r = repair(&req);
         assert!(r.safe && (r.min_separation_m - 55.0).abs() < 0.05, "{r:?}");
         Ok(())
+    }
+
+    #[test]
+    fn retiming_keeps_the_arrival_only_where_the_speed_range_allows() {
+        // Two 100 m legs at 1 m/s from t = 0; the range is 0.5–1.0 m/s.
+        let p = |x: f64| Vec3::new(x, 0.0, 0.0);
+        let base = Trajectory {
+            times: vec![0.0, 100.0, 200.0],
+            points: vec![p(0.0), p(100.0), p(200.0)],
+        };
+        // The first leg slower (125 s at 0.8 m/s): the second cannot make up 25 s at 1 m/s,
+        // so the arrival moves to 225 s.
+        let t = retimed(&base, 50.0, 1.25, (0.5, 1.0));
+        assert!((t.times[1] - 125.0).abs() < 1e-9 && (t.times[2] - 225.0).abs() < 1e-9);
+        // The first leg at 0.8 × its time would need 1.25 m/s: it is flown at 1 m/s.
+        let t = retimed(&base, 50.0, 0.8, (0.5, 1.0));
+        assert!((t.times[1] - 100.0).abs() < 1e-9 && (t.times[2] - 200.0).abs() < 1e-9);
+        // With room in the range (up to 2 m/s): 80 s, then 120 s, arriving at 200 s.
+        let t = retimed(&base, 50.0, 0.8, (0.5, 2.0));
+        assert!((t.times[1] - 80.0).abs() < 1e-9 && (t.times[2] - 200.0).abs() < 1e-9);
+        // A closest approach on the second leg slows both legs (the prefix is every leg that
+        // starts before it): nothing is left to make up the time.
+        let t = retimed(&base, 150.0, 1.1, (0.5, 2.0));
+        assert!((t.times[1] - 110.0).abs() < 1e-9 && (t.times[2] - 220.0).abs() < 1e-9);
     }
 }
