@@ -283,9 +283,10 @@ fn an_inspection_tour_is_run_and_repaired_round_a_new_obstacle_keeping_its_point
     let report = execution_report(&out)?;
     let f = &report["figures"];
     assert!(num(f, "min_separation_m") >= 20.0, "{f}");
-    // The cages' 1 m planning margin (seed 003) is thinner than the tracking error and the fix
-    // noise, so the executed tracks may graze a net (reported, exit 3); the repair itself must
-    // keep out of the new obstacle: checked on the plan below.
+    // The cages' 3 m planning margin covers the simulated tracking error at the 95th
+    // percentile, not its maximum plus the fix noise, so an executed track may still graze a
+    // net (reported, exit 3); the repair itself must keep out of the new obstacle: checked on
+    // the plan below.
     for v in f["vehicles"].as_array().into_iter().flatten() {
         assert!(num(v, "max_cross_track_m") < 20.0, "{v}");
         assert!(v["arrived_s"].as_f64().is_some(), "{v}");

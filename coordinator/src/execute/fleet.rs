@@ -37,8 +37,14 @@ pub struct Tracked {
     pub heard: Option<Instant>,
     /// Where the latest report puts it on its plan.
     pub progress: Option<Progress>,
-    /// Executed track: every reported fix.
+    /// Executed track: every reported fix and, between two fixes on the same plan, that
+    /// plan's corners shifted by the fixes' offsets from it ([`Fleet::report`]).
     pub track: Trajectory,
+    /// Fixes in `track`.
+    pub fixes: usize,
+    /// The last fix in `track`: its plan time, its offset from the plan there, the plan's
+    /// revision.
+    anchor: Option<(f64, Vec3, u32)>,
     /// Cross-track error of every report, metres.
     pub cross_track: Vec<f64>,
     /// Mission time of its first `arrived` report.
@@ -100,6 +106,8 @@ impl Fleet {
                         times: Vec::new(),
                         points: Vec::new(),
                     },
+                    fixes: 0,
+                    anchor: None,
                     cross_track: Vec::new(),
                     arrived_s: None,
                     lost: false,
@@ -142,8 +150,21 @@ impl Fleet {
         }
         v.progress = Some(progress);
         if v.track.times.last().is_none_or(|&last| now >= last) {
+            let tau = progress.plan_time_s;
+            let offset = p - v.plan.position_at(tau);
+            if let (Some((tau0, offset0, revision)), Some(&t0)) = (v.anchor, v.track.times.last()) {
+                if revision == v.revision {
+                    let corners = along_plan(&v.plan, (t0, tau0, offset0), (now, tau, offset));
+                    for (t, q) in corners {
+                        v.track.times.push(t);
+                        v.track.points.push(q);
+                    }
+                }
+            }
             v.track.times.push(now);
             v.track.points.push(p);
+            v.fixes += 1;
+            v.anchor = Some((tau, offset, v.revision));
         }
         if t.state.status == VehicleStatus::Arrived && v.arrived_s.is_none() {
             v.arrived_s = Some(t.state.arrived_s.unwrap_or(now));
@@ -263,7 +284,7 @@ impl Fleet {
             .iter()
             .map(|v| VehicleFigures {
                 vehicle: v.id.clone(),
-                reports: v.track.times.len(),
+                reports: v.fixes,
                 arrived_s: v.arrived_s,
                 in_window: v
                     .arrived_s
@@ -290,6 +311,31 @@ impl Fleet {
             latency_p99_ms: quantile(&self.latencies_ms, 0.99),
         }
     }
+}
+
+/// The executed track between two fixes `(mission time, plan time, offset from the plan)`:
+/// the plan's corners between the two plan times, each shifted by the offset interpolated
+/// between the fixes' and timed in proportion. Joining the fixes by a straight line instead
+/// cuts every corner between them: at 100× real time 2 Hz fixes are 50 mission seconds apart,
+/// and the chord of a tour round a 50 m cage passes metres inside the net the vehicle went
+/// round. Nothing is added when the plan time does not advance, or advances more than twice
+/// as fast as mission time (the fix was matched to another part of a path that passes near
+/// itself): then the fixes are joined directly.
+fn along_plan(plan: &Trajectory, from: (f64, f64, Vec3), to: (f64, f64, Vec3)) -> Vec<(f64, Vec3)> {
+    let ((t0, tau0, o0), (t1, tau1, o1)) = (from, to);
+    let (dt, dtau) = (t1 - t0, tau1 - tau0);
+    if dt <= 0.0 || dtau <= 0.0 || dtau > 2.0 * dt + 1.0 {
+        return Vec::new();
+    }
+    plan.times
+        .iter()
+        .zip(&plan.points)
+        .filter(|(tau, _)| **tau > tau0 && **tau < tau1)
+        .map(|(tau, q)| {
+            let s = (tau - tau0) / dtau;
+            (t0 + s * dt, q + o0 + (o1 - o0) * s)
+        })
+        .collect()
 }
 
 /// Closest approach of `track` to the surface of any hard obstacle, metres.
@@ -325,7 +371,7 @@ pub struct VehicleFigures {
     pub in_window: bool,
     /// Largest cross-track error reported, metres.
     pub max_cross_track_m: f64,
-    /// Closest the executed track (fixes joined by straight lines) came to a hard obstacle's
+    /// Closest the executed track (fixes joined along the plan, see [`Tracked::track`]) came to a hard obstacle's
     /// physical surface, metres (negative: a collision; below its inflation margin: inside
     /// the keep-out sphere); `None` without hard obstacles or fixes.
     pub min_obstacle_clearance_m: Option<f64>,
@@ -344,7 +390,7 @@ pub struct VehicleFigures {
 pub struct ExecutionFigures {
     /// Minimum separation, metres.
     pub d_min_m: f64,
-    /// Closest approach of two executed tracks (fixes joined by straight lines), metres.
+    /// Closest approach of two executed tracks ([`Tracked::track`]), metres.
     pub min_separation_m: Option<f64>,
     /// When, mission seconds.
     pub min_separation_at_s: Option<f64>,
@@ -398,6 +444,69 @@ mod tests {
                 arrived_s: (status == VehicleStatus::Arrived).then_some(100.0),
             },
         }
+    }
+
+    #[test]
+    fn between_two_fixes_the_track_follows_the_plan_round_its_corners() {
+        // East 100 m then north 100 m at 1 m/s; an obstacle of 10 m inside the corner.
+        let p = |x: f64, y: f64| Vec3::new(x, y, 0.0);
+        let plan = Trajectory {
+            times: vec![0.0, 100.0, 200.0],
+            points: vec![p(0.0, 0.0), p(100.0, 0.0), p(100.0, 100.0)],
+        };
+        let ids = vec!["a".to_string()];
+        let mut f = Fleet::new(&ids, std::slice::from_ref(&plan), 50.0, 60.0);
+        // Fixes 2 m left of the plan at t = 50 and 2 m short of it at t = 150.
+        f.report(
+            report("a", 0, 50.0, [50.0, 2.0, 0.0], VehicleStatus::Underway),
+            1,
+        );
+        f.report(
+            report("a", 1, 150.0, [98.0, 50.0, 0.0], VehicleStatus::Underway),
+            2,
+        );
+        // The corner (100, 0) at plan time 100, halfway: offset (0, 2) + ½ ((−2, 0) − (0, 2)).
+        let track = &f.vehicles[0].track;
+        assert_eq!(track.times, vec![50.0, 100.0, 150.0]);
+        assert!((track.points[1] - p(99.0, 1.0)).norm() < 1e-9, "{track:?}");
+        assert_eq!(f.vehicles[0].fixes, 2);
+        let cage = Obstacle {
+            id: "o".into(),
+            kind: ObstacleKind::Hard,
+            centre: [75.0, 25.0, 0.0],
+            radius_m: 10.0,
+            inflation_m: 1.0,
+        };
+        // Both legs pass the centre at |49·23 + 25| / √2402 = 23.5053 m: 13.5053 m clear. The
+        // chord (50, 2)–(98, 50) would pass 1.414 m from the centre, 8.6 m inside.
+        let fig = f.figures(200.0, 10.0, std::slice::from_ref(&cage));
+        let clearance = fig.vehicles[0].min_obstacle_clearance_m.unwrap_or(f64::NAN);
+        assert!((clearance - 13.505_309_691).abs() < 1e-6, "{clearance}");
+        assert_eq!(fig.vehicles[0].reports, 2);
+        // A fix 10 s later that matches the plan 110 s further on (past the corner) is joined
+        // directly: plan time ran more than twice as fast as mission time.
+        let mut f = Fleet::new(&ids, std::slice::from_ref(&plan), 50.0, 60.0);
+        f.report(
+            report("a", 0, 50.0, [50.0, 2.0, 0.0], VehicleStatus::Underway),
+            1,
+        );
+        f.report(
+            report("a", 1, 60.0, [100.0, 60.0, 0.0], VehicleStatus::Underway),
+            2,
+        );
+        assert_eq!(f.vehicles[0].track.times, vec![50.0, 60.0]);
+        // Nor is one on a new revision of the plan.
+        let mut f = Fleet::new(&ids, std::slice::from_ref(&plan), 50.0, 60.0);
+        f.report(
+            report("a", 0, 50.0, [50.0, 2.0, 0.0], VehicleStatus::Underway),
+            1,
+        );
+        f.vehicles[0].revision = 1;
+        f.report(
+            report("a", 1, 150.0, [98.0, 50.0, 0.0], VehicleStatus::Underway),
+            2,
+        );
+        assert_eq!(f.vehicles[0].track.times, vec![50.0, 150.0]);
     }
 
     #[test]
