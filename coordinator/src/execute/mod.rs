@@ -12,6 +12,7 @@ pub mod log;
 mod react;
 mod repair;
 pub mod replan;
+mod track;
 
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
