@@ -11,12 +11,12 @@ use shoal_common::execution::picture::{self, Conflict, Progress};
 use shoal_common::execution::VehicleStatus;
 use shoal_common::geometry::Vec3;
 use shoal_common::scenario::Obstacle;
-
-use super::track::{along_plan, obstacle_clearance};
 use shoal_common::separation;
 use shoal_common::stats::quantile;
 use shoal_common::trajectory::Trajectory;
 use shoal_common::wire::open::{FleetStatus, Telemetry, VehicleStatusRow, OPEN_VERSION};
+
+use super::track::{along_plan, obstacle_clearance};
 
 /// How far either side of the mission time a report's nearest plan point is searched,
 /// mission seconds (a path that passes near itself must not make progress jump).
@@ -328,9 +328,9 @@ pub struct VehicleFigures {
     pub in_window: bool,
     /// Largest cross-track error reported, metres.
     pub max_cross_track_m: f64,
-    /// Closest the executed track (fixes joined along the plan, see [`Tracked::track`]) came to a hard obstacle's
-    /// physical surface, metres (negative: a collision; below its inflation margin: inside
-    /// the keep-out sphere); `None` without hard obstacles or fixes.
+    /// Closest the executed track ([`Tracked::track`]) came to a hard obstacle's physical
+    /// surface, metres (negative: a collision; below its inflation margin: inside the keep-out
+    /// sphere); `None` without hard obstacles or fixes.
     pub min_obstacle_clearance_m: Option<f64>,
     /// Median cross-track error, metres.
     pub median_cross_track_m: f64,
