@@ -175,17 +175,23 @@ pub fn repair(r: &Request) -> Replanned {
         .count();
     let range = (v.speed_min_mps, v.speed_max_mps);
     let on_time = timed(points, &speeds, r.t0, r.current.arrival() - r.t0, range);
+    let buffered = d_min + r.separation_buffer_m.max(0.0);
     let (separation, closest_at) = closest_vehicle(r, &on_time, d_min);
-    let mut candidates = vec![(on_time.clone(), separation)];
-    if separation < d_min + r.separation_buffer_m {
-        for f in &RETIMINGS[1..] {
-            let t = retimed(&on_time, closest_at, *f, range);
-            let (s, _) = closest_vehicle(r, &t, d_min);
-            candidates.push((t, s));
-        }
-    }
-    let wanted = [d_min + r.separation_buffer_m.max(0.0), d_min];
-    let pick = wanted
+    let retimings: Vec<(Trajectory, f64)> = if separation < buffered {
+        RETIMINGS[1..]
+            .iter()
+            .map(|f| {
+                let t = retimed(&on_time, closest_at, *f, range);
+                let (s, _) = closest_vehicle(r, &t, d_min);
+                (t, s)
+            })
+            .collect()
+    } else {
+        Vec::new()
+    };
+    let mut candidates = vec![(on_time, separation)];
+    candidates.extend(retimings);
+    let pick = [buffered, d_min]
         .iter()
         .find_map(|d| candidates.iter().position(|(_, s)| *s >= *d))
         .unwrap_or(0);
