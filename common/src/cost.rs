@@ -427,8 +427,18 @@ impl FleetModel {
             .enumerate()
             .map(|(i, _)| self.decode(i, &x[self.layout.chromosome(i)]))
             .collect();
-        let legs: Vec<Vec<f64>> = paths.iter().map(Path::leg_lengths).collect();
-        let lengths: Vec<f64> = legs.iter().map(|l| l.iter().sum()).collect();
+        // Every vehicle's leg lengths in one buffer (one allocation per evaluation, not one
+        // per vehicle), vehicle i's at `spans[i]`.
+        let mut legs = Vec::with_capacity(paths.iter().map(|p| p.points.len()).sum());
+        let spans: Vec<std::ops::Range<usize>> = paths
+            .iter()
+            .map(|p| {
+                let start = legs.len();
+                legs.extend(p.points.windows(2).map(|w| (w[1] - w[0]).norm()));
+                start..legs.len()
+            })
+            .collect();
+        let lengths: Vec<f64> = spans.iter().map(|r| legs[r.clone()].iter().sum()).collect();
         let arrival = common_arrival(
             s.fleet.mission_time_s,
             lengths
@@ -443,9 +453,9 @@ impl FleetModel {
             .collect();
         let trajectories: Vec<Trajectory> = paths
             .into_iter()
-            .zip(&legs)
+            .zip(&spans)
             .zip(&s.vehicles)
-            .map(|((p, l), v)| retime_legs(p, l, v, arrival))
+            .map(|((p, r), v)| retime_legs(p, &legs[r.clone()], v, arrival))
             .collect();
         let motions: Vec<Motion> = trajectories.iter().map(Motion::new).collect();
         let mut sep_penalty = 0.0;

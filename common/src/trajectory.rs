@@ -275,7 +275,13 @@ pub fn retime(path: &Path, vehicle: &Vehicle, target: f64) -> Trajectory {
 pub fn retime_legs(path: Path, lengths: &[f64], vehicle: &Vehicle, target: f64) -> Trajectory {
     let (p_lo, p_hi) = (1.0 / vehicle.speed_max_mps, 1.0 / vehicle.speed_min_mps);
     let total: f64 = lengths.iter().sum();
-    let pace_of = |v: &f64| 1.0 / v.clamp(vehicle.speed_min_mps, vehicle.speed_max_mps);
+    // Each leg's requested pace (s/m), computed once: the search below revisits every leg
+    // several times. The speeds' own storage is reused, so this allocates nothing.
+    let Path { points, speeds } = path;
+    let mut paces = speeds;
+    for v in paces.iter_mut() {
+        *v = 1.0 / v.clamp(vehicle.speed_min_mps, vehicle.speed_max_mps);
+    }
     let alpha = if total * p_lo >= target {
         None
     } else if total * p_hi <= target {
@@ -284,8 +290,7 @@ pub fn retime_legs(path: Path, lengths: &[f64], vehicle: &Vehicle, target: f64) 
         // T(α) and its slope on the current piece (the free legs' Σ l p).
         let eval = |a: f64| -> (f64, f64) {
             let (mut t, mut slope) = (0.0, 0.0);
-            for (l, v) in lengths.iter().zip(&path.speeds) {
-                let p = pace_of(v);
+            for (l, &p) in lengths.iter().zip(&paces) {
                 let q = a * p;
                 if q <= p_lo {
                     t += l * p_lo;
@@ -298,18 +303,12 @@ pub fn retime_legs(path: Path, lengths: &[f64], vehicle: &Vehicle, target: f64) 
             }
             (t, slope)
         };
-        let (max_p, min_p) = path
-            .speeds
+        let (max_p, min_p) = paces
             .iter()
-            .map(pace_of)
-            .fold((f64::MIN, f64::MAX), |(hi, lo), p| (hi.max(p), lo.min(p)));
+            .fold((f64::MIN, f64::MAX), |(hi, lo), p| (hi.max(*p), lo.min(*p)));
         let (mut lo, mut hi) = (p_lo / max_p, p_hi / min_p);
         // Start from the unclamped solution.
-        let free: f64 = lengths
-            .iter()
-            .zip(&path.speeds)
-            .map(|(l, v)| l * pace_of(v))
-            .sum();
+        let free: f64 = lengths.iter().zip(&paces).map(|(l, p)| l * p).sum();
         let mut a = (target / free).clamp(lo, hi);
         for _ in 0..100 {
             let (t, slope) = eval(a);
@@ -338,22 +337,19 @@ pub fn retime_legs(path: Path, lengths: &[f64], vehicle: &Vehicle, target: f64) 
         }
         Some(a)
     };
-    let mut times = Vec::with_capacity(path.points.len());
+    let mut times = Vec::with_capacity(points.len());
     let mut t = 0.0;
     times.push(0.0);
-    for (l, v) in lengths.iter().zip(&path.speeds) {
+    for (l, p) in lengths.iter().zip(&paces) {
         let pace = match alpha {
             None => p_lo,
             Some(a) if a.is_infinite() => p_hi,
-            Some(a) => (a * pace_of(v)).clamp(p_lo, p_hi),
+            Some(a) => (a * p).clamp(p_lo, p_hi),
         };
         t += l * pace;
         times.push(t);
     }
-    Trajectory {
-        times,
-        points: path.points,
-    }
+    Trajectory { times, points }
 }
 
 #[cfg(test)]
