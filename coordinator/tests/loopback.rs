@@ -156,3 +156,71 @@ fn agents_that_never_join_are_named() -> TestResult {
     assert!(e.contains(&endpoint), "{e}");
     Ok(())
 }
+
+/// The cages fleet's inspection tours (two AUVs, a one-shot mission) with a debug-build budget.
+fn tours() -> Result<Scenario, Box<dyn std::error::Error>> {
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../scenarios/cages-fleet.toml");
+    let mut s = Scenario::load(&path)?;
+    s.optimizer.iterations = 60;
+    s.optimizer.particles = 20;
+    Ok(s)
+}
+
+/// An agent of `vehicle` that is up for `hold` and gone again before it accepts anything: its
+/// liveliness token only, as left behind by an agent killed just after it started planning,
+/// before its `Joined` went out.
+fn fleeting_agent(
+    vehicle: &str,
+    endpoint: &str,
+    hold: Duration,
+) -> std::thread::JoinHandle<anyhow::Result<()>> {
+    use zenoh::Wait;
+    let (vehicle, endpoint) = (vehicle.to_string(), endpoint.to_string());
+    std::thread::spawn(move || {
+        let config = shoal_common::wire::session::client_config(&[endpoint], true)?;
+        let session = zenoh::open(config)
+            .wait()
+            .map_err(|e| anyhow::anyhow!("open: {e}"))?;
+        let key = shoal_common::wire::topics::liveliness(&vehicle)?;
+        let token = session
+            .liveliness()
+            .declare_token(key.as_str())
+            .wait()
+            .map_err(|e| anyhow::anyhow!("token: {e}"))?;
+        std::thread::sleep(hold);
+        drop(token);
+        session
+            .close()
+            .wait()
+            .map_err(|e| anyhow::anyhow!("close: {e}"))?;
+        Ok(())
+    })
+}
+
+#[test]
+fn a_tour_agent_gone_before_it_joined_is_planned_by_the_coordinator() -> TestResult {
+    let s = tours()?;
+    let endpoint = free_endpoint()?;
+    let agents = vec![agent("auv1", &endpoint)];
+    let fleeting = fleeting_agent("auv2", &endpoint, Duration::from_secs(2));
+    // Before the fix the fleet waited for auv2 to come back and failed after the join timeout.
+    let plan = coordinate(&s, options("loopback-fleeting", &endpoint, 20), |_| {})??;
+    finish(agents)?;
+    match fleeting.join() {
+        Ok(r) => r?,
+        Err(_) => return Err("the fleeting agent's thread panicked".into()),
+    }
+    let d = plan.distributed.as_ref().ok_or("no distributed figures")?;
+    let names: Vec<&str> = d.degraded.iter().map(|x| x.vehicle.as_str()).collect();
+    assert_eq!(names, ["auv2"], "{:?}", d.degraded);
+    assert!(
+        plan.notices
+            .iter()
+            .any(|n| n.contains("auv2's tour was planned by the coordinator")),
+        "{:?}",
+        plan.notices
+    );
+    assert_eq!(plan.vehicles.len(), 2);
+    assert!(plan.fitness.is_finite());
+    Ok(())
+}

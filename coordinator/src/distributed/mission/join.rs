@@ -29,13 +29,7 @@ impl Run<'_> {
             if let Some(agents) = local.as_deref_mut() {
                 for (v, status) in agents.exited() {
                     let Some(i) = self.index(&v) else { continue };
-                    // A one-shot agent may finish (and exit) before the last one joins; its
-                    // result or `Done` can still be in flight, so it is only marked gone and
-                    // the share is planned here after the grace period if nothing comes.
-                    if self.job.is_some() || self.seats[i].joined {
-                        self.lost(i, format!("its agent process exited ({status})"));
-                        self.seats[i].joined = true;
-                    } else {
+                    if !self.left_while_joining(i, format!("its agent process exited ({status})")) {
                         anyhow::bail!(
                             "the agent of {v} exited before joining ({status}); see its log"
                         );
@@ -58,13 +52,16 @@ impl Run<'_> {
                 Some(Event::Alive(v)) => {
                     if let Some(i) = self.index(&v) {
                         self.seats[i].alive = true;
+                        self.seats[i].gone = None;
                         self.assign(i, context)?;
                     }
                 }
                 Some(Event::Gone(v)) => {
                     if let Some(i) = self.index(&v) {
-                        self.seats[i].alive = false;
-                        self.seats[i].joined = false;
+                        self.left_while_joining(
+                            i,
+                            "its agent left the network (liveliness token gone)".into(),
+                        );
                     }
                 }
                 Some(Event::Message(AgentToCoordinator::Joined { vehicle, .. })) => {
@@ -121,6 +118,26 @@ impl Run<'_> {
             }
         }
         Ok(())
+    }
+
+    /// Vehicle `i`'s agent went (its process exited, or its liveliness token went) while the
+    /// fleet was joining. Returns whether the fleet goes on without it.
+    ///
+    /// In a one-shot mission, or once the agent has joined, it is only marked gone: a one-shot
+    /// agent may finish (and exit) before the last one joins, its `Joined`, result or `Done` may
+    /// still be in flight, and an agent killed just after it accepted may never have sent its
+    /// `Joined` at all. Its share is then planned here after the grace period if nothing comes
+    /// (in an exchange mission: its followers, see [`Run::collect`]). Otherwise the seat waits
+    /// for an agent to come (back) until the join deadline.
+    fn left_while_joining(&mut self, i: usize, why: String) -> bool {
+        if self.job.is_some() || self.seats[i].joined {
+            self.lost(i, why);
+            self.seats[i].joined = true;
+            true
+        } else {
+            self.seats[i].alive = false;
+            false
+        }
     }
 
     fn join_error(&self) -> anyhow::Error {
