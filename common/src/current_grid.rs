@@ -56,11 +56,11 @@ pub const SPACING_TOLERANCE: f64 = 1e-6;
 #[derive(Debug, thiserror::Error)]
 pub enum CurrentGridError {
     /// The file could not be read.
-    #[error("{}: cannot read: {source}", file.display())]
+    /// The reason is in the message, not a `source` (a chained report would print it twice).
+    #[error("{}: cannot read: {error}", file.display())]
     Io {
         file: PathBuf,
-        #[source]
-        source: std::io::Error,
+        error: std::io::Error,
     },
     /// The first line that is not blank or a comment is not `x,y,z,u,v,w` (`found` is empty when
     /// the file has no such line).
@@ -232,9 +232,9 @@ fn index_of(values: &[f64], v: f64) -> Option<usize> {
 impl GridCurrent {
     /// Reads a current grid file (see the [module documentation](self) for the format).
     pub fn load(path: &Path) -> Result<GridCurrent, CurrentGridError> {
-        let text = std::fs::read_to_string(path).map_err(|source| CurrentGridError::Io {
+        let text = std::fs::read_to_string(path).map_err(|error| CurrentGridError::Io {
             file: path.to_path_buf(),
-            source,
+            error,
         })?;
         GridCurrent::from_csv(&text, path)
     }

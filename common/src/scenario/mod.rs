@@ -31,11 +31,12 @@ pub const KNOT_MPS: f64 = 1852.0 / 3600.0;
 #[derive(Debug, thiserror::Error)]
 pub enum ScenarioError {
     /// The file could not be read at all.
-    #[error("{file}: cannot read: {source}")]
+    /// The reason is in the message and deliberately not a `source`: a chained report (`{:#}`)
+    /// would print it twice.
+    #[error("{file}: cannot read: {error}")]
     Io {
         file: PathBuf,
-        #[source]
-        source: std::io::Error,
+        error: std::io::Error,
     },
     /// TOML syntax, an unknown key, a missing key or a value of the wrong type.
     #[error("{file}: {message}")]
@@ -201,9 +202,9 @@ pub struct Fleet {
 impl Scenario {
     /// Reads, parses and validates a scenario file.
     pub fn load(path: &Path) -> Result<Scenario, ScenarioError> {
-        let text = std::fs::read_to_string(path).map_err(|source| ScenarioError::Io {
+        let text = std::fs::read_to_string(path).map_err(|error| ScenarioError::Io {
             file: path.to_path_buf(),
-            source,
+            error,
         })?;
         Scenario::parse(&text, path)
     }
@@ -534,4 +535,4 @@ impl Scenario {
 }
 
 #[cfg(test)]
-mod tests;
+pub(crate) mod tests;

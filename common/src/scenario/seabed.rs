@@ -191,9 +191,9 @@ fn load_grid(g: &SeabedGrid, file: &Path, bad: Bad) -> Result<HeightGrid, Scenar
             ));
         }
         std::fs::read_to_string(&g.file)
-            .map_err(|source| crate::terrain::TerrainError::Io {
+            .map_err(|error| crate::terrain::TerrainError::Io {
                 file: g.file.clone(),
-                source,
+                error,
             })
             .and_then(|text| HeightGrid::from_csv(&text, &g.file, g.cell_m, g.origin))
     } else {

@@ -31,6 +31,36 @@ fn parse(text: &str) -> Result<Scenario, ScenarioError> {
     Scenario::parse(text, Path::new("scenarios/x.toml"))
 }
 
+/// The report `main` prints (`{:#}`): the error and every `source` below it, joined by ": ".
+pub(crate) fn chained(e: &dyn std::error::Error) -> String {
+    let mut text = e.to_string();
+    let mut next = e.source();
+    while let Some(s) = next {
+        text = format!("{text}: {s}");
+        next = s.source();
+    }
+    text
+}
+
+#[test]
+fn a_missing_file_is_named_with_its_reason_once() {
+    let missing = Path::new("/nonexistent-shoal-dir/m.toml");
+    let Err(e) = Scenario::load(missing) else {
+        panic!("a missing file loaded");
+    };
+    let Err(io) = std::fs::read_to_string(missing) else {
+        panic!("a missing file was read");
+    };
+    let reason = io.to_string();
+    let text = chained(&e);
+    assert!(
+        text.starts_with("/nonexistent-shoal-dir/m.toml: cannot read: "),
+        "{text}"
+    );
+    // The OS words ("No such file or directory (os error 2)") once, not once per chain link.
+    assert_eq!(text.matches(&reason).count(), 1, "{text}");
+}
+
 #[test]
 fn good_file_parses_with_table5_defaults() -> Result<(), ScenarioError> {
     let s = parse(GOOD)?;

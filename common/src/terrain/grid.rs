@@ -7,10 +7,11 @@ use std::path::{Path, PathBuf};
 #[derive(Debug, thiserror::Error)]
 pub enum TerrainError {
     /// The file could not be read.
-    #[error("{}: cannot read: {source}", file.display())]
+    /// The reason is in the message, not a `source` (a chained report would print it twice).
+    #[error("{}: cannot read: {error}", file.display())]
     Io {
         file: PathBuf,
-        source: std::io::Error,
+        error: std::io::Error,
     },
     /// [`HeightGrid::load`] does not know the extension.
     #[error("{}: unknown terrain format (expected extension .asc or .csv)", file.display())]
@@ -375,9 +376,9 @@ impl HeightGrid {
                 })
             }
         };
-        let text = std::fs::read_to_string(path).map_err(|source| TerrainError::Io {
+        let text = std::fs::read_to_string(path).map_err(|error| TerrainError::Io {
             file: path.to_path_buf(),
-            source,
+            error,
         })?;
         parse(&text, path)
     }
@@ -564,7 +565,15 @@ mod tests {
             ([0.0, 0.0], 1.0, Some(3.0))
         );
         let missing = HeightGrid::load(&dir.join("none.csv"));
-        assert!(matches!(missing, Err(TerrainError::Io { .. })));
+        match missing {
+            // The OS reason once in the chained report, which is what `main` prints.
+            Err(e @ TerrainError::Io { .. }) => {
+                let text = crate::scenario::tests::chained(&e);
+                assert_eq!(text.matches("(os error").count(), 1, "{text}");
+                assert!(text.contains("none.csv: cannot read: "), "{text}");
+            }
+            other => panic!("{other:?}"),
+        }
         let txt = HeightGrid::load(&dir.join("g.txt"));
         assert!(matches!(txt, Err(TerrainError::UnknownFormat { .. })));
         std::fs::remove_dir_all(&dir)?;
