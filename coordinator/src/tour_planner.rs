@@ -32,6 +32,7 @@ pub fn plan(
         Err(why) => return unplannable(scenario, why),
     };
     let n = scenario.vehicles.len();
+    let mut evaluations = 0;
     let tours: Vec<TourPlan> = std::thread::scope(|s| {
         let job = &job;
         let handles: Vec<_> = (0..n)
@@ -43,11 +44,12 @@ pub fn plan(
             .map(|(v, h)| {
                 // A planning thread cannot panic on scenario data; if it did, plan again here.
                 let t = h.join().unwrap_or_else(|_| job.plan_vehicle(v));
+                evaluations += t.evaluations;
                 observe(&IterationReport {
                     iteration: v + 1,
                     max_iterations: n,
                     best_cost: t.tour_length_m,
-                    evaluations: 0,
+                    evaluations,
                 });
                 t
             })
@@ -154,7 +156,7 @@ pub fn assemble(
         common_arrival_s: finish,
         d_min_m: scenario.fleet.d_min_m,
         iterations: o.iterations,
-        evaluations: 0,
+        evaluations: tours.iter().map(|t| t.evaluations).sum(),
         termination: "MaxIterations".to_string(),
         vehicles: assessment.vehicles,
         fleet: assessment.fleet,

@@ -46,6 +46,9 @@ fn agents_plan_their_own_tours_and_match_the_in_process_plan() -> TestResult {
         );
         assert_eq!(json["vehicles"][k]["tour"], local["vehicles"][k]["tour"]);
     }
+    // The agents' evaluations come up with their tours: the same count as planning here.
+    assert!(key(&json, "evaluations").as_u64().is_some_and(|n| n > 0));
+    assert_eq!(key(&json, "evaluations"), key(&local, "evaluations"));
     fleet.passed();
     Ok(())
 }

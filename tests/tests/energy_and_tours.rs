@@ -110,6 +110,9 @@ fn de_pso_tours_inspect_every_cage_without_touching_one() -> TestResult {
         let growth = num(t, "growth_m");
         assert!(growth >= 0.0 && num(t, "growth_rate") < 0.5, "{group}: {t}");
         assert!((num(t, "tour_length_m") - num(t, "straight_tour_length_m") - growth).abs() < 1e-6);
+        // The order swarm alone evaluates 100 × (2000 + 1) tours (seed 003 Table 3).
+        let evaluations = key(&json, "evaluations").as_u64().unwrap_or(0);
+        assert!(evaluations >= 100 * 2001, "{group}: {evaluations}");
     }
     Ok(())
 }

@@ -234,19 +234,24 @@ fn run_share(
     plan: &SharePlanner,
 ) -> MissionReport {
     let iterations = a.scenario.optimizer.iterations as u32;
-    let outcome = match plan(a) {
+    let (outcome, evaluations) = match plan(a) {
         Ok((message, words)) => {
+            // A tour's swarms count their evaluations; a coverage strip has no swarm.
+            let evaluations = match &message {
+                AgentToCoordinator::Tour { evaluations, .. } => *evaluations,
+                _ => 0,
+            };
             send(message);
-            words
+            (words, evaluations)
         }
-        Err(why) => why,
+        Err(why) => (why, 0),
     };
     send(AgentToCoordinator::Done {
         mission: a.mission.clone(),
         vehicle: a.vehicle.clone(),
         iterations,
         elites_sent: 0,
-        evaluations: 0,
+        evaluations,
         dropped: dropped.load(Ordering::Relaxed),
     });
     MissionReport {

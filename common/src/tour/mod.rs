@@ -37,7 +37,7 @@ use crate::swarm::depso::DePso;
 use crate::swarm::lcpso::Lcpso;
 use crate::swarm::ldiwpso::LdiwPso;
 use crate::swarm::multi::stream_seed;
-use crate::swarm::{Executor, SolverState, VelocityCapped};
+use crate::swarm::{Executor, Outcome, SolverState, VelocityCapped};
 
 /// Clearance the leg planner keeps from a cage's surface, metres. The seed treats the AUV as a
 /// point and the cage sphere itself as the obstacle; 1 m of margin stays well inside the 5 m
@@ -135,9 +135,13 @@ pub struct TourPlan {
     /// Segment–cage intersections along `path`, against the cages inflated by the clearance,
     /// with the contact guard (0 for a safe tour).
     pub cage_intersections: usize,
+    /// Cost evaluations spent on it: the order swarm's tour lengths plus every leg swarm's path
+    /// costs (a straight leg that is already clear costs none).
+    pub evaluations: u64,
 }
 
-/// Plans one leg with `algorithm`; returns its polyline (both end points included).
+/// Plans one leg with `algorithm`; returns its polyline (both end points included) and the cost
+/// evaluations its swarm made.
 ///
 /// A straight leg that is already clear is kept as it is: nothing is shorter, so no swarm is run.
 /// Otherwise the swarm's best path is returned, or the straight one if the swarm did worse by the
@@ -147,37 +151,36 @@ pub fn plan_leg(
     algorithm: LegAlgorithm,
     settings: &LegSettings,
     seed: u64,
-) -> Vec<Vec3> {
+) -> (Vec<Vec3>, u64) {
     let straight = vec![problem.start, problem.end];
     if problem.waypoints == 0 || problem.feasible(&straight) {
-        return straight;
+        return (straight, 0);
     }
     let ex = Executor::new(settings.iterations);
     let m = settings.particles;
     let cap = settings.velocity_cap;
-    let best = match algorithm {
-        LegAlgorithm::DePso => ex
-            .run(problem, &mut DePso::table5(m, seed).capped(cap), |_| {})
-            .state
-            .best_position()
-            .to_vec(),
-        LegAlgorithm::LdiwPso => ex
-            .run(problem, &mut LdiwPso::table5(m, seed).capped(cap), |_| {})
-            .state
-            .best_position()
-            .to_vec(),
-        LegAlgorithm::Lcpso => ex
-            .run(problem, &mut Lcpso::table5(m, seed).capped(cap), |_| {})
-            .state
-            .best_position()
-            .to_vec(),
+    let (best, evaluations) = match algorithm {
+        LegAlgorithm::DePso => {
+            best_of(ex.run(problem, &mut DePso::table5(m, seed).capped(cap), |_| {}))
+        }
+        LegAlgorithm::LdiwPso => {
+            best_of(ex.run(problem, &mut LdiwPso::table5(m, seed).capped(cap), |_| {}))
+        }
+        LegAlgorithm::Lcpso => {
+            best_of(ex.run(problem, &mut Lcpso::table5(m, seed).capped(cap), |_| {}))
+        }
     };
     let path = problem.path(&best);
     if problem.path_cost(&path) <= problem.path_cost(&straight) {
-        path
+        (path, evaluations)
     } else {
-        straight
+        (straight, evaluations)
     }
+}
+
+/// The best position of a finished run and the evaluations it made.
+fn best_of<S: SolverState>(run: Outcome<S>) -> (Vec<f64>, u64) {
+    (run.state.best_position().to_vec(), run.state.evaluations())
 }
 
 /// Plans a closed inspection tour from `base` through every point of `points` (seed 003 §V).
@@ -203,7 +206,7 @@ pub fn plan_tour(
         seed: stream_seed(seed, 0),
         ..settings.order.clone()
     };
-    let tour = orderer.order(&dist);
+    let (tour, mut evaluations) = orderer.order_counted(&dist);
     let order: Vec<usize> = tour
         .iter()
         .skip(1)
@@ -221,12 +224,13 @@ pub fn plan_tour(
             bounds,
             settings.leg.waypoints,
         );
-        let leg = plan_leg(
+        let (leg, spent) = plan_leg(
             &problem,
             algorithm,
             &settings.leg,
             stream_seed(seed, k as u64 + 1),
         );
+        evaluations += spent;
         leg_lengths.push(path_length(&leg));
         path.extend(leg.into_iter().skip(1));
     }
@@ -246,6 +250,7 @@ pub fn plan_tour(
         } else {
             0.0
         },
+        evaluations,
     }
 }
 
@@ -291,6 +296,10 @@ mod tests {
     fn de_pso_tour_of_group_a_is_safe_and_complete() {
         let (pts, plan) = group_a_plan(LegAlgorithm::DePso, 1);
         assert_eq!(plan.cage_intersections, 0, "{plan:?}");
+        // The order swarm's 50 × (300 + 1) tours, plus the swarms of the legs that had to bend
+        // round a cage (the tour is longer than its straight legs, so at least one did).
+        assert!(plan.growth_m > 0.0);
+        assert!(plan.evaluations > 50 * 301, "{}", plan.evaluations);
         // Every point exactly once, in order along the path.
         let mut seen = plan.order.clone();
         seen.sort_unstable();
@@ -397,7 +406,7 @@ mod tests {
             5,
         );
         let leg = plan_leg(&p, LegAlgorithm::DePso, &small().leg, 0);
-        assert_eq!(leg, vec![p.start, p.end]);
+        assert_eq!(leg, (vec![p.start, p.end], 0), "no swarm, no evaluation");
         assert_eq!(LegAlgorithm::Lcpso.name(), "lcpso");
     }
 
@@ -412,10 +421,12 @@ mod tests {
             paper_bounds(),
             5,
         );
-        for algorithm in [
-            LegAlgorithm::DePso,
-            LegAlgorithm::LdiwPso,
-            LegAlgorithm::Lcpso,
+        // Evaluations: 30 particles at the start, then each particle once per iteration (its
+        // move), and DE-PSO once more (its DE trial): 30 + 10 × 30 = 330, 30 + 10 × 60 = 630.
+        for (algorithm, evaluations) in [
+            (LegAlgorithm::DePso, 630),
+            (LegAlgorithm::LdiwPso, 330),
+            (LegAlgorithm::Lcpso, 330),
         ] {
             let with = |cap| {
                 let settings = LegSettings {
@@ -425,12 +436,14 @@ mod tests {
                 };
                 plan_leg(&p, algorithm, &settings, 3)
             };
-            let own = with(None);
+            let (own, spent) = with(None);
             assert_ne!(
                 own,
                 vec![p.start, p.end],
                 "{algorithm:?} kept a blocked leg"
             );
+            assert_eq!(spent, evaluations, "{algorithm:?}");
+            let with = |cap| with(cap).0;
             // Table 5's solvers' own cap is 0.2: naming it changes nothing, another cap does.
             assert_eq!(own, with(Some(0.2)), "{algorithm:?}");
             assert_ne!(own, with(Some(0.005)), "{algorithm:?}");

@@ -140,23 +140,30 @@ impl SwapPso {
     /// A short closed tour over the nodes of `dist` (a square matrix, node 0 the base): the node
     /// sequence, starting and ending with 0 (`[0, …, 0]`, length n + 1; `[]` for no node).
     pub fn order(&self, dist: &[Vec<f64>]) -> Vec<usize> {
+        self.order_counted(dist).0
+    }
+
+    /// [`SwapPso::order`] and the tour lengths the swarm evaluated (the 2-opt pass after it
+    /// compares edge pairs, not tours, and is not counted).
+    pub fn order_counted(&self, dist: &[Vec<f64>]) -> (Vec<usize>, u64) {
         let n = dist.len();
         if n == 0 {
-            return Vec::new();
+            return (Vec::new(), 0);
         }
-        let mut best = self.search(dist, (1..n).collect());
+        let (mut best, evaluations) = self.search(dist, (1..n).collect());
         two_opt(dist, &mut best);
         let mut tour = Vec::with_capacity(n + 1);
         tour.push(0);
         tour.extend(best);
         tour.push(0);
-        tour
+        (tour, evaluations)
     }
 
-    /// The PSO itself over permutations of `nodes`; returns the best order found.
-    fn search(&self, dist: &[Vec<f64>], nodes: Vec<usize>) -> Vec<usize> {
+    /// The PSO itself over permutations of `nodes`; returns the best order found and the
+    /// evaluations made (none for fewer than two nodes: there is only one order).
+    fn search(&self, dist: &[Vec<f64>], nodes: Vec<usize>) -> (Vec<usize>, u64) {
         if nodes.len() < 2 {
-            return nodes;
+            return (nodes, 0);
         }
         let mut rng = StdRng::seed_from_u64(self.seed);
         let m = self.particles.max(1);
@@ -169,6 +176,7 @@ impl SwapPso {
             .collect();
         let mut vs: Vec<Vec<(usize, usize)>> = vec![Vec::new(); m];
         let mut costs: Vec<f64> = xs.iter().map(|x| open_order_length(dist, x)).collect();
+        let mut evaluations = m as u64;
         let mut pbest = xs.clone();
         let mut pcost = costs.clone();
         let (mut gbest, mut gcost) = (xs[0].clone(), costs[0]);
@@ -204,6 +212,7 @@ impl SwapPso {
                 }
                 vs[i] = v;
                 costs[i] = open_order_length(dist, x);
+                evaluations += 1;
                 if costs[i] < pcost[i] {
                     pcost[i] = costs[i];
                     pbest[i].clone_from(x);
@@ -216,7 +225,7 @@ impl SwapPso {
             // seed 003 eq. (13)
             w -= (w - 0.01) / m as f64;
         }
-        gbest
+        (gbest, evaluations)
     }
 }
 
@@ -328,7 +337,9 @@ mod tests {
     fn swap_pso_without_2_opt_already_finds_the_optimum() {
         // The PSO alone (the polish disabled by calling the search directly) on 8 nodes.
         let d = random_instance(8, 11);
-        let best = SwapPso::table3(11).search(&d, (1..8).collect());
+        let (best, evaluations) = SwapPso::table3(11).search(&d, (1..8).collect());
+        // Table 3: 100 particles evaluated at the start and once in each of 2000 iterations.
+        assert_eq!(evaluations, 100 * 2001);
         assert_abs_diff_eq!(
             open_order_length(&d, &best),
             brute_force(&d),
@@ -349,5 +360,9 @@ mod tests {
         // A ragged matrix does not panic; its missing entries are unreachable.
         let ragged = vec![vec![0.0, 1.0], vec![1.0]];
         assert_eq!(p.order(&ragged), vec![0, 1, 0]);
+        // Counted: 100 × (200 + 1) tours for 9 points; none when there is one order only.
+        assert_eq!(p.order_counted(&d), (p.order(&d), 100 * 201));
+        assert_eq!(p.order_counted(&[vec![0.0]]).1, 0);
+        assert_eq!(p.order_counted(&ragged).1, 0);
     }
 }

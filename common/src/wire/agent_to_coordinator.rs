@@ -65,6 +65,8 @@ pub enum AgentToCoordinator {
         straight_m: f64,
         /// Segment–cage intersections of `path`.
         intersections: u32,
+        /// Cost evaluations the agent spent on the tour (protocol version 2).
+        evaluations: u64,
     },
     /// Fleet coverage missions (seed 002 with several crawlers): the plan of the agent's strip
     /// (its figures and its exact path). Sent once, before `Done`.
@@ -91,6 +93,7 @@ impl AgentToCoordinator {
             leg_lengths: t.leg_lengths.clone(),
             straight_m: t.straight_tour_length_m,
             intersections: t.cage_intersections as u32,
+            evaluations: t.evaluations,
         }
     }
 
@@ -126,6 +129,7 @@ pub fn tour_from_wire(
     leg_lengths: &[f64],
     straight_m: f64,
     intersections: u32,
+    evaluations: u64,
     share_len: usize,
 ) -> Result<TourPlan, String> {
     let finite = path.iter().flatten().all(|v| v.is_finite())
@@ -155,6 +159,7 @@ pub fn tour_from_wire(
             0.0
         },
         cage_intersections: intersections as usize,
+        evaluations,
     })
 }
 
@@ -173,6 +178,7 @@ mod tests {
             growth_m: 2.0,
             growth_rate: 0.25,
             cage_intersections: 0,
+            evaluations: 12_345,
         };
         let AgentToCoordinator::Tour {
             order,
@@ -180,16 +186,25 @@ mod tests {
             leg_lengths,
             straight_m,
             intersections,
+            evaluations,
             ..
         } = AgentToCoordinator::tour("m", "auv1", &t)
         else {
             panic!("not a tour");
         };
-        let back = tour_from_wire(&order, &path, &leg_lengths, straight_m, intersections, 2);
+        let back = tour_from_wire(
+            &order,
+            &path,
+            &leg_lengths,
+            straight_m,
+            intersections,
+            evaluations,
+            2,
+        );
         assert_eq!(back, Ok(t));
-        assert!(tour_from_wire(&order, &path, &leg_lengths, straight_m, 0, 1).is_err());
-        assert!(tour_from_wire(&order, &[[f64::NAN, 0.0, 0.0]], &[], 0.0, 0, 2).is_err());
-        assert!(tour_from_wire(&[], &[], &[], 0.0, 0, 0).is_err());
+        assert!(tour_from_wire(&order, &path, &leg_lengths, straight_m, 0, 0, 1).is_err());
+        assert!(tour_from_wire(&order, &[[f64::NAN, 0.0, 0.0]], &[], 0.0, 0, 0, 2).is_err());
+        assert!(tour_from_wire(&[], &[], &[], 0.0, 0, 0, 0).is_err());
     }
 
     #[test]

@@ -22,7 +22,9 @@ use crate::distributed::{Chromosome, Context};
 use crate::trajectory::Trajectory;
 
 /// Protocol version every message carries; a peer speaking another version is ignored.
-pub const PROTOCOL_VERSION: u16 = 1;
+/// Bumped whenever a message's layout changes (bincode is not self-describing):
+/// 2 — `AgentToCoordinator::Tour` carries the tour's evaluations.
+pub const PROTOCOL_VERSION: u16 = 2;
 
 /// A message of either direction with its protocol version.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

@@ -67,6 +67,7 @@ impl ShareJob {
                     leg_lengths,
                     straight_m,
                     intersections,
+                    evaluations,
                     ..
                 },
             ) => {
@@ -78,6 +79,7 @@ impl ShareJob {
                         &leg_lengths,
                         straight_m,
                         intersections,
+                        evaluations,
                         share,
                     )
                     .map(Share::Tour),
