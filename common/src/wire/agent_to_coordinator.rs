@@ -122,34 +122,43 @@ impl AgentToCoordinator {
 
 /// The tour a `Tour` message carries, checked: every number finite, a path of at least one
 /// point, and no visit index beyond `share_len`. The length is the legs' sum (as the planner
-/// adds it up), the growth is recomputed from it.
+/// adds it up), the growth is recomputed from it. `None` for any other kind of message.
 pub fn tour_from_wire(
-    order: &[u32],
-    path: &[[f64; 3]],
-    leg_lengths: &[f64],
-    straight_m: f64,
-    intersections: u32,
-    evaluations: u64,
+    m: &AgentToCoordinator,
     share_len: usize,
-) -> Result<TourPlan, String> {
+) -> Option<Result<TourPlan, String>> {
+    let AgentToCoordinator::Tour {
+        order,
+        path,
+        leg_lengths,
+        straight_m,
+        intersections,
+        evaluations,
+        ..
+    } = m
+    else {
+        return None;
+    };
+    let straight_m = *straight_m;
     let finite = path.iter().flatten().all(|v| v.is_finite())
         && leg_lengths.iter().all(|v| v.is_finite())
         && straight_m.is_finite();
     if !finite || path.is_empty() {
-        return Err("a tour with an empty path or a non-finite number".into());
-    }
-    if let Some(k) = order.iter().find(|&&k| k as usize >= share_len) {
-        return Err(format!(
-            "a tour visiting point {k} of a share of {share_len} points"
+        return Some(Err(
+            "a tour with an empty path or a non-finite number".into()
         ));
     }
-    let path: Vec<Vec3> = path.iter().map(|p| Vec3::new(p[0], p[1], p[2])).collect();
+    if let Some(k) = order.iter().find(|&&k| k as usize >= share_len) {
+        return Some(Err(format!(
+            "a tour visiting point {k} of a share of {share_len} points"
+        )));
+    }
     let tour_length_m: f64 = leg_lengths.iter().sum();
     let growth_m = tour_length_m - straight_m;
-    Ok(TourPlan {
+    Some(Ok(TourPlan {
         order: order.iter().map(|&k| k as usize).collect(),
-        path,
-        leg_lengths: leg_lengths.to_vec(),
+        path: path.iter().map(|p| Vec3::new(p[0], p[1], p[2])).collect(),
+        leg_lengths: leg_lengths.clone(),
         tour_length_m,
         straight_tour_length_m: straight_m,
         growth_m,
@@ -158,9 +167,9 @@ pub fn tour_from_wire(
         } else {
             0.0
         },
-        cage_intersections: intersections as usize,
-        evaluations,
-    })
+        cage_intersections: *intersections as usize,
+        evaluations: *evaluations,
+    }))
 }
 
 #[cfg(test)]
@@ -180,31 +189,32 @@ mod tests {
             cage_intersections: 0,
             evaluations: 12_345,
         };
-        let AgentToCoordinator::Tour {
-            order,
-            path,
-            leg_lengths,
-            straight_m,
-            intersections,
-            evaluations,
-            ..
-        } = AgentToCoordinator::tour("m", "auv1", &t)
-        else {
-            panic!("not a tour");
-        };
-        let back = tour_from_wire(
-            &order,
-            &path,
-            &leg_lengths,
-            straight_m,
-            intersections,
-            evaluations,
-            2,
+        let m = AgentToCoordinator::tour("m", "auv1", &t);
+        assert_eq!(tour_from_wire(&m, 2), Some(Ok(t)));
+        assert!(
+            matches!(tour_from_wire(&m, 1), Some(Err(_))),
+            "point 1 of a share of 1"
         );
-        assert_eq!(back, Ok(t));
-        assert!(tour_from_wire(&order, &path, &leg_lengths, straight_m, 0, 0, 1).is_err());
-        assert!(tour_from_wire(&order, &[[f64::NAN, 0.0, 0.0]], &[], 0.0, 0, 0, 2).is_err());
-        assert!(tour_from_wire(&[], &[], &[], 0.0, 0, 0, 0).is_err());
+        let tour = |path: Vec<[f64; 3]>| AgentToCoordinator::Tour {
+            mission: "m".into(),
+            vehicle: "auv1".into(),
+            order: vec![],
+            path,
+            leg_lengths: vec![],
+            straight_m: 0.0,
+            intersections: 0,
+            evaluations: 0,
+        };
+        assert!(matches!(
+            tour_from_wire(&tour(vec![[f64::NAN, 0.0, 0.0]]), 2),
+            Some(Err(_))
+        ));
+        assert!(matches!(tour_from_wire(&tour(vec![]), 0), Some(Err(_))));
+        let joined = AgentToCoordinator::Joined {
+            mission: "m".into(),
+            vehicle: "auv1".into(),
+        };
+        assert_eq!(tour_from_wire(&joined, 2), None);
     }
 
     #[test]

@@ -59,31 +59,9 @@ impl ShareJob {
     /// is not this job's kind of result.
     fn read(&self, i: usize, m: AgentToCoordinator) -> Option<Result<Share, String>> {
         match (self, m) {
-            (
-                ShareJob::Tours(job),
-                AgentToCoordinator::Tour {
-                    order,
-                    path,
-                    leg_lengths,
-                    straight_m,
-                    intersections,
-                    evaluations,
-                    ..
-                },
-            ) => {
+            (ShareJob::Tours(job), m) => {
                 let share = job.shares.get(i).map_or(0, Vec::len);
-                Some(
-                    tour_from_wire(
-                        &order,
-                        &path,
-                        &leg_lengths,
-                        straight_m,
-                        intersections,
-                        evaluations,
-                        share,
-                    )
-                    .map(Share::Tour),
-                )
+                tour_from_wire(&m, share).map(|t| t.map(Share::Tour))
             }
             (ShareJob::Strips(job, _), AgentToCoordinator::Coverage { strip, plan, .. }) => {
                 Some(match job.strips.get(i) {
