@@ -40,3 +40,14 @@ pub fn straight_particle(model: &FleetModel) -> Vec<f64> {
     }
     x
 }
+
+/// The report `main` prints (`{:#}`): the error and every `source` below it, joined by ": ".
+pub fn chained(e: &dyn std::error::Error) -> String {
+    let mut text = e.to_string();
+    let mut next = e.source();
+    while let Some(s) = next {
+        text = format!("{text}: {s}");
+        next = s.source();
+    }
+    text
+}

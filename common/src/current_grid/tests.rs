@@ -202,7 +202,7 @@ fn load_reads_a_file_and_names_an_unreadable_one() -> TestResult {
         Err(e @ CurrentGridError::Io { .. }) => {
             assert!(e.to_string().contains("none.csv: cannot read"), "{e}");
             // The OS reason once in the chained report, which is what `main` prints.
-            let text = crate::scenario::tests::chained(&e);
+            let text = crate::fixtures::chained(&e);
             assert_eq!(text.matches("(os error").count(), 1, "{text}");
         }
         other => panic!("{other:?}"),

@@ -535,4 +535,4 @@ impl Scenario {
 }
 
 #[cfg(test)]
-pub(crate) mod tests;
+mod tests;

@@ -31,17 +31,6 @@ fn parse(text: &str) -> Result<Scenario, ScenarioError> {
     Scenario::parse(text, Path::new("scenarios/x.toml"))
 }
 
-/// The report `main` prints (`{:#}`): the error and every `source` below it, joined by ": ".
-pub(crate) fn chained(e: &dyn std::error::Error) -> String {
-    let mut text = e.to_string();
-    let mut next = e.source();
-    while let Some(s) = next {
-        text = format!("{text}: {s}");
-        next = s.source();
-    }
-    text
-}
-
 #[test]
 fn a_missing_file_is_named_with_its_reason_once() {
     let missing = Path::new("/nonexistent-shoal-dir/m.toml");
@@ -52,7 +41,7 @@ fn a_missing_file_is_named_with_its_reason_once() {
         panic!("a missing file was read");
     };
     let reason = io.to_string();
-    let text = chained(&e);
+    let text = crate::fixtures::chained(&e);
     assert!(
         text.starts_with("/nonexistent-shoal-dir/m.toml: cannot read: "),
         "{text}"
