@@ -4,6 +4,7 @@
 use std::fmt::Write;
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
 
 use shoal_common::plan::Plan;
 use shoal_common::scenario::{Algorithm, Scenario};
@@ -108,7 +109,7 @@ pub fn compare(
     algorithms: &[Algorithm],
     seeds: std::ops::Range<u64>,
     distributed: Option<&DistributedOptions>,
-    stop: &AtomicBool,
+    stop: &Arc<AtomicBool>,
     progress: &mut dyn FnMut(&Plan),
 ) -> anyhow::Result<Vec<Cell>> {
     let mut cells = Vec::new();
@@ -245,7 +246,7 @@ mod tests {
             &[Algorithm::Pso, Algorithm::APso],
             1..4,
             None,
-            &AtomicBool::new(false),
+            &Arc::new(AtomicBool::new(false)),
             &mut |p| seen.push((p.algorithm.clone(), p.seed, p.fitness)),
         )
         .unwrap_or_else(|e| panic!("compare failed: {e}"));
@@ -279,7 +280,7 @@ mod tests {
             &[Algorithm::Pso],
             1..3,
             None,
-            &AtomicBool::new(true),
+            &Arc::new(AtomicBool::new(true)),
             &mut |_| {},
         )
         .unwrap_or_else(|e| panic!("compare failed: {e}"));

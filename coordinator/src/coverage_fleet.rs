@@ -6,6 +6,7 @@
 
 use std::path::Path;
 use std::sync::atomic::AtomicBool;
+use std::sync::Arc;
 
 use anyhow::Context;
 use serde::Serialize;
@@ -42,7 +43,7 @@ pub fn plan_fleet_coverage(
     scenario: &Scenario,
     out: &Path,
     quiet: bool,
-    distributed: Option<(&DistributedOptions, &AtomicBool)>,
+    distributed: Option<(&DistributedOptions, &Arc<AtomicBool>)>,
 ) -> anyhow::Result<bool> {
     let job = FleetCoverage::new(scenario)
         .map_err(|e| anyhow::anyhow!("{}: {e}", scenario_file.display()))?;

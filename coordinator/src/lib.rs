@@ -80,7 +80,7 @@ pub fn run(command: Command, shutdown: Arc<AtomicBool>) -> anyhow::Result<i32> {
     }
 }
 
-fn compare_command(args: &compare::CompareArgs, stop: &AtomicBool) -> anyhow::Result<i32> {
+fn compare_command(args: &compare::CompareArgs, stop: &Arc<AtomicBool>) -> anyhow::Result<i32> {
     let scenarios = args
         .scenarios
         .iter()
@@ -241,7 +241,7 @@ fn plan_command(args: &PlanArgs, shutdown: Arc<AtomicBool>) -> anyhow::Result<i3
                 &scenario,
                 &args.out,
                 args.quiet,
-                options.as_ref().map(|o| (o, shutdown.as_ref())),
+                options.as_ref().map(|o| (o, &shutdown)),
             )?
         } else {
             coverage_cmd::plan_coverage_command(

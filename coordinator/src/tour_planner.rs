@@ -20,10 +20,11 @@ use shoal_common::trajectory::Trajectory;
 
 use crate::energy_planner::unplannable;
 
-/// Plans the scenario's inspection tours in this process, one thread per vehicle.
+/// Plans the scenario's inspection tours in this process, one thread per vehicle. A raised
+/// `stop` cuts every swarm short; the tours are still complete (see [`assemble`]).
 pub fn plan(
     scenario: &Scenario,
-    _stop: Option<Arc<AtomicBool>>,
+    stop: Option<Arc<AtomicBool>>,
     observe: &mut dyn FnMut(&IterationReport),
 ) -> Plan {
     let started = Instant::now();
@@ -34,16 +35,16 @@ pub fn plan(
     let n = scenario.vehicles.len();
     let mut evaluations = 0;
     let tours: Vec<TourPlan> = std::thread::scope(|s| {
-        let job = &job;
+        let (job, stop) = (&job, stop.as_ref());
         let handles: Vec<_> = (0..n)
-            .map(|v| s.spawn(move || job.plan_vehicle(v)))
+            .map(|v| s.spawn(move || job.plan_vehicle(v, stop)))
             .collect();
         handles
             .into_iter()
             .enumerate()
             .map(|(v, h)| {
                 // A planning thread cannot panic on scenario data; if it did, plan again here.
-                let t = h.join().unwrap_or_else(|_| job.plan_vehicle(v));
+                let t = h.join().unwrap_or_else(|_| job.plan_vehicle(v, stop));
                 evaluations += t.evaluations;
                 observe(&IterationReport {
                     iteration: v + 1,
@@ -59,6 +60,9 @@ pub fn plan(
 }
 
 /// The plan of a fleet's tours (one per vehicle, scenario order), however they were planned.
+/// When a stop cut any tour's swarms short, the plan says so (`termination` "Interrupted" and
+/// a notice naming those vehicles): it is complete and checked like any plan, but less
+/// optimised than the budget would make it.
 pub fn assemble(
     scenario: &Scenario,
     job: &FleetTours,
@@ -134,6 +138,19 @@ pub fn assemble(
     let total: f64 = tours.iter().map(|t| t.tour_length_m).sum();
     let penalty = tours.iter().map(|t| t.cage_intersections).sum::<usize>() as f64;
     let mut notices = Vec::new();
+    let cut: Vec<&str> = scenario
+        .vehicles
+        .iter()
+        .zip(tours)
+        .filter(|(_, t)| t.interrupted)
+        .map(|(v, _)| v.id.as_str())
+        .collect();
+    if !cut.is_empty() {
+        notices.push(format!(
+            "planning was interrupted: the tours of {} were finished from what their swarms had found so far (every point is still visited); this is the best plan found so far",
+            cut.join(", ")
+        ));
+    }
     if n > 1 {
         notices.push(format!(
             "{} inspection points shared among {n} AUVs; every AUV is back at its base at {finish:.0} s",
@@ -157,10 +174,84 @@ pub fn assemble(
         d_min_m: scenario.fleet.d_min_m,
         iterations: o.iterations,
         evaluations: tours.iter().map(|t| t.evaluations).sum(),
-        termination: "MaxIterations".to_string(),
+        termination: if cut.is_empty() {
+            "MaxIterations"
+        } else {
+            "Interrupted"
+        }
+        .to_string(),
         vehicles: assessment.vehicles,
         fleet: assessment.fleet,
         convergence: Vec::new(),
         distributed: None,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use std::path::PathBuf;
+
+    use super::*;
+
+    /// The cages fleet (two AUVs) with `iterations` for every swarm.
+    fn cages_fleet(iterations: usize) -> Result<Scenario, String> {
+        let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../scenarios/cages-fleet.toml");
+        let mut s = Scenario::load(&path).map_err(|e| e.to_string())?;
+        s.optimizer.iterations = iterations;
+        s.optimizer.particles = 20;
+        if let Some(inspection) = s.inspection.as_mut() {
+            inspection.order_iterations = iterations;
+            inspection.order_particles = 20;
+        }
+        Ok(s)
+    }
+
+    /// Inspection points the plan's tours visit, and the scenario's count.
+    fn visited(s: &Scenario, plan: &Plan) -> (usize, usize) {
+        let visited = plan
+            .vehicles
+            .iter()
+            .filter_map(|v| v.tour.as_ref())
+            .map(|t| t.order.len())
+            .sum();
+        let points = 2 * s.inspection.as_ref().map_or(0, |i| i.cage_indices(s).len());
+        (visited, points)
+    }
+
+    #[test]
+    fn ctrl_c_gives_complete_tours_marked_interrupted() -> Result<(), String> {
+        // A budget that would take hours: the plan comes back only if the stop reaches the
+        // swarms.
+        let s = cages_fleet(1_000_000)?;
+        let raised = Arc::new(AtomicBool::new(true));
+        let mut reports = 0;
+        let plan = plan(&s, Some(raised), &mut |_| reports += 1);
+        assert_eq!(plan.termination, "Interrupted");
+        assert!(
+            plan.notices.iter().any(|n| n
+                .starts_with("planning was interrupted: the tours of auv1, auv2 were finished")),
+            "{:?}",
+            plan.notices
+        );
+        let (visited, points) = visited(&s, &plan);
+        assert!(points > 0);
+        assert_eq!(visited, points);
+        assert_eq!(reports, 2, "one progress line per vehicle");
+        Ok(())
+    }
+
+    #[test]
+    fn a_stop_never_raised_changes_nothing() -> Result<(), String> {
+        let s = cages_fleet(20)?;
+        let lowered = Arc::new(AtomicBool::new(false));
+        let with = plan(&s, Some(lowered), &mut |_| {});
+        let without = plan(&s, None, &mut |_| {});
+        assert_eq!(with.termination, "MaxIterations");
+        assert!(!with.notices.iter().any(|n| n.contains("interrupted")));
+        assert_eq!(with.fitness, without.fitness);
+        assert_eq!(with.evaluations, without.evaluations);
+        let (visited, points) = visited(&s, &with);
+        assert_eq!(visited, points);
+        Ok(())
     }
 }

@@ -66,7 +66,7 @@ fn coordinate(
     let (tx, rx) = mpsc::channel();
     let s = s.clone();
     std::thread::spawn(move || {
-        let stop = AtomicBool::new(false);
+        let stop = Arc::new(AtomicBool::new(false));
         let plan = plan_distributed(&s, &o, &stop, &mut |st| on_iteration(st.iteration));
         let _ = tx.send(plan);
     });
@@ -222,5 +222,70 @@ fn a_tour_agent_gone_before_it_joined_is_planned_by_the_coordinator() -> TestRes
     );
     assert_eq!(plan.vehicles.len(), 2);
     assert!(plan.fitness.is_finite());
+    Ok(())
+}
+
+#[test]
+fn ctrl_c_in_a_tour_mission_ends_it_at_once_with_complete_tours() -> TestResult {
+    // A budget that would take hours: the test ends only if the stop reaches every swarm, the
+    // coordinator's and the agents'.
+    let mut s = tours()?;
+    s.optimizer.iterations = 1_000_000;
+    if let Some(inspection) = s.inspection.as_mut() {
+        inspection.order_iterations = 1_000_000;
+    }
+    let endpoint = free_endpoint()?;
+    let agents = vec![agent("auv1", &endpoint), agent("auv2", &endpoint)];
+    let o = options("loopback-tour-stop", &endpoint, 30);
+    let (tx, rx) = mpsc::channel();
+    let scenario = s.clone();
+    std::thread::spawn(move || {
+        let stop = Arc::new(AtomicBool::new(false));
+        let flag = Arc::clone(&stop);
+        // The first status comes once both agents have joined and are planning: Ctrl-C then.
+        let plan = plan_distributed(&scenario, &o, &stop, &mut |_| {
+            flag.store(true, Ordering::Relaxed)
+        });
+        let _ = tx.send(plan);
+    });
+    let plan = rx
+        .recv_timeout(LIMIT)
+        .map_err(|_| format!("no plan within {LIMIT:?}"))??;
+    assert_eq!(plan.termination, "Interrupted");
+    assert!(
+        plan.notices
+            .iter()
+            .any(|n| n.contains("planning was interrupted") && n.contains("auv1, auv2")),
+        "{:?}",
+        plan.notices
+    );
+    // The tours are the agents', cut short by the coordinator's Stop and sent as they stood:
+    // none had to be planned by the coordinator.
+    let d = plan.distributed.as_ref().ok_or("no distributed figures")?;
+    assert!(d.degraded.is_empty(), "{:?}", d.degraded);
+    assert!(plan.evaluations > 0);
+    // Every inspection point is still visited by one of the two tours.
+    let visited: usize = plan
+        .vehicles
+        .iter()
+        .filter_map(|v| v.tour.as_ref())
+        .map(|t| t.order.len())
+        .sum();
+    let points = 2 * s
+        .inspection
+        .as_ref()
+        .map_or(0, |i| i.cage_indices(&s).len());
+    assert!(points > 0);
+    assert_eq!(visited, points);
+    // The agents (one mission each) end by themselves: the coordinator's Stop cut their tours.
+    let deadline = std::time::Instant::now() + Duration::from_secs(30);
+    while agents.iter().any(|a| !a.handle.is_finished()) {
+        if std::time::Instant::now() > deadline {
+            finish(agents)?;
+            return Err("an agent still planned its tour 30 s after the coordinator's Stop".into());
+        }
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    finish(agents)?;
     Ok(())
 }

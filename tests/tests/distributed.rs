@@ -21,6 +21,7 @@ use std::time::{Duration, Instant};
 use common::fleet::{endpoint, free_port, Fleet, Handle};
 use common::{check_plan_run, coordinator, key, number, without_shoal_env, TestResult};
 use serde_json::Value;
+use shoal_common::wire::PROTOCOL_VERSION;
 use zenoh::Wait;
 
 /// Three AUVs; a distributed plan at the default budget takes about 2 s in a debug build.
@@ -265,12 +266,12 @@ fn bincode_str(s: &str) -> Vec<u8> {
     [&(s.len() as u64).to_le_bytes()[..], s.as_bytes()].concat()
 }
 
-/// A well-formed message of protocol version 3: were its version 2 (this build's), it would be a
-/// `CoordinatorToAgent::Stop` of `mission` (variant 3) — a receiver that ignored the version
-/// would end the mission early — and on an agent's `out` key it would read as a
+/// A well-formed message of the next protocol version: were its version this build's, it would
+/// be a `CoordinatorToAgent::Stop` of `mission` (variant 3) — a receiver that ignored the
+/// version would end the mission early — and on an agent's `out` key it would read as a
 /// `AgentToCoordinator::Joined` (variant 2) claiming `vehicle`.
 fn wrong_version(mission: &str, to_agent: bool, vehicle: &str) -> Vec<u8> {
-    let mut m = vec![3u8, 0];
+    let mut m = (PROTOCOL_VERSION + 1).to_le_bytes().to_vec();
     if to_agent {
         m.extend_from_slice(&3u32.to_le_bytes());
         m.extend(bincode_str(mission));
@@ -283,10 +284,15 @@ fn wrong_version(mission: &str, to_agent: bool, vehicle: &str) -> Vec<u8> {
     m
 }
 
-/// Version 2 (this build's), then an enum variant no message has: malformed for any reader of
-/// this version.
-fn malformed_v2(state: &mut u64) -> Vec<u8> {
-    [&[2u8, 0, 0xff, 0xff, 0xff, 0xff][..], &random_bytes(state)].concat()
+/// This build's version, then an enum variant no message has: malformed for any reader of this
+/// version.
+fn malformed_this_version(state: &mut u64) -> Vec<u8> {
+    [
+        &PROTOCOL_VERSION.to_le_bytes()[..],
+        &[0xff, 0xff, 0xff, 0xff],
+        &random_bytes(state),
+    ]
+    .concat()
 }
 
 /// Publishes garbage on `keys` every 50 ms from an independent Zenoh client of `endpoint` until
@@ -311,7 +317,7 @@ fn publish_garbage(
                 for (k, to_agent) in &keys {
                     for bytes in [
                         random_bytes(&mut state),
-                        malformed_v2(&mut state),
+                        malformed_this_version(&mut state),
                         wrong_version(&mission, *to_agent, "auv1"),
                     ] {
                         session.put(k.as_str(), bytes).wait()?;

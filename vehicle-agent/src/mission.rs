@@ -96,7 +96,7 @@ pub fn run(
         return run_strip(&a, send, dropped);
     }
     if a.scenario.optimizer.algorithm.is_tour_planner() {
-        return run_tour(&a, send, dropped);
+        return run_tour(&a, inbox, send, dropped, stop);
     }
     let o = a.scenario.optimizer.clone();
     let model = Arc::new(FleetModel::new(&a.scenario));
@@ -169,24 +169,77 @@ pub fn run(
 
 /// A tour mission (seed 003): this vehicle's share of the inspection points follows from the
 /// scenario alone ([`FleetTours`]), so the agent plans its tour at once, sends it, and is done.
+///
+/// While it plans, a `Stop` from the coordinator (Ctrl-C there) or the agent's own shutdown
+/// (`stop`) cuts the tour's swarms short. The tour, complete but less optimised, is still sent,
+/// marked interrupted: a coordinator that is stopping takes it as the best found so far; one
+/// that is not plans the share itself.
 fn run_tour(
     a: &Assignment,
+    inbox: &Receiver<CoordinatorToAgent>,
     send: &dyn Fn(AgentToCoordinator),
     dropped: &AtomicU32,
+    stop: &AtomicBool,
 ) -> MissionReport {
     run_share(a, send, dropped, &|a| {
         let job = FleetTours::new(&a.scenario)?;
-        let tour = job.plan_vehicle(a.index);
-        let words = format!(
+        let cut = Arc::new(AtomicBool::new(false));
+        let (tour, why) = std::thread::scope(|s| {
+            let planning = s.spawn(|| job.plan_vehicle(a.index, Some(&cut)));
+            let why = watch_while_planning(inbox, stop, &cut, || planning.is_finished());
+            // The planning thread cannot panic on scenario data; if it did, plan here (cut
+            // short if a stop came).
+            let tour = planning
+                .join()
+                .unwrap_or_else(|_| job.plan_vehicle(a.index, Some(&cut)));
+            (tour, why)
+        });
+        let mut words = format!(
             "tour of {} points planned: {:.1} m",
             tour.order.len(),
             tour.tour_length_m
         );
+        if tour.interrupted {
+            let why = why.unwrap_or_else(|| "stopped".into());
+            words = format!("{why}; {words}, cut short");
+        }
         Ok((
             AgentToCoordinator::tour(&a.mission, &a.vehicle, &tour),
             words,
         ))
     })
+}
+
+/// Waits until `finished`, reading the inbox: a `Stop` from the coordinator, or the agent
+/// shutting down (`stop`, or the inbox closing), raises `cut`; returns why it did.
+fn watch_while_planning(
+    inbox: &Receiver<CoordinatorToAgent>,
+    stop: &AtomicBool,
+    cut: &AtomicBool,
+    finished: impl Fn() -> bool,
+) -> Option<String> {
+    let mut why: Option<String> = None;
+    while !finished() {
+        if why.is_none() && stop.load(Ordering::Relaxed) {
+            why = Some("the agent is shutting down".into());
+        }
+        match inbox.recv_timeout(Duration::from_millis(50)) {
+            Ok(CoordinatorToAgent::Stop { reason, .. }) if why.is_none() => {
+                why = Some(format!("stopped: {reason}"));
+            }
+            Ok(_) | Err(RecvTimeoutError::Timeout) => {}
+            Err(RecvTimeoutError::Disconnected) => {
+                if why.is_none() {
+                    why = Some("the agent is shutting down".into());
+                }
+                std::thread::sleep(Duration::from_millis(20));
+            }
+        }
+        if why.is_some() {
+            cut.store(true, Ordering::Relaxed);
+        }
+    }
+    why
 }
 
 /// A fleet coverage mission (seed 002 with several crawlers): the vehicle's strip follows from
@@ -223,7 +276,7 @@ fn run_strip(
 }
 
 /// Plans a one-shot share: the result message and its summary in words, or why there is none.
-type SharePlanner = dyn Fn(&Assignment) -> Result<(AgentToCoordinator, String), String>;
+type SharePlanner<'a> = dyn Fn(&Assignment) -> Result<(AgentToCoordinator, String), String> + 'a;
 
 /// A mission planned in one go: `plan` gives the result message and its summary in words (or
 /// why there is none); the result goes up, then `Done`.
@@ -231,7 +284,7 @@ fn run_share(
     a: &Assignment,
     send: &dyn Fn(AgentToCoordinator),
     dropped: &AtomicU32,
-    plan: &SharePlanner,
+    plan: &SharePlanner<'_>,
 ) -> MissionReport {
     let iterations = a.scenario.optimizer.iterations as u32;
     let (outcome, evaluations) = match plan(a) {
@@ -321,5 +374,154 @@ fn wait_for_migrants(
                 return Wait::End(format!("stopped: {reason}"))
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use std::cell::RefCell;
+    use std::path::PathBuf;
+    use std::sync::mpsc;
+
+    use shoal_common::trajectory::Trajectory;
+    use shoal_common::wire::agent_to_coordinator::tour_from_wire;
+
+    use super::*;
+
+    /// auv1's share of the cages fleet's tours, with `iterations` for its legs and its order.
+    fn tour_assignment(iterations: usize) -> Result<Assignment, String> {
+        let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../scenarios/cages-fleet.toml");
+        let mut scenario = Scenario::load(&path).map_err(|e| e.to_string())?;
+        scenario.optimizer.iterations = iterations;
+        scenario.optimizer.particles = 20;
+        if let Some(inspection) = scenario.inspection.as_mut() {
+            inspection.order_iterations = iterations;
+            inspection.order_particles = 20;
+        }
+        let trajectories = scenario
+            .vehicles
+            .iter()
+            .map(|v| Trajectory {
+                times: vec![0.0],
+                points: vec![v.start()],
+            })
+            .collect();
+        Ok(Assignment {
+            mission: "m".into(),
+            vehicle: scenario.vehicles[0].id.clone(),
+            index: 0,
+            scenario,
+            context: Context {
+                round: 0,
+                arrival: 0.0,
+                trajectories,
+            },
+        })
+    }
+
+    /// Runs the mission with `queued` already in its inbox; returns its report and what it sent.
+    fn run_tour_mission(
+        a: Assignment,
+        queued: Option<CoordinatorToAgent>,
+        shutting_down: bool,
+    ) -> (MissionReport, Vec<AgentToCoordinator>) {
+        let (tx, rx) = mpsc::channel();
+        if let Some(m) = queued {
+            let _ = tx.send(m);
+        }
+        let sent = RefCell::new(Vec::new());
+        let report = run(
+            a,
+            1,
+            &rx,
+            &|m| sent.borrow_mut().push(m),
+            &AtomicU32::new(0),
+            &AtomicBool::new(shutting_down),
+            Duration::from_secs(60),
+        );
+        (report, sent.into_inner())
+    }
+
+    #[test]
+    fn a_tour_is_planned_sent_and_followed_by_done() -> Result<(), String> {
+        let (report, sent) = run_tour_mission(tour_assignment(30)?, None, false);
+        assert!(report.outcome.starts_with("tour of "), "{}", report.outcome);
+        let [AgentToCoordinator::Tour {
+            evaluations,
+            interrupted: false,
+            ..
+        }, AgentToCoordinator::Done {
+            evaluations: done, ..
+        }] = sent.as_slice()
+        else {
+            return Err(format!("sent {sent:?}"));
+        };
+        // The order swarm alone evaluates 20 × (30 + 1) tours.
+        assert!(*evaluations >= 20 * 31, "{evaluations}");
+        assert_eq!(done, evaluations);
+        Ok(())
+    }
+
+    #[test]
+    fn a_stop_from_the_coordinator_cuts_the_tour_short_and_sends_it_marked() -> Result<(), String> {
+        // A budget that would take hours in a debug build: the test ends only if the stop
+        // reaches the swarms.
+        let stop = CoordinatorToAgent::Stop {
+            mission: "m".into(),
+            reason: "the coordinator was interrupted".into(),
+        };
+        let (report, sent) = run_tour_mission(tour_assignment(1_000_000)?, Some(stop), false);
+        assert!(
+            report
+                .outcome
+                .starts_with("stopped: the coordinator was interrupted; tour of "),
+            "{}",
+            report.outcome
+        );
+        assert!(
+            report.outcome.ends_with(", cut short"),
+            "{}",
+            report.outcome
+        );
+        // The tour as it stood goes up, marked, then Done.
+        let [tour @ AgentToCoordinator::Tour {
+            interrupted: true,
+            evaluations,
+            ..
+        }, AgentToCoordinator::Done {
+            evaluations: done, ..
+        }] = sent.as_slice()
+        else {
+            return Err(format!("sent {sent:?}"));
+        };
+        assert_eq!(done, evaluations);
+        let share = FleetTours::new(&tour_assignment(1)?.scenario)?.shares[0].len();
+        let t = tour_from_wire(tour, share).ok_or("not a tour")??;
+        assert_eq!(t.order.len(), share, "every point of the share is visited");
+        Ok(())
+    }
+
+    #[test]
+    fn an_agent_shutting_down_cuts_its_tour_short() -> Result<(), String> {
+        let (report, sent) = run_tour_mission(tour_assignment(1_000_000)?, None, true);
+        assert!(
+            report.outcome.starts_with("the agent is shutting down; "),
+            "{}",
+            report.outcome
+        );
+        assert!(
+            matches!(
+                sent.as_slice(),
+                [
+                    AgentToCoordinator::Tour {
+                        interrupted: true,
+                        ..
+                    },
+                    AgentToCoordinator::Done { .. }
+                ]
+            ),
+            "{sent:?}"
+        );
+        Ok(())
     }
 }

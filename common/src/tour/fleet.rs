@@ -3,6 +3,9 @@
 //! the scenario, so the coordinator and every agent derive the same job from the same file and
 //! each agent can plan its own share without being told more than the scenario.
 
+use std::sync::atomic::AtomicBool;
+use std::sync::Arc;
+
 use crate::geometry::Vec3;
 use crate::scenario::{Algorithm, FirstPointMode, Scenario};
 use crate::swarm::multi::stream_seed;
@@ -108,6 +111,7 @@ impl FleetTours {
                     clearance_m: 0.0,
                     velocity_cap: o.max_velocity_fraction,
                 },
+                stop: None,
             },
             seed: o.seed,
             points,
@@ -115,7 +119,8 @@ impl FleetTours {
     }
 
     /// Plans vehicle `v`'s tour (an empty tour at its base for a vehicle the job does not know).
-    pub fn plan_vehicle(&self, v: usize) -> TourPlan {
+    /// `stop`, when raised, cuts its swarms short ([`TourPlan::interrupted`]).
+    pub fn plan_vehicle(&self, v: usize, stop: Option<&Arc<AtomicBool>>) -> TourPlan {
         let base = self.bases.get(v).copied().unwrap_or_else(Vec3::zeros);
         let mine: Vec<InspectionPoint> = self
             .shares
@@ -128,7 +133,10 @@ impl FleetTours {
             &self.inflated,
             self.bounds,
             self.algorithm,
-            &self.settings,
+            &TourSettings {
+                stop: stop.cloned(),
+                ..self.settings.clone()
+            },
             stream_seed(self.seed, v as u64),
         )
     }

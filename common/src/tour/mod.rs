@@ -29,15 +29,20 @@ pub use leg::{
     feasible, intersections, path_length, safety_spheres, segment_hits, LegProblem, Sphere,
     CHORD_WEIGHT, HIT_PENALTY_M,
 };
-pub use order::{distance_matrix, open_order_length, swap_sequence, tour_length, two_opt, SwapPso};
+pub use order::{
+    distance_matrix, open_order_length, swap_sequence, tour_length, two_opt, Ordered, SwapPso,
+};
 pub use split::{short_tour, split_points};
+
+use std::sync::atomic::AtomicBool;
+use std::sync::Arc;
 
 use crate::geometry::Vec3;
 use crate::swarm::depso::DePso;
 use crate::swarm::lcpso::Lcpso;
 use crate::swarm::ldiwpso::LdiwPso;
 use crate::swarm::multi::stream_seed;
-use crate::swarm::{Executor, Outcome, SolverState, VelocityCapped};
+use crate::swarm::{Executor, Outcome, SolverState, Termination, VelocityCapped};
 
 /// Clearance the leg planner keeps from a cage's surface, metres. The seed treats the AUV as a
 /// point and the cage sphere itself as the obstacle; 1 m of margin stays well inside the 5 m
@@ -99,10 +104,14 @@ impl LegSettings {
 /// Settings of [`plan_tour`].
 #[derive(Debug, Clone)]
 pub struct TourSettings {
-    /// The ordering swarm; its `seed` is replaced by one derived from the plan's seed.
+    /// The ordering swarm; its `seed` is replaced by one derived from the plan's seed and its
+    /// `stop` by the one below.
     pub order: SwapPso,
     /// The leg swarms.
     pub leg: LegSettings,
+    /// Raised to cut every swarm of the tour short (Ctrl-C, shutdown): each keeps the best it
+    /// has, so the tour is still complete, only less optimised ([`TourPlan::interrupted`]).
+    pub stop: Option<Arc<AtomicBool>>,
 }
 
 impl TourSettings {
@@ -111,6 +120,7 @@ impl TourSettings {
         TourSettings {
             order: SwapPso::table3(0),
             leg: LegSettings::table5(),
+            stop: None,
         }
     }
 }
@@ -138,10 +148,24 @@ pub struct TourPlan {
     /// Cost evaluations spent on it: the order swarm's tour lengths plus every leg swarm's path
     /// costs (a straight leg that is already clear costs none).
     pub evaluations: u64,
+    /// The stop flag cut the order swarm or a leg swarm short: the tour is complete but was
+    /// not optimised with the whole budget.
+    pub interrupted: bool,
 }
 
-/// Plans one leg with `algorithm`; returns its polyline (both end points included) and the cost
-/// evaluations its swarm made.
+/// One planned leg.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Leg {
+    /// Its polyline, both end points included.
+    pub path: Vec<Vec3>,
+    /// Cost evaluations its swarm made (0 when no swarm ran).
+    pub evaluations: u64,
+    /// The stop flag ended its swarm before the iteration budget.
+    pub interrupted: bool,
+}
+
+/// Plans one leg with `algorithm`. `stop`, when raised, ends its swarm after the current
+/// iteration (before the first if it is raised already: only the initial swarm is evaluated).
 ///
 /// A straight leg that is already clear is kept as it is: nothing is shorter, so no swarm is run.
 /// Otherwise the swarm's best path is returned, or the straight one if the swarm did worse by the
@@ -151,15 +175,21 @@ pub fn plan_leg(
     algorithm: LegAlgorithm,
     settings: &LegSettings,
     seed: u64,
-) -> (Vec<Vec3>, u64) {
+    stop: Option<&Arc<AtomicBool>>,
+) -> Leg {
     let straight = vec![problem.start, problem.end];
     if problem.waypoints == 0 || problem.feasible(&straight) {
-        return (straight, 0);
+        return Leg {
+            path: straight,
+            evaluations: 0,
+            interrupted: false,
+        };
     }
-    let ex = Executor::new(settings.iterations);
+    let mut ex = Executor::new(settings.iterations);
+    ex.stop = stop.cloned();
     let m = settings.particles;
     let cap = settings.velocity_cap;
-    let (best, evaluations) = match algorithm {
+    let (best, evaluations, interrupted) = match algorithm {
         LegAlgorithm::DePso => {
             best_of(ex.run(problem, &mut DePso::table5(m, seed).capped(cap), |_| {}))
         }
@@ -171,23 +201,33 @@ pub fn plan_leg(
         }
     };
     let path = problem.path(&best);
-    if problem.path_cost(&path) <= problem.path_cost(&straight) {
-        (path, evaluations)
+    let path = if problem.path_cost(&path) <= problem.path_cost(&straight) {
+        path
     } else {
-        (straight, evaluations)
+        straight
+    };
+    Leg {
+        path,
+        evaluations,
+        interrupted,
     }
 }
 
-/// The best position of a finished run and the evaluations it made.
-fn best_of<S: SolverState>(run: Outcome<S>) -> (Vec<f64>, u64) {
-    (run.state.best_position().to_vec(), run.state.evaluations())
+/// The best position of a finished run, the evaluations it made and whether it was stopped.
+fn best_of<S: SolverState>(run: Outcome<S>) -> (Vec<f64>, u64, bool) {
+    (
+        run.state.best_position().to_vec(),
+        run.state.evaluations(),
+        run.termination == Termination::Interrupted,
+    )
 }
 
 /// Plans a closed inspection tour from `base` through every point of `points` (seed 003 §V).
 ///
 /// The order comes from the swap-operator PSO on straight-line distances (seeded with
 /// `stream_seed(seed, 0)`); leg `k` is planned by [`plan_leg`] with `stream_seed(seed, k + 1)`,
-/// so a plan is reproducible from `seed` alone. Nothing here panics on odd input: an inverted box
+/// so a plan is reproducible from `seed` alone (unless `settings.stop` is raised while it runs).
+/// Nothing here panics on odd input: an inverted box
 /// is put in order, and a point inside a cage simply leaves `cage_intersections` above zero.
 pub fn plan_tour(
     base: Vec3,
@@ -204,9 +244,14 @@ pub fn plan_tour(
     let dist = distance_matrix(&nodes);
     let orderer = SwapPso {
         seed: stream_seed(seed, 0),
+        stop: settings.stop.clone(),
         ..settings.order.clone()
     };
-    let (tour, mut evaluations) = orderer.order_counted(&dist);
+    let Ordered {
+        tour,
+        mut evaluations,
+        mut interrupted,
+    } = orderer.order_counted(&dist);
     let order: Vec<usize> = tour
         .iter()
         .skip(1)
@@ -224,15 +269,17 @@ pub fn plan_tour(
             bounds,
             settings.leg.waypoints,
         );
-        let (leg, spent) = plan_leg(
+        let leg = plan_leg(
             &problem,
             algorithm,
             &settings.leg,
             stream_seed(seed, k as u64 + 1),
+            settings.stop.as_ref(),
         );
-        evaluations += spent;
-        leg_lengths.push(path_length(&leg));
-        path.extend(leg.into_iter().skip(1));
+        evaluations += leg.evaluations;
+        interrupted |= leg.interrupted;
+        leg_lengths.push(path_length(&leg.path));
+        path.extend(leg.path.into_iter().skip(1));
     }
     let tour_length_m: f64 = leg_lengths.iter().sum();
     let straight_tour_length_m = tour_length(&dist, &tour);
@@ -251,6 +298,7 @@ pub fn plan_tour(
             0.0
         },
         evaluations,
+        interrupted,
     }
 }
 
@@ -273,10 +321,19 @@ mod tests {
                 clearance_m: LEG_CLEARANCE_M,
                 velocity_cap: None,
             },
+            stop: None,
         }
     }
 
     fn group_a_plan(algorithm: LegAlgorithm, seed: u64) -> (Vec<InspectionPoint>, TourPlan) {
+        group_a_plan_with(algorithm, seed, &small())
+    }
+
+    fn group_a_plan_with(
+        algorithm: LegAlgorithm,
+        seed: u64,
+        settings: &TourSettings,
+    ) -> (Vec<InspectionPoint>, TourPlan) {
         let cages = cage_group_a();
         let base = paper_base();
         let pts = inspection_points(&cages, MONITOR_STANDOFF_M, FirstPoint::Toward(base));
@@ -286,21 +343,14 @@ mod tests {
             &cages,
             paper_bounds(),
             algorithm,
-            &small(),
+            settings,
             seed,
         );
         (pts, plan)
     }
 
-    #[test]
-    fn de_pso_tour_of_group_a_is_safe_and_complete() {
-        let (pts, plan) = group_a_plan(LegAlgorithm::DePso, 1);
-        assert_eq!(plan.cage_intersections, 0, "{plan:?}");
-        // The order swarm's 50 × (300 + 1) tours, plus the swarms of the legs that had to bend
-        // round a cage (the tour is longer than its straight legs, so at least one did).
-        assert!(plan.growth_m > 0.0);
-        assert!(plan.evaluations > 50 * 301, "{}", plan.evaluations);
-        // Every point exactly once, in order along the path.
+    /// Every inspection point exactly once, in the tour's order along its path.
+    fn assert_visits_every_point_in_order(pts: &[InspectionPoint], plan: &TourPlan) {
         let mut seen = plan.order.clone();
         seen.sort_unstable();
         assert_eq!(seen, (0..pts.len()).collect::<Vec<_>>());
@@ -315,6 +365,18 @@ mod tests {
         }
         assert_eq!(plan.path.first(), Some(&paper_base()));
         assert_eq!(plan.path.last(), Some(&paper_base()));
+    }
+
+    #[test]
+    fn de_pso_tour_of_group_a_is_safe_and_complete() {
+        let (pts, plan) = group_a_plan(LegAlgorithm::DePso, 1);
+        assert_eq!(plan.cage_intersections, 0, "{plan:?}");
+        // The order swarm's 50 × (300 + 1) tours, plus the swarms of the legs that had to bend
+        // round a cage (the tour is longer than its straight legs, so at least one did).
+        assert!(plan.growth_m > 0.0);
+        assert!(plan.evaluations > 50 * 301, "{}", plan.evaluations);
+        assert!(!plan.interrupted);
+        assert_visits_every_point_in_order(&pts, &plan);
         // Table 6's measures are consistent.
         assert_eq!(plan.leg_lengths.len(), pts.len() + 1);
         assert_abs_diff_eq!(plan.tour_length_m, path_length(&plan.path), epsilon = 1e-6);
@@ -337,6 +399,24 @@ mod tests {
             .collect();
         assert!(intersections(&straight, &safety_spheres(&cage_group_a(), 1.0)) > 0);
         assert!(plan.growth_m > 1.0, "{}", plan.growth_m);
+    }
+
+    #[test]
+    fn a_raised_stop_still_gives_a_complete_tour_from_the_initial_swarms() {
+        let settings = TourSettings {
+            stop: Some(Arc::new(AtomicBool::new(true))),
+            ..small()
+        };
+        let (pts, plan) = group_a_plan_with(LegAlgorithm::DePso, 1, &settings);
+        assert!(plan.interrupted);
+        assert_visits_every_point_in_order(&pts, &plan);
+        assert_eq!(plan.leg_lengths.len(), pts.len() + 1);
+        // No iteration ran: the order swarm evaluated its 50 initial tours, and every leg that
+        // needed a swarm its 30 initial particles (at least one leg did: the straight tour
+        // crosses the cages).
+        let legs = (plan.evaluations - 50) / 30;
+        assert_eq!(plan.evaluations, 50 + 30 * legs, "{}", plan.evaluations);
+        assert!((1..=pts.len() as u64 + 1).contains(&legs), "{legs}");
     }
 
     /// Seed 003 §V-B at full Table 3 / Table 5 budgets on both groups (slow in a debug build:
@@ -405,8 +485,17 @@ mod tests {
             paper_bounds(),
             5,
         );
-        let leg = plan_leg(&p, LegAlgorithm::DePso, &small().leg, 0);
-        assert_eq!(leg, (vec![p.start, p.end], 0), "no swarm, no evaluation");
+        let leg = plan_leg(&p, LegAlgorithm::DePso, &small().leg, 0, None);
+        let straight = Leg {
+            path: vec![p.start, p.end],
+            evaluations: 0,
+            interrupted: false,
+        };
+        assert_eq!(leg, straight, "no swarm, no evaluation");
+        // A raised stop changes nothing for a leg that runs no swarm.
+        let raised = Arc::new(AtomicBool::new(true));
+        let leg = plan_leg(&p, LegAlgorithm::DePso, &small().leg, 0, Some(&raised));
+        assert_eq!(leg, straight);
         assert_eq!(LegAlgorithm::Lcpso.name(), "lcpso");
     }
 
@@ -434,16 +523,21 @@ mod tests {
                     velocity_cap: cap,
                     ..small().leg
                 };
-                plan_leg(&p, algorithm, &settings, 3)
+                plan_leg(&p, algorithm, &settings, 3, None)
             };
-            let (own, spent) = with(None);
+            let Leg {
+                path: own,
+                evaluations: spent,
+                interrupted,
+            } = with(None);
+            assert!(!interrupted);
             assert_ne!(
                 own,
                 vec![p.start, p.end],
                 "{algorithm:?} kept a blocked leg"
             );
             assert_eq!(spent, evaluations, "{algorithm:?}");
-            let with = |cap| with(cap).0;
+            let with = |cap| with(cap).path;
             // Table 5's solvers' own cap is 0.2: naming it changes nothing, another cap does.
             assert_eq!(own, with(Some(0.2)), "{algorithm:?}");
             assert_ne!(own, with(Some(0.005)), "{algorithm:?}");

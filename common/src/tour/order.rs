@@ -16,6 +16,9 @@
 //! - the final best tour is polished by 2-opt, so the answer is at least 2-opt optimal whatever
 //!   the budget.
 
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+
 use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
 
@@ -122,6 +125,20 @@ pub struct SwapPso {
     pub c2: f64,
     /// RNG seed.
     pub seed: u64,
+    /// Raised to end the search before its budget (Ctrl-C, shutdown): the best order found so
+    /// far is kept (and still polished by 2-opt).
+    pub stop: Option<Arc<AtomicBool>>,
+}
+
+/// What [`SwapPso::order_counted`] found.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Ordered {
+    /// The closed tour `[0, …, 0]` (`[]` for no node).
+    pub tour: Vec<usize>,
+    /// Tour lengths the swarm evaluated.
+    pub evaluations: u64,
+    /// The stop flag ended the search before its iteration budget.
+    pub interrupted: bool,
 }
 
 impl SwapPso {
@@ -134,36 +151,46 @@ impl SwapPso {
             c1: 0.7,
             c2: 0.7,
             seed,
+            stop: None,
         }
     }
 
     /// A short closed tour over the nodes of `dist` (a square matrix, node 0 the base): the node
     /// sequence, starting and ending with 0 (`[0, …, 0]`, length n + 1; `[]` for no node).
     pub fn order(&self, dist: &[Vec<f64>]) -> Vec<usize> {
-        self.order_counted(dist).0
+        self.order_counted(dist).tour
     }
 
-    /// [`SwapPso::order`] and the tour lengths the swarm evaluated (the 2-opt pass after it
-    /// compares edge pairs, not tours, and is not counted).
-    pub fn order_counted(&self, dist: &[Vec<f64>]) -> (Vec<usize>, u64) {
+    /// [`SwapPso::order`], the tour lengths the swarm evaluated (the 2-opt pass after it
+    /// compares edge pairs, not tours, and is not counted) and whether `stop` cut it short.
+    pub fn order_counted(&self, dist: &[Vec<f64>]) -> Ordered {
         let n = dist.len();
         if n == 0 {
-            return (Vec::new(), 0);
+            return Ordered {
+                tour: Vec::new(),
+                evaluations: 0,
+                interrupted: false,
+            };
         }
-        let (mut best, evaluations) = self.search(dist, (1..n).collect());
+        let (mut best, evaluations, interrupted) = self.search(dist, (1..n).collect());
         two_opt(dist, &mut best);
         let mut tour = Vec::with_capacity(n + 1);
         tour.push(0);
         tour.extend(best);
         tour.push(0);
-        (tour, evaluations)
+        Ordered {
+            tour,
+            evaluations,
+            interrupted,
+        }
     }
 
-    /// The PSO itself over permutations of `nodes`; returns the best order found and the
-    /// evaluations made (none for fewer than two nodes: there is only one order).
-    fn search(&self, dist: &[Vec<f64>], nodes: Vec<usize>) -> (Vec<usize>, u64) {
+    /// The PSO itself over permutations of `nodes`; returns the best order found, the
+    /// evaluations made (none for fewer than two nodes: there is only one order) and whether
+    /// the stop flag ended it before its budget.
+    fn search(&self, dist: &[Vec<f64>], nodes: Vec<usize>) -> (Vec<usize>, u64, bool) {
         if nodes.len() < 2 {
-            return (nodes, 0);
+            return (nodes, 0, false);
         }
         let mut rng = StdRng::seed_from_u64(self.seed);
         let m = self.particles.max(1);
@@ -187,6 +214,13 @@ impl SwapPso {
         }
         let mut w = self.w0;
         for _ in 0..self.iterations {
+            if self
+                .stop
+                .as_ref()
+                .is_some_and(|s| s.load(Ordering::Relaxed))
+            {
+                return (gbest, evaluations, true);
+            }
             for i in 0..m {
                 let x = &mut xs[i];
                 let mut v = Vec::new();
@@ -225,7 +259,7 @@ impl SwapPso {
             // seed 003 eq. (13)
             w -= (w - 0.01) / m as f64;
         }
-        (gbest, evaluations)
+        (gbest, evaluations, false)
     }
 }
 
@@ -337,7 +371,8 @@ mod tests {
     fn swap_pso_without_2_opt_already_finds_the_optimum() {
         // The PSO alone (the polish disabled by calling the search directly) on 8 nodes.
         let d = random_instance(8, 11);
-        let (best, evaluations) = SwapPso::table3(11).search(&d, (1..8).collect());
+        let (best, evaluations, interrupted) = SwapPso::table3(11).search(&d, (1..8).collect());
+        assert!(!interrupted);
         // Table 3: 100 particles evaluated at the start and once in each of 2000 iterations.
         assert_eq!(evaluations, 100 * 2001);
         assert_abs_diff_eq!(
@@ -361,8 +396,39 @@ mod tests {
         let ragged = vec![vec![0.0, 1.0], vec![1.0]];
         assert_eq!(p.order(&ragged), vec![0, 1, 0]);
         // Counted: 100 × (200 + 1) tours for 9 points; none when there is one order only.
-        assert_eq!(p.order_counted(&d), (p.order(&d), 100 * 201));
-        assert_eq!(p.order_counted(&[vec![0.0]]).1, 0);
-        assert_eq!(p.order_counted(&ragged).1, 0);
+        assert_eq!(
+            p.order_counted(&d),
+            Ordered {
+                tour: p.order(&d),
+                evaluations: 100 * 201,
+                interrupted: false
+            }
+        );
+        assert_eq!(p.order_counted(&[vec![0.0]]).evaluations, 0);
+        assert_eq!(p.order_counted(&ragged).evaluations, 0);
+    }
+
+    #[test]
+    fn a_raised_stop_ends_the_search_at_once_with_a_complete_polished_tour() {
+        let d = random_instance(8, 4);
+        let stop = Arc::new(AtomicBool::new(true));
+        let p = SwapPso {
+            stop: Some(Arc::clone(&stop)),
+            ..SwapPso::table3(4)
+        };
+        let cut = p.order_counted(&d);
+        // Only the 100 initial tours were evaluated; the answer still visits every node once
+        // and is 2-opt optimal.
+        assert_eq!((cut.evaluations, cut.interrupted), (100, true));
+        let mut seen = cut.tour[1..8].to_vec();
+        seen.sort_unstable();
+        assert_eq!(seen, (1..8).collect::<Vec<_>>());
+        let mut polished = cut.tour[1..8].to_vec();
+        two_opt(&d, &mut polished);
+        assert_eq!(polished, cut.tour[1..8].to_vec());
+        // Lowered, the same solver runs its whole budget.
+        stop.store(false, Ordering::Relaxed);
+        let full = p.order_counted(&d);
+        assert_eq!((full.evaluations, full.interrupted), (100 * 2001, false));
     }
 }

@@ -67,6 +67,9 @@ pub enum AgentToCoordinator {
         intersections: u32,
         /// Cost evaluations the agent spent on the tour (protocol version 2).
         evaluations: u64,
+        /// A stop (the coordinator's, or the agent shutting down) cut the tour's swarms short:
+        /// the tour is complete but less optimised (protocol version 3).
+        interrupted: bool,
     },
     /// Fleet coverage missions (seed 002 with several crawlers): the plan of the agent's strip
     /// (its figures and its exact path). Sent once, before `Done`.
@@ -94,6 +97,7 @@ impl AgentToCoordinator {
             straight_m: t.straight_tour_length_m,
             intersections: t.cage_intersections as u32,
             evaluations: t.evaluations,
+            interrupted: t.interrupted,
         }
     }
 
@@ -134,6 +138,7 @@ pub fn tour_from_wire(
         straight_m,
         intersections,
         evaluations,
+        interrupted,
         ..
     } = m
     else {
@@ -169,6 +174,7 @@ pub fn tour_from_wire(
         },
         cage_intersections: *intersections as usize,
         evaluations: *evaluations,
+        interrupted: *interrupted,
     }))
 }
 
@@ -188,9 +194,17 @@ mod tests {
             growth_rate: 0.25,
             cage_intersections: 0,
             evaluations: 12_345,
+            interrupted: false,
         };
         let m = AgentToCoordinator::tour("m", "auv1", &t);
-        assert_eq!(tour_from_wire(&m, 2), Some(Ok(t)));
+        assert_eq!(tour_from_wire(&m, 2), Some(Ok(t.clone())));
+        // A tour cut short says so.
+        let cut = TourPlan {
+            interrupted: true,
+            ..t
+        };
+        let m = AgentToCoordinator::tour("m", "auv1", &cut);
+        assert_eq!(tour_from_wire(&m, 2), Some(Ok(cut)));
         assert!(
             matches!(tour_from_wire(&m, 1), Some(Err(_))),
             "point 1 of a share of 1"
@@ -204,6 +218,7 @@ mod tests {
             straight_m: 0.0,
             intersections: 0,
             evaluations: 0,
+            interrupted: false,
         };
         assert!(matches!(
             tour_from_wire(&tour(vec![[f64::NAN, 0.0, 0.0]]), 2),

@@ -13,6 +13,7 @@ pub mod network;
 
 use std::path::PathBuf;
 use std::sync::atomic::AtomicBool;
+use std::sync::Arc;
 use std::time::Duration;
 
 use shoal_common::cost::FleetModel;
@@ -82,7 +83,7 @@ pub fn default_mission_id(scenario: &Scenario) -> String {
 pub fn plan_distributed(
     scenario: &Scenario,
     options: &DistributedOptions,
-    stop: &AtomicBool,
+    stop: &Arc<AtomicBool>,
     observe: &mut dyn FnMut(&mission::Status),
 ) -> anyhow::Result<Plan> {
     topics::check_id("mission", &options.mission)?;
@@ -160,7 +161,7 @@ pub fn plan_strips_distributed(
     job: shoal_common::coverage::fleet::FleetCoverage,
     map: shoal_common::coverage::TerrainMap25,
     options: &DistributedOptions,
-    stop: &AtomicBool,
+    stop: &Arc<AtomicBool>,
     observe: &mut dyn FnMut(&mission::Status),
 ) -> anyhow::Result<(
     Vec<shoal_common::coverage::fleet::StripPlan>,
@@ -191,7 +192,7 @@ fn share_mission(
     scenario: &Scenario,
     job: mission::ShareJob,
     options: &DistributedOptions,
-    stop: &AtomicBool,
+    stop: &Arc<AtomicBool>,
     observe: &mut dyn FnMut(&mission::Status),
 ) -> anyhow::Result<(Vec<mission::Share>, shoal_common::plan::DistributedFigures)> {
     let mut session = Session::open(scenario, options)?;

@@ -102,6 +102,8 @@ struct Run<'a> {
     mission: String,
     /// One-shot missions: the fleet's job (to check the results agents send).
     job: Option<Arc<ShareJob>>,
+    /// One-shot missions: the stop flag; a share planned here is cut short when it is raised.
+    stop: Option<Arc<AtomicBool>>,
 }
 
 /// Runs the mission and returns the best plan's run result and the network figures.
@@ -257,7 +259,7 @@ pub fn run_share_mission(
     mission: &str,
     timing: Timing,
     local: Option<&mut LocalAgents>,
-    stop: &AtomicBool,
+    stop: &Arc<AtomicBool>,
     observe: &mut dyn FnMut(&Status),
 ) -> anyhow::Result<(Vec<Share>, DistributedFigures)> {
     let model = Arc::new(FleetModel::new(scenario));
@@ -300,6 +302,7 @@ impl<'a> Run<'a> {
             timing,
             mission: mission.to_string(),
             job: None,
+            stop: None,
         }
     }
 }
@@ -508,14 +511,19 @@ impl Run<'_> {
         Ok(())
     }
 
-    /// Tells the agents the mission is over and collects their figures (2 s at most).
-    fn finish(&mut self, reason: &str) {
+    /// Tells every agent of the mission to stop.
+    fn tell_stop(&mut self, reason: &str) {
         if let Err(e) = self.net.broadcast(CoordinatorToAgent::Stop {
             mission: self.mission.clone(),
             reason: reason.to_string(),
         }) {
             tracing::warn!("cannot tell the agents to stop: {e:#}");
         }
+    }
+
+    /// Tells the agents the mission is over and collects their figures (2 s at most).
+    fn finish(&mut self, reason: &str) {
+        self.tell_stop(reason);
         let deadline = Instant::now() + Duration::from_secs(2);
         while self
             .seats

@@ -24,6 +24,10 @@ use super::{Run, Status, GONE_GRACE};
 /// Shortest time the coordinator waits for the results once every agent has joined.
 const MIN_SHARE_WAIT: Duration = Duration::from_secs(60);
 
+/// After Ctrl-C, how long the coordinator waits for the tours its `Stop` cut short before it
+/// finishes the missing ones itself (an agent needs milliseconds to end its swarms).
+const STOP_GRACE: Duration = Duration::from_secs(2);
+
 /// What the agents of a one-shot mission plan.
 pub enum ShareJob {
     /// Inspection tours (seed 003).
@@ -44,10 +48,11 @@ pub enum Share {
 }
 
 impl ShareJob {
-    /// Plans vehicle `i`'s share in this process.
-    fn plan_here(&self, i: usize) -> Share {
+    /// Plans vehicle `i`'s share in this process. A raised `stop` cuts a tour's swarms short
+    /// (the tour is still complete); a coverage strip is always planned whole.
+    fn plan_here(&self, i: usize, stop: Option<&Arc<AtomicBool>>) -> Share {
         match self {
-            ShareJob::Tours(job) => Share::Tour(job.plan_vehicle(i)),
+            ShareJob::Tours(job) => Share::Tour(job.plan_vehicle(i, stop)),
             ShareJob::Strips(job, map) => match job.plan_vehicle(map, i, &mut |_, _| {}) {
                 Ok(p) => Share::Strip(Box::new(p)),
                 Err(e) => Share::Failed(e.to_string()),
@@ -124,7 +129,7 @@ impl Run<'_> {
             seat.id,
             job.noun()
         );
-        seat.share = Some(job.plan_here(i));
+        seat.share = Some(job.plan_here(i, self.stop.as_ref()));
         seat.alive = false;
         seat.joined = true;
         seat.degraded = Some(DegradedVehicle {
@@ -141,13 +146,20 @@ impl Run<'_> {
             return;
         };
         match job.read(i, m) {
-            Some(Ok(share)) if self.seats[i].share.is_none() => {
+            Some(Ok(_)) if self.seats[i].share.is_some() => self
+                .net
+                .out_of_turn(&format!("a second {} from {vehicle}", job.noun())),
+            // Cut short without this coordinator asking (its agent is shutting down): the
+            // share deserves its whole budget, here.
+            Some(Ok(Share::Tour(t))) if t.interrupted && !self.stopping() => {
+                self.seats[i].joined = true;
+                let why = "its agent stopped before its tour was finished".to_string();
+                self.degrade_share(i, job, why);
+            }
+            Some(Ok(share)) => {
                 self.seats[i].share = Some(share);
                 self.seats[i].joined = true;
             }
-            Some(Ok(_)) => self
-                .net
-                .out_of_turn(&format!("a second {} from {vehicle}", job.noun())),
             Some(Err(why)) => self.net.out_of_turn(&format!("{vehicle}: {why}")),
             None => self.net.out_of_turn(&format!(
                 "{vehicle} sent another kind of result than a {}",
@@ -175,7 +187,16 @@ impl Run<'_> {
         self.degrade_share(i, job, why);
     }
 
-    /// Waits for every vehicle's share (see the module doc).
+    /// Whether this coordinator was told to stop (Ctrl-C).
+    fn stopping(&self) -> bool {
+        self.stop
+            .as_ref()
+            .is_some_and(|s| s.load(Ordering::Relaxed))
+    }
+
+    /// Waits for every vehicle's share (see the module doc). On Ctrl-C the agents still
+    /// planning are told to stop; what they send within [`STOP_GRACE`] is kept (a tour cut
+    /// short), and the shares still missing are planned here, cut short as well.
     fn collect_shares(
         &mut self,
         job: &ShareJob,
@@ -184,6 +205,7 @@ impl Run<'_> {
     ) {
         let deadline = Instant::now() + self.timing.round.max(MIN_SHARE_WAIT);
         let n = self.seats.len();
+        let mut stopping_since: Option<Instant> = None;
         loop {
             let waiting: Vec<usize> = (0..n).filter(|&i| self.seats[i].share.is_none()).collect();
             observe(&Status {
@@ -202,10 +224,23 @@ impl Run<'_> {
                 return;
             }
             if stop.load(Ordering::Relaxed) {
-                for i in waiting {
-                    self.degrade_share(i, job, "the coordinator was interrupted".into());
+                let since = match stopping_since {
+                    Some(t) => t,
+                    None => {
+                        self.tell_stop("the coordinator was interrupted");
+                        *stopping_since.insert(Instant::now())
+                    }
+                };
+                if since.elapsed() >= STOP_GRACE {
+                    for i in waiting {
+                        let why = format!(
+                            "the coordinator was interrupted and its agent sent nothing within {:.0} s",
+                            STOP_GRACE.as_secs_f64()
+                        );
+                        self.degrade_share(i, job, why);
+                    }
+                    continue;
                 }
-                continue;
             }
             for &i in &waiting {
                 let expired = self.seats[i]
@@ -256,12 +291,13 @@ pub fn run_shares(
     run: &mut Run,
     job: ShareJob,
     local: Option<&mut LocalAgents>,
-    stop: &AtomicBool,
+    stop: &Arc<AtomicBool>,
     observe: &mut dyn FnMut(&Status),
 ) -> anyhow::Result<(Vec<Share>, DistributedFigures)> {
     let context = base_context(run);
     let job = Arc::new(job);
     run.job = Some(Arc::clone(&job));
+    run.stop = Some(Arc::clone(stop));
     run.join(&context, local, stop)?;
     run.collect_shares(&job, stop, observe);
     run.finish("plan complete");
@@ -270,7 +306,7 @@ pub fn run_shares(
             run.seats[i]
                 .share
                 .clone()
-                .unwrap_or_else(|| job.plan_here(i))
+                .unwrap_or_else(|| job.plan_here(i, Some(stop)))
         })
         .collect();
     let iterations = run.scenario.optimizer.iterations as u32;
