@@ -197,12 +197,7 @@ impl Run<'_> {
     /// Waits for every vehicle's share (see the module doc). On Ctrl-C the agents still
     /// planning are told to stop; what they send within [`STOP_GRACE`] is kept (a tour cut
     /// short), and the shares still missing are planned here, cut short as well.
-    fn collect_shares(
-        &mut self,
-        job: &ShareJob,
-        stop: &AtomicBool,
-        observe: &mut dyn FnMut(&Status),
-    ) {
+    fn collect_shares(&mut self, job: &ShareJob, observe: &mut dyn FnMut(&Status)) {
         let deadline = Instant::now() + self.timing.round.max(MIN_SHARE_WAIT);
         let n = self.seats.len();
         let mut stopping_since: Option<Instant> = None;
@@ -223,7 +218,7 @@ impl Run<'_> {
             if waiting.is_empty() {
                 return;
             }
-            if stop.load(Ordering::Relaxed) {
+            if self.stopping() {
                 let since = match stopping_since {
                     Some(t) => t,
                     None => {
@@ -299,7 +294,7 @@ pub fn run_shares(
     run.job = Some(Arc::clone(&job));
     run.stop = Some(Arc::clone(stop));
     run.join(&context, local, stop)?;
-    run.collect_shares(&job, stop, observe);
+    run.collect_shares(&job, observe);
     run.finish("plan complete");
     let shares = (0..run.seats.len())
         .map(|i| {
