@@ -33,7 +33,8 @@ pub fn plan(
         Err(why) => return unplannable(scenario, why),
     };
     let n = scenario.vehicles.len();
-    let mut evaluations = 0;
+    // Progress, as in a distributed run: the tours finished so far, their summed length.
+    let (mut evaluations, mut length) = (0, 0.0);
     let tours: Vec<TourPlan> = std::thread::scope(|s| {
         let (job, stop) = (&job, stop.as_ref());
         let handles: Vec<_> = (0..n)
@@ -46,10 +47,11 @@ pub fn plan(
                 // A planning thread cannot panic on scenario data; if it did, plan again here.
                 let t = h.join().unwrap_or_else(|_| job.plan_vehicle(v, stop));
                 evaluations += t.evaluations;
+                length += t.tour_length_m;
                 observe(&IterationReport {
                     iteration: v + 1,
                     max_iterations: n,
-                    best_cost: t.tour_length_m,
+                    best_cost: length,
                     evaluations,
                 });
                 t
@@ -224,8 +226,10 @@ mod tests {
         // swarms.
         let s = cages_fleet(1_000_000)?;
         let raised = Arc::new(AtomicBool::new(true));
-        let mut reports = 0;
-        let plan = plan(&s, Some(raised), &mut |_| reports += 1);
+        let mut reports = Vec::new();
+        let plan = plan(&s, Some(raised), &mut |r| {
+            reports.push((r.iteration, r.max_iterations, r.best_cost))
+        });
         assert_eq!(plan.termination, "Interrupted");
         assert!(
             plan.notices.iter().any(|n| n
@@ -236,7 +240,19 @@ mod tests {
         let (visited, points) = visited(&s, &plan);
         assert!(points > 0);
         assert_eq!(visited, points);
-        assert_eq!(reports, 2, "one progress line per vehicle");
+        // One progress line per vehicle, with the length of the tours finished so far (the
+        // plan's fitness without penalty once all are in), as a distributed run reports it.
+        let lengths: Vec<f64> = plan
+            .vehicles
+            .iter()
+            .filter_map(|v| v.tour.as_ref())
+            .map(|t| t.tour_length_m)
+            .collect();
+        assert_eq!(
+            reports,
+            [(1, 2, lengths[0]), (2, 2, lengths[0] + lengths[1])]
+        );
+        assert_eq!(plan.objective, lengths[0] + lengths[1]);
         Ok(())
     }
 
