@@ -109,4 +109,20 @@ fn bad_inspection_values_name_the_field() {
         e.contains("optimizer.algorithm") && e.contains("[inspection]"),
         "{e}"
     );
+    // And the [inspection] table needs a tour algorithm: another planner would send the AUV
+    // nowhere (its goal is its start) and call that feasible.
+    for other in ["amp-pso", "ipso", "epa-pso"] {
+        let e = refused(
+            "cages-a",
+            "algorithm = \"de-pso\"",
+            &format!("algorithm = \"{other}\""),
+        );
+        assert!(
+            e.contains("optimizer.algorithm")
+                && e.contains(other)
+                && e.contains("[inspection]")
+                && e.contains("de-pso, ldiw-pso or lcpso"),
+            "{e}"
+        );
+    }
 }

@@ -90,6 +90,12 @@ fn compare_command(args: &compare::CompareArgs, stop: &Arc<AtomicBool>) -> anyho
                 s.optimizer.iterations = i;
             }
             s.validate(p)?;
+            // Every algorithm must fit every scenario, checked before the first run.
+            for &a in &args.algorithms {
+                let mut with = s.clone();
+                with.optimizer.algorithm = a;
+                with.validate(p)?;
+            }
             Ok(s)
         })
         .collect::<anyhow::Result<Vec<_>>>()?;

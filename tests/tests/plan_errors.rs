@@ -81,3 +81,60 @@ fn unknown_algorithm_is_refused() -> TestResult {
     );
     Ok(())
 }
+
+#[test]
+fn an_inspection_scenario_refuses_a_path_planner() -> TestResult {
+    // Its AUV returns to its base: a start-to-goal planner would plan it a path of zero length
+    // and call the plan feasible.
+    let dir = tempfile::tempdir()?;
+    let out = dir.path().join("out");
+    let r = plan(&scenario("cages-a"), &out, &["--algorithm", "amp-pso"]);
+    assert_eq!(r.code(), Some(1), "{r}");
+    for needle in [
+        "cages-a.toml",
+        "optimizer.algorithm",
+        "amp-pso",
+        "[inspection]",
+    ] {
+        assert!(
+            r.stderr.contains(needle),
+            "stderr does not mention `{needle}`:\n{r}"
+        );
+    }
+    assert!(!out.join("plan.json").exists(), "a plan was written:\n{r}");
+    Ok(())
+}
+
+#[test]
+fn compare_refuses_an_algorithm_that_does_not_fit_a_scenario_before_running_any() -> TestResult {
+    let mut cmd = std::process::Command::new(common::coordinator());
+    common::without_shoal_env(&mut cmd);
+    cmd.current_dir(common::root())
+        .arg("compare")
+        .arg(scenario("amp-pso-1"))
+        .args([
+            "--seeds",
+            "1",
+            "--iterations",
+            "2",
+            "--algorithms",
+            "pso,de-pso",
+        ]);
+    let out = cmd.output()?;
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    for needle in ["amp-pso-1.toml", "optimizer.algorithm", "de-pso"] {
+        assert!(
+            stderr.contains(needle),
+            "stderr does not mention `{needle}`:\n{stderr}"
+        );
+    }
+    // Refused up front: no run was made, no table printed.
+    assert!(!stderr.contains("seed 1: fitness"), "{stderr}");
+    assert!(
+        out.stdout.is_empty(),
+        "{}",
+        String::from_utf8_lossy(&out.stdout)
+    );
+    Ok(())
+}

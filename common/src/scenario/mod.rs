@@ -416,6 +416,15 @@ impl Scenario {
                 ));
             }
         }
+        if self.inspection.is_some() && !algorithm.is_tour_planner() {
+            // Every vehicle of an inspection scenario returns to its base: any other planner
+            // would plan it a path of zero length and call it feasible.
+            return Err(bad(
+                "optimizer.algorithm".into(),
+                format!("{:?}", algorithm.as_str()),
+                "plans paths from a start to a goal, but this scenario has an [inspection] table: plan its tours with de-pso, ldiw-pso or lcpso",
+            ));
+        }
         Ok(())
     }
 
