@@ -234,6 +234,12 @@ fn plan_command(args: &PlanArgs, shutdown: Arc<AtomicBool>) -> anyhow::Result<i3
                 args.scenario.display()
             );
         }
+        if let Some(a) = args.algorithm {
+            eprintln!(
+                "note: --algorithm {} is not used: a [coverage] mission plans with seed 002's Boustrophedon",
+                a.as_str()
+            );
+        }
         std::fs::create_dir_all(&args.out)
             .with_context(|| format!("cannot create output directory {}", args.out.display()))?;
         let feasible = if fleet {

@@ -88,11 +88,18 @@ fn the_hybrid_a_star_baseline_runs_under_the_same_macro_routing() -> TestResult 
             .replace("track = true", "track = false")
     })?;
     let out = dir.path().join("out");
-    let r = plan(&file, &out, &[]);
+    // An --algorithm a coverage mission does not use is named as such, not silently dropped.
+    let r = plan(&file, &out, &["--algorithm", "mp-pso"]);
     assert!(
         matches!(r.code(), Some(0) | Some(3)),
         "{}\n{}",
         r.stdout,
+        r.stderr
+    );
+    assert!(
+        r.stderr
+            .contains("note: --algorithm mp-pso is not used: a [coverage] mission plans"),
+        "{}",
         r.stderr
     );
     let json: Value = serde_json::from_str(&std::fs::read_to_string(out.join("plan.json"))?)?;
