@@ -3,7 +3,7 @@
 //! (`<out>/execution.json`, the mission log `<out>/mission.ndjson`).
 
 use std::path::PathBuf;
-use std::sync::atomic::AtomicBool;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::Duration;
 
@@ -165,6 +165,12 @@ pub fn run_command(args: &RunArgs, shutdown: Arc<AtomicBool>) -> anyhow::Result<
     write_outputs(&p.out, &plan)?;
     write_svg(&p.out, &scenario, &plan)?;
     say(&summary::summary(&plan));
+    if shutdown.load(Ordering::Relaxed) {
+        // Ctrl-C while planning asks for the plan so far, not for a mission started and
+        // stopped at once.
+        eprintln!("interrupted while planning: the plan so far is written, it is not executed");
+        return Ok(EXIT_VIOLATIONS);
+    }
     if !plan.feasible {
         eprintln!("the plan is not feasible: it is not executed (see plan.json)");
         return Ok(EXIT_VIOLATIONS);
