@@ -4,6 +4,7 @@
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
 
 use anyhow::Context;
 use serde::Serialize;
@@ -21,12 +22,46 @@ pub struct CoveragePlanFile<'a> {
     pub scenario: &'a str,
     /// Always `coverage`: tells readers this is not a fleet trajectory plan.
     pub kind: &'static str,
-    /// No clearance violation and, when tracked, the vehicle reached the end.
+    /// No clearance violation and, when tracked to the end, the vehicle reached it.
     pub feasible: bool,
+    /// `Completed`, or `Interrupted` when Ctrl-C cut the tracking simulation short.
+    pub termination: CoverageTermination,
     /// Plain-words remarks.
     pub notices: Vec<String>,
     /// The figures.
     pub coverage: &'a CoverageReport,
+}
+
+/// How a coverage mission ended (`plan.json`'s `termination`, named as a fleet plan's).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub enum CoverageTermination {
+    /// Planned and, when the scenario says so, tracked to the end.
+    Completed,
+    /// Ctrl-C cut a tracking simulation short; the plan itself is whole.
+    Interrupted,
+}
+
+impl CoverageTermination {
+    /// `Interrupted` when any of `reports` had its tracking cut short.
+    pub fn of<'a>(reports: impl IntoIterator<Item = &'a CoverageReport>) -> Self {
+        let cut = reports
+            .into_iter()
+            .any(|r| r.tracking.as_ref().is_some_and(|t| t.interrupted));
+        if cut {
+            CoverageTermination::Interrupted
+        } else {
+            CoverageTermination::Completed
+        }
+    }
+}
+
+/// Whether `r` passes: no planned sample closer than the safety clearance and, when tracked to
+/// the end, the vehicle reached it (a simulation cut short by Ctrl-C judges nothing).
+pub fn passes(r: &CoverageReport) -> bool {
+    r.samples_below_clearance == 0
+        && r.tracking
+            .as_ref()
+            .is_none_or(|t| t.reached_end || t.interrupted)
 }
 
 /// The area a scenario covers: its bounds' horizontal extent.
@@ -35,14 +70,16 @@ pub fn scenario_area(scenario: &Scenario) -> Rect {
     Rect::new(b.min[0], b.min[1], b.max[0], b.max[1])
 }
 
-/// Runs the mission of `scenario` (which has a `[coverage]` table) into `out`; returns the exit
-/// status (0 feasible, 2 otherwise, as `plan`).
+/// Runs the mission of `scenario` (which has a `[coverage]` table) into `out`; returns whether
+/// the plan is feasible. A raised `stop` (Ctrl-C) cuts the tracking simulation short; the plan
+/// is still written, marked `Interrupted`.
 pub fn plan_coverage_command(
     scenario_file: &Path,
     scenario: &Scenario,
     settings: &CoverageSettings,
     out: &Path,
     quiet: bool,
+    stop: &AtomicBool,
 ) -> anyhow::Result<bool> {
     let seed = settings.terrain_seed.unwrap_or(scenario.optimizer.seed);
     let dir = scenario_file.parent().unwrap_or(Path::new("."));
@@ -62,16 +99,17 @@ pub fn plan_coverage_command(
         scenario_area(scenario),
         terrain_seed,
         scenario.optimizer.seed,
+        Some(stop),
         &mut progress,
     )
     .with_context(|| format!("{}: coverage mission", scenario_file.display()))?;
     let notices = notices(&report);
-    let feasible = report.samples_below_clearance == 0
-        && report.tracking.as_ref().is_none_or(|t| t.reached_end);
+    let feasible = passes(&report);
     let file = CoveragePlanFile {
         scenario: &scenario.name,
         kind: "coverage",
         feasible,
+        termination: CoverageTermination::of([&report]),
         notices: notices.clone(),
         coverage: &report,
     };
@@ -129,7 +167,12 @@ pub fn notices(r: &CoverageReport) -> Vec<String> {
         ));
     }
     if let Some(t) = &r.tracking {
-        if !t.reached_end {
+        if t.interrupted {
+            out.push(format!(
+                "tracking was interrupted after {:.0} s of simulated driving: its figures cover that stretch only, and whether the vehicle reaches the end of the path was not checked",
+                t.sim_time_s
+            ));
+        } else if !t.reached_end {
             out.push("the tracked vehicle did not reach the end of the path in time".into());
         }
         if t.qp_failures > 0 {
@@ -198,8 +241,9 @@ pub struct BenchCoverageArgs {
     pub out: Option<PathBuf>,
 }
 
-/// Runs both methods on every seed and prints seed 002 Table 2 style rows.
-pub fn bench_coverage(args: &BenchCoverageArgs) -> anyhow::Result<i32> {
+/// Runs both methods on every seed and prints seed 002 Table 2 style rows. A raised `stop`
+/// (Ctrl-C) ends the bench: the run it cut short is left out, the tables hold the finished ones.
+pub fn bench_coverage(args: &BenchCoverageArgs, stop: &AtomicBool) -> anyhow::Result<i32> {
     let scenario = Scenario::load(&args.scenario)?;
     let Some(settings) = scenario.coverage.clone() else {
         anyhow::bail!("{}: no [coverage] table", args.scenario.display());
@@ -209,8 +253,12 @@ pub fn bench_coverage(args: &BenchCoverageArgs) -> anyhow::Result<i32> {
         "| seed | method | coverage % | passable % | planning s | samples < clearance | min clearance m | max abs cte m | median abs cte m | detours | virtual boundaries | transits | unreached |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     let mut sums: Vec<(DetourMethod, Vec<[f64; 5]>)> = Vec::new();
-    for seed in 1..=args.seeds {
+    let mut finished = 0;
+    'seeds: for seed in 1..=args.seeds {
         for method in [DetourMethod::Arcs, DetourMethod::HybridAStar] {
+            if stop.load(Ordering::Relaxed) {
+                break 'seeds;
+            }
             let mut s = settings.clone();
             s.planner.detour = method;
             s.track = !args.no_track;
@@ -221,8 +269,13 @@ pub fn bench_coverage(args: &BenchCoverageArgs) -> anyhow::Result<i32> {
                 scenario_area(&scenario),
                 Some(seed),
                 seed,
+                Some(stop),
                 &mut |_, _| {},
             )?;
+            if r.tracking.as_ref().is_some_and(|t| t.interrupted) {
+                break 'seeds;
+            }
+            finished += 1;
             let (max_cte, med_cte) = r.tracking.as_ref().map_or((f64::NAN, f64::NAN), |t| {
                 (t.max_abs_cte_m, t.median_abs_cte_m)
             });
@@ -272,6 +325,12 @@ pub fn bench_coverage(args: &BenchCoverageArgs) -> anyhow::Result<i32> {
             rows.iter().filter(|r| r[2] > 0.0).count(),
             worst(3),
             rows.iter().map(|r| r[4]).sum::<f64>() / n
+        ));
+    }
+    let runs = 2 * args.seeds;
+    if finished < runs {
+        table.push_str(&format!(
+            "\ninterrupted: {finished} of {runs} runs finished; the tables hold only those\n"
         ));
     }
     print!("{table}");

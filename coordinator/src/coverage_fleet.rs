@@ -15,7 +15,7 @@ use shoal_common::coverage::TerrainMap25;
 use shoal_common::plan::DistributedFigures;
 use shoal_common::scenario::Scenario;
 
-use crate::coverage_cmd::{notices, write_outputs};
+use crate::coverage_cmd::{notices, passes, write_outputs, CoverageTermination};
 use crate::distributed::{plan_strips_distributed, DistributedOptions};
 use crate::svg_coverage::render_fleet_coverage;
 
@@ -26,8 +26,11 @@ pub struct FleetCoveragePlanFile<'a> {
     pub scenario: &'a str,
     /// Always `coverage-fleet`.
     pub kind: &'static str,
-    /// No clearance violation, every pair kept `d_min`, every tracked crawler reached its end.
+    /// No clearance violation, every pair kept `d_min`, every crawler tracked to the end
+    /// reached it.
     pub feasible: bool,
+    /// `Completed`, or `Interrupted` when Ctrl-C cut a crawler's tracking simulation short.
+    pub termination: CoverageTermination,
     /// Plain-words remarks.
     pub notices: Vec<String>,
     /// The figures.
@@ -37,13 +40,15 @@ pub struct FleetCoveragePlanFile<'a> {
 }
 
 /// Plans `scenario`'s fleet coverage into `out`; `distributed` runs it over agents. Returns
-/// whether the plan is feasible.
+/// whether the plan is feasible. A raised `stop` (Ctrl-C) cuts the crawlers' tracking
+/// simulations short, the agents' too; every strip is still planned whole.
 pub fn plan_fleet_coverage(
     scenario_file: &Path,
     scenario: &Scenario,
     out: &Path,
     quiet: bool,
-    distributed: Option<(&DistributedOptions, &Arc<AtomicBool>)>,
+    distributed: Option<&DistributedOptions>,
+    stop: &Arc<AtomicBool>,
 ) -> anyhow::Result<bool> {
     let job = FleetCoverage::new(scenario)
         .map_err(|e| anyhow::anyhow!("{}: {e}", scenario_file.display()))?;
@@ -63,8 +68,8 @@ pub fn plan_fleet_coverage(
             .floor()
     ));
     let (plans, figures) = match distributed {
-        None => (plan_in_process(&job, &map, &say)?, None),
-        Some((options, stop)) => {
+        None => (plan_in_process(&job, &map, stop, &say)?, None),
+        Some(options) => {
             let mut last = usize::MAX;
             let (plans, figures) = plan_strips_distributed(
                 scenario,
@@ -91,14 +96,12 @@ pub fn plan_fleet_coverage(
     let sep = &report.separation;
     let feasible = report.samples_below_clearance == 0
         && sep.min_distance_m >= sep.d_min_m
-        && report
-            .vehicles
-            .iter()
-            .all(|v| v.report.tracking.as_ref().is_none_or(|t| t.reached_end));
+        && report.vehicles.iter().all(|v| passes(&v.report));
     let file = FleetCoveragePlanFile {
         scenario: &scenario.name,
         kind: "coverage-fleet",
         feasible,
+        termination: CoverageTermination::of(report.vehicles.iter().map(|v| &v.report)),
         notices: notices.clone(),
         fleet: &report,
         distributed: figures.as_ref(),
@@ -118,13 +121,14 @@ pub fn plan_fleet_coverage(
 fn plan_in_process(
     job: &FleetCoverage,
     map: &TerrainMap25,
+    stop: &AtomicBool,
     say: &(dyn Fn(String) + Sync),
 ) -> anyhow::Result<Vec<StripPlan>> {
     std::thread::scope(|s| {
         let handles: Vec<_> = (0..job.ids.len())
             .map(|i| {
                 s.spawn(move || {
-                    let plan = job.plan_vehicle(map, i, &mut |_, _| {});
+                    let plan = job.plan_vehicle(map, i, Some(stop), &mut |_, _| {});
                     if let Ok(p) = &plan {
                         say(format!(
                             "coverage fleet: {}'s strip planned, {:.0} m",

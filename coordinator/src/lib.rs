@@ -57,7 +57,7 @@ pub fn run(command: Command, shutdown: Arc<AtomicBool>) -> anyhow::Result<i32> {
         Command::BenchFunctions(args) => bench_functions::command(&args, &shutdown),
         Command::BenchEnergy(args) => bench_energy::command(&args, &shutdown),
         Command::BenchCages(args) => bench_cages::command(&args, &shutdown),
-        Command::BenchCoverage(args) => coverage_cmd::bench_coverage(&args),
+        Command::BenchCoverage(args) => coverage_cmd::bench_coverage(&args, &shutdown),
         Command::Run(args) => run_cmd::run_command(&args, shutdown),
         Command::Replay(args) => replay::command(&args),
         Command::Serve(args) => serve::command(&args, shutdown),
@@ -253,7 +253,8 @@ fn plan_command(args: &PlanArgs, shutdown: Arc<AtomicBool>) -> anyhow::Result<i3
                 &scenario,
                 &args.out,
                 args.quiet,
-                options.as_ref().map(|o| (o, &shutdown)),
+                options.as_ref(),
+                &shutdown,
             )?
         } else {
             coverage_cmd::plan_coverage_command(
@@ -262,6 +263,7 @@ fn plan_command(args: &PlanArgs, shutdown: Arc<AtomicBool>) -> anyhow::Result<i3
                 settings,
                 &args.out,
                 args.quiet,
+                &shutdown,
             )?
         };
         return Ok(if feasible {

@@ -14,7 +14,9 @@ use common::{agent, finish, free_endpoint, Agent, TestResult};
 use shoal_common::distributed::lockstep;
 use shoal_common::plan::Plan;
 use shoal_common::scenario::Scenario;
-use shoal_coordinator::distributed::{plan_distributed, AgentsMode, DistributedOptions};
+use shoal_coordinator::distributed::{
+    plan_distributed, plan_strips_distributed, AgentsMode, DistributedOptions,
+};
 
 /// Longest any test waits for a plan.
 const LIMIT: Duration = Duration::from_secs(90);
@@ -283,6 +285,71 @@ fn ctrl_c_in_a_tour_mission_ends_it_at_once_with_complete_tours() -> TestResult 
         if std::time::Instant::now() > deadline {
             finish(agents)?;
             return Err("an agent still planned its tour 30 s after the coordinator's Stop".into());
+        }
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    finish(agents)?;
+    Ok(())
+}
+
+#[test]
+fn ctrl_c_in_a_coverage_fleet_mission_cuts_the_agents_tracking_short() -> TestResult {
+    // Three crawlers on a flat 600 m × 600 m, tracked. Untouched, each strip's tracking takes
+    // seconds (a 300 m map takes 1.6 s for all three), far longer than the Stop needs to come:
+    // the tracking must come back interrupted.
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../scenarios/cpp-fleet.toml");
+    let mut s = Scenario::load(&path)?;
+    s.bounds.max[0] = 600.0;
+    s.bounds.max[1] = 600.0;
+    // Each crawler from the west end of its 200 m strip to the east end.
+    for (k, v) in s.vehicles.iter_mut().enumerate() {
+        let y = 200.0 * k as f64;
+        v.start = [5.0, y + 5.0, v.start[2]];
+        v.goal = [595.0, y + 195.0, v.goal[2]];
+    }
+    let coverage = s.coverage.as_mut().ok_or("no [coverage]")?;
+    coverage.terrain.size_m = [600.0, 600.0];
+    // No seamounts or trenches: 8 of them on this small map leave some strips no row.
+    coverage.terrain.random_peaks.count = 0;
+    coverage.terrain.random_pits.count = 0;
+    assert!(coverage.track);
+    s.validate(&path)?;
+    let job = shoal_common::coverage::fleet::FleetCoverage::new(&s)?;
+    let map = job.map(std::path::Path::new("."))?;
+    let endpoint = free_endpoint()?;
+    let agents: Vec<Agent> = ["crawler1", "crawler2", "crawler3"]
+        .iter()
+        .map(|v| agent(v, &endpoint))
+        .collect();
+    let o = options("loopback-strip-stop", &endpoint, 30);
+    let (tx, rx) = mpsc::channel();
+    std::thread::spawn(move || {
+        let stop = Arc::new(AtomicBool::new(false));
+        let flag = Arc::clone(&stop);
+        // The first status comes once every agent has joined: Ctrl-C then.
+        let plans = plan_strips_distributed(&s, job, map, &o, &stop, &mut |_| {
+            flag.store(true, Ordering::Relaxed)
+        });
+        let _ = tx.send(plans);
+    });
+    let (plans, figures) = rx
+        .recv_timeout(LIMIT)
+        .map_err(|_| format!("no plan within {LIMIT:?}"))??;
+    // The strips are the agents', planned whole, their tracking cut short by the Stop.
+    assert!(figures.degraded.is_empty(), "{:?}", figures.degraded);
+    assert_eq!(plans.len(), 3);
+    for p in &plans {
+        let t = p.report.tracking.as_ref().ok_or("not tracked")?;
+        assert!(t.interrupted && !t.reached_end, "{t:?}");
+        assert!(p.path.length() > 1000.0, "{}", p.path.length());
+    }
+    let deadline = std::time::Instant::now() + Duration::from_secs(30);
+    while agents.iter().any(|a| !a.handle.is_finished()) {
+        if std::time::Instant::now() > deadline {
+            finish(agents)?;
+            return Err(
+                "an agent still tracked its strip 30 s after the coordinator's Stop".into(),
+            );
         }
         std::thread::sleep(Duration::from_millis(50));
     }

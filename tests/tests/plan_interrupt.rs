@@ -1,5 +1,6 @@
 //! Ctrl-C during a long plan: the coordinator stops after the current iteration and still writes
-//! the best plan so far, saying it was interrupted; `run` then does not execute it.
+//! the best plan so far, saying it was interrupted; `run` then does not execute it. A coverage
+//! mission cuts its tracking simulation short and still writes its (whole) plan.
 
 mod common;
 
@@ -13,12 +14,13 @@ use std::time::{Duration, Instant};
 use common::{coordinator, key, root, scenario};
 
 /// Runs `shoal-coordinator COMMAND SCENARIO ARGS… --out OUT` with a budget far too large to
-/// finish within the test, sends SIGINT once the first progress line is on stderr, and returns
-/// its exit status and stderr.
+/// finish within the test, sends SIGINT once `started` is on stderr, and returns its exit status
+/// and stderr.
 fn interrupted(
     command: &str,
     name: &str,
     args: &[&str],
+    started: &str,
     out: &Path,
     stderr_path: &Path,
 ) -> Result<(ExitStatus, String), Box<dyn Error>> {
@@ -40,12 +42,12 @@ fn interrupted(
         .stdout(Stdio::null())
         .stderr(File::create(stderr_path)?)
         .spawn()?;
-    // Wait for the first progress line, so the handler is installed and planning has begun.
-    let started = Instant::now();
-    while !std::fs::read_to_string(stderr_path)?.contains("iteration") {
+    // Wait for the progress line, so the handler is installed and the long work has begun.
+    let since = Instant::now();
+    while !std::fs::read_to_string(stderr_path)?.contains(started) {
         assert!(
-            started.elapsed() < Duration::from_secs(60),
-            "no progress on stderr"
+            since.elapsed() < Duration::from_secs(60),
+            "no {started:?} on stderr"
         );
         thread::sleep(Duration::from_millis(50));
     }
@@ -56,7 +58,7 @@ fn interrupted(
         if let Some(s) = child.try_wait()? {
             break s;
         }
-        if started.elapsed() > Duration::from_secs(120) {
+        if since.elapsed() > Duration::from_secs(120) {
             let _ = child.kill();
             panic!(
                 "still running after SIGINT:\n{}",
@@ -89,6 +91,7 @@ fn sigint_writes_the_best_plan_so_far() -> Result<(), Box<dyn Error>> {
         "plan",
         "amp-pso-1",
         &["--in-process", "--populations", "2", "--particles", "10"],
+        "iteration",
         &out,
         &dir.path().join("stderr.log"),
     )?;
@@ -108,6 +111,7 @@ fn sigint_while_run_plans_writes_the_plan_and_executes_nothing() -> Result<(), B
         "run",
         "amp-pso-2",
         &["--in-process", "--populations", "2", "--particles", "10"],
+        "iteration",
         &out,
         &dir.path().join("stderr.log"),
     )?;
@@ -122,5 +126,51 @@ fn sigint_while_run_plans_writes_the_plan_and_executes_nothing() -> Result<(), B
     assert!(!stderr.contains("executing mission"), "{stderr}");
     assert!(!out.join("execution.json").exists());
     assert!(!out.join("mission.ndjson").exists());
+    Ok(())
+}
+
+#[test]
+fn sigint_cuts_a_coverage_missions_tracking_short() -> Result<(), Box<dyn Error>> {
+    // Tracking the whole seabed takes seconds; the signal comes as it starts.
+    let dir = tempfile::tempdir()?;
+    let out = dir.path().join("out");
+    let (status, stderr) = interrupted(
+        "plan",
+        "cpp-seabed",
+        &["--in-process"],
+        "coverage: tracking",
+        &out,
+        &dir.path().join("stderr.log"),
+    )?;
+    assert_eq!(status.code(), Some(0), "{status}\n{stderr}");
+    let plan: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("plan.json"))?)?;
+    assert_eq!(key(&plan, "kind"), "coverage");
+    assert_eq!(key(&plan, "termination"), "Interrupted");
+    assert_eq!(key(&plan, "coverage.tracking.interrupted"), true);
+    assert_eq!(key(&plan, "coverage.tracking.reached_end"), false);
+    let notices = key(&plan, "notices").to_string();
+    assert!(
+        notices.contains("tracking was interrupted after"),
+        "{notices}"
+    );
+    assert!(!notices.contains("did not reach the end"), "{notices}");
+    // The plan itself is whole: its path covers the area (86 % on this map, seed 1) and the
+    // tracking drove only the start of it.
+    let ratio = key(&plan, "coverage.coverage.ratio")
+        .as_f64()
+        .unwrap_or(0.0);
+    assert!(ratio > 0.8, "{ratio}");
+    let planned = key(&plan, "coverage.path_length_m").as_f64().unwrap_or(0.0);
+    assert!(planned > 10_000.0, "{planned}");
+    // The crawler tracks at under 1 m/s: it drove fewer metres than seconds simulated.
+    let simulated = key(&plan, "coverage.tracking.sim_time_s")
+        .as_f64()
+        .unwrap_or(f64::NAN);
+    assert!(
+        simulated < planned / 2.0,
+        "{simulated} s simulated for {planned} m"
+    );
+    assert!(out.join("plan.svg").is_file());
     Ok(())
 }

@@ -93,7 +93,7 @@ pub fn run(
     idle: Duration,
 ) -> MissionReport {
     if a.scenario.coverage.is_some() {
-        return run_strip(&a, send, dropped);
+        return run_strip(&a, inbox, send, dropped, stop);
     }
     if a.scenario.optimizer.algorithm.is_tour_planner() {
         return run_tour(&a, inbox, send, dropped, stop);
@@ -183,17 +183,7 @@ fn run_tour(
 ) -> MissionReport {
     run_share(a, send, dropped, &|a| {
         let job = FleetTours::new(&a.scenario)?;
-        let cut = Arc::new(AtomicBool::new(false));
-        let (tour, why) = std::thread::scope(|s| {
-            let planning = s.spawn(|| job.plan_vehicle(a.index, Some(&cut)));
-            let why = watch_while_planning(inbox, stop, &cut, || planning.is_finished());
-            // The planning thread cannot panic on scenario data; if it did, plan here (cut
-            // short if a stop came).
-            let tour = planning
-                .join()
-                .unwrap_or_else(|_| job.plan_vehicle(a.index, Some(&cut)));
-            (tour, why)
-        });
+        let (tour, why) = plan_watched(inbox, stop, |cut| job.plan_vehicle(a.index, Some(cut)));
         let mut words = format!(
             "tour of {} points planned: {:.1} m",
             tour.order.len(),
@@ -207,6 +197,24 @@ fn run_tour(
             AgentToCoordinator::tour(&a.mission, &a.vehicle, &tour),
             words,
         ))
+    })
+}
+
+/// Runs `plan` on its own thread while [`watch_while_planning`] reads the inbox; `plan` gets
+/// the flag a stop raises. Returns its result and why it was cut short, if it was.
+fn plan_watched<T: Send>(
+    inbox: &Receiver<CoordinatorToAgent>,
+    stop: &AtomicBool,
+    plan: impl Fn(&Arc<AtomicBool>) -> T + Sync,
+) -> (T, Option<String>) {
+    let cut = Arc::new(AtomicBool::new(false));
+    std::thread::scope(|s| {
+        let planning = s.spawn(|| plan(&cut));
+        let why = watch_while_planning(inbox, stop, &cut, || planning.is_finished());
+        // The planning thread cannot panic on scenario data; if it did, plan here (cut short
+        // if a stop came).
+        let result = planning.join().unwrap_or_else(|_| plan(&cut));
+        (result, why)
     })
 }
 
@@ -246,25 +254,35 @@ fn watch_while_planning(
 /// the scenario alone ([`FleetCoverage`]), so the agent builds the seabed map, plans (and
 /// tracks) its strip, sends it, and is done. A heightmap file is looked up from the agent's
 /// working directory; when it is not there the coordinator plans the strip instead.
+///
+/// A `Stop` from the coordinator or the agent's own shutdown cuts the tracking simulation short,
+/// as for a tour: the strip, planned whole, is still sent with its tracking marked interrupted.
 fn run_strip(
     a: &Assignment,
+    inbox: &Receiver<CoordinatorToAgent>,
     send: &dyn Fn(AgentToCoordinator),
     dropped: &AtomicU32,
+    stop: &AtomicBool,
 ) -> MissionReport {
     run_share(a, send, dropped, &|a| {
         let job = FleetCoverage::new(&a.scenario)?;
         let map = job.map(Path::new(".")).map_err(|e| e.to_string())?;
-        let plan = job
-            .plan_vehicle(&map, a.index, &mut |stage, f| {
+        let (plan, why) = plan_watched(inbox, stop, |cut| {
+            job.plan_vehicle(&map, a.index, Some(cut), &mut |stage, f| {
                 tracing::debug!("strip {}: {stage} {:.0} %", a.index, 100.0 * f)
             })
-            .map_err(|e| e.to_string())?;
-        let words = format!(
+        });
+        let plan = plan.map_err(|e| e.to_string())?;
+        let mut words = format!(
             "strip {} planned: coverage {:.2} %, {:.0} m",
             a.index,
             100.0 * plan.report.coverage.ratio,
             plan.path.length()
         );
+        if plan.report.tracking.as_ref().is_some_and(|t| t.interrupted) {
+            let why = why.unwrap_or_else(|| "stopped".into());
+            words = format!("{why}; {words}, tracking cut short");
+        }
         let message = AgentToCoordinator::Coverage {
             mission: a.mission.clone(),
             vehicle: a.vehicle.clone(),
@@ -419,8 +437,33 @@ mod tests {
         })
     }
 
+    /// crawler1's strip of `cpp-fleet.toml` shrunk to a flat-ish 300 m × 300 m, tracked.
+    fn strip_assignment() -> Result<Assignment, String> {
+        let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../scenarios/cpp-fleet.toml");
+        let mut scenario = Scenario::load(&path).map_err(|e| e.to_string())?;
+        scenario.bounds.max[0] = 300.0;
+        scenario.bounds.max[1] = 300.0;
+        // Each crawler from the west end of its 100 m strip to the east end.
+        for (k, v) in scenario.vehicles.iter_mut().enumerate() {
+            let y = 100.0 * k as f64;
+            v.start = [5.0, y + 5.0, v.start[2]];
+            v.goal = [295.0, y + 95.0, v.goal[2]];
+        }
+        let coverage = scenario.coverage.as_mut().ok_or("no [coverage]")?;
+        coverage.terrain.size_m = [300.0, 300.0];
+        // No seamounts or trenches: 8 of them on this small map leave some strips no row.
+        coverage.terrain.random_peaks.count = 0;
+        coverage.terrain.random_pits.count = 0;
+        assert!(coverage.track);
+        scenario.validate(&path).map_err(|e| e.to_string())?;
+        let mut a = tour_assignment(1)?;
+        a.vehicle = scenario.vehicles[0].id.clone();
+        a.scenario = scenario;
+        Ok(a)
+    }
+
     /// Runs the mission with `queued` already in its inbox; returns its report and what it sent.
-    fn run_tour_mission(
+    fn run_one_shot(
         a: Assignment,
         queued: Option<CoordinatorToAgent>,
         shutting_down: bool,
@@ -444,7 +487,7 @@ mod tests {
 
     #[test]
     fn a_tour_is_planned_sent_and_followed_by_done() -> Result<(), String> {
-        let (report, sent) = run_tour_mission(tour_assignment(30)?, None, false);
+        let (report, sent) = run_one_shot(tour_assignment(30)?, None, false);
         assert!(report.outcome.starts_with("tour of "), "{}", report.outcome);
         let [AgentToCoordinator::Tour {
             evaluations,
@@ -470,7 +513,7 @@ mod tests {
             mission: "m".into(),
             reason: "the coordinator was interrupted".into(),
         };
-        let (report, sent) = run_tour_mission(tour_assignment(1_000_000)?, Some(stop), false);
+        let (report, sent) = run_one_shot(tour_assignment(1_000_000)?, Some(stop), false);
         assert!(
             report
                 .outcome
@@ -503,7 +546,7 @@ mod tests {
 
     #[test]
     fn an_agent_shutting_down_cuts_its_tour_short() -> Result<(), String> {
-        let (report, sent) = run_tour_mission(tour_assignment(1_000_000)?, None, true);
+        let (report, sent) = run_one_shot(tour_assignment(1_000_000)?, None, true);
         assert!(
             report.outcome.starts_with("the agent is shutting down; "),
             "{}",
@@ -522,6 +565,39 @@ mod tests {
             ),
             "{sent:?}"
         );
+        Ok(())
+    }
+
+    #[test]
+    fn a_stop_from_the_coordinator_cuts_the_strips_tracking_short() -> Result<(), String> {
+        // The Stop is in the inbox before planning starts: the strip's tracking must come
+        // back interrupted (untouched, it drives 3 km of rows).
+        let stop = CoordinatorToAgent::Stop {
+            mission: "m".into(),
+            reason: "the coordinator was interrupted".into(),
+        };
+        let (report, sent) = run_one_shot(strip_assignment()?, Some(stop), false);
+        assert!(
+            report
+                .outcome
+                .starts_with("stopped: the coordinator was interrupted; strip 0 planned: "),
+            "{}",
+            report.outcome
+        );
+        assert!(
+            report.outcome.ends_with(", tracking cut short"),
+            "{}",
+            report.outcome
+        );
+        let [AgentToCoordinator::Coverage { strip: 0, plan, .. }, AgentToCoordinator::Done { .. }] =
+            sent.as_slice()
+        else {
+            return Err(format!("sent {sent:?}"));
+        };
+        let tracking = plan.report.tracking.as_ref().ok_or("not tracked")?;
+        assert!(tracking.interrupted && !tracking.reached_end);
+        // The strip itself is planned whole: its path spans the strip's rows.
+        assert!(plan.path.length() > 1000.0, "{}", plan.path.length());
         Ok(())
     }
 }

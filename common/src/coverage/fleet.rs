@@ -14,6 +14,7 @@
 //! by delaying starts ([`separate`]); a conflict no delay resolves is reported, never hidden.
 
 use std::path::Path;
+use std::sync::atomic::AtomicBool;
 
 use serde::{Deserialize, Serialize};
 
@@ -123,11 +124,13 @@ impl FleetCoverage {
         build_map(&self.settings, self.terrain_seed, dir)
     }
 
-    /// Plans (and, when the scenario says so, tracks) vehicle `i`'s strip on `map`.
+    /// Plans (and, when the scenario says so, tracks) vehicle `i`'s strip on `map`; a raised
+    /// `stop` cuts the tracking short (see [`run_coverage`]).
     pub fn plan_vehicle(
         &self,
         map: &TerrainMap25,
         i: usize,
+        stop: Option<&AtomicBool>,
         progress: &mut dyn FnMut(&str, f64),
     ) -> Result<StripPlan, CoverageError> {
         let strip = self.strips.get(i).copied().ok_or_else(|| {
@@ -142,8 +145,15 @@ impl FleetCoverage {
             .is_none()
             .then_some(self.terrain_seed);
         let seed = self.tracking_seed.wrapping_add(i as u64);
-        let (report, plan) =
-            run_coverage(&self.settings, map, strip, terrain_seed, seed, progress)?;
+        let (report, plan) = run_coverage(
+            &self.settings,
+            map,
+            strip,
+            terrain_seed,
+            seed,
+            stop,
+            progress,
+        )?;
         Ok(StripPlan {
             report,
             path: plan.path,
@@ -493,6 +503,34 @@ mod tests {
     }
 
     #[test]
+    fn a_stop_cuts_only_the_tracking_short() {
+        let map = crate::coverage::test_map(30, vec![0.0; 900]);
+        let settings = CoverageSettings::default();
+        assert!(settings.track);
+        let strip = Rect::new(0.0, 0.0, 58.0, 30.0);
+        let run = |stop: bool| {
+            let flag = AtomicBool::new(stop);
+            match run_coverage(&settings, &map, strip, None, 1, Some(&flag), &mut |_, _| {}) {
+                Ok((report, _)) => report,
+                Err(e) => panic!("{e}"),
+            }
+        };
+        let (whole, cut) = (run(false), run(true));
+        let (Some(w), Some(c)) = (&whole.tracking, &cut.tracking) else {
+            panic!("not tracked");
+        };
+        assert!(w.reached_end && !w.interrupted);
+        assert!(c.interrupted && !c.reached_end);
+        assert_eq!(c.qp_solves, 0);
+        assert!(w.qp_solves > 0);
+        // The plan and its figures are those of the whole run.
+        assert_eq!(cut.planned_path, whole.planned_path);
+        assert_eq!(cut.coverage, whole.coverage);
+        assert_eq!(cut.path_length_m, whole.path_length_m);
+        assert_eq!(cut.samples_below_clearance, whole.samples_below_clearance);
+    }
+
+    #[test]
     fn a_strip_plan_from_elsewhere_is_checked_before_use() {
         let map = crate::coverage::test_map(30, vec![0.0; 900]);
         let settings = CoverageSettings {
@@ -500,10 +538,11 @@ mod tests {
             ..CoverageSettings::default()
         };
         let strip = Rect::new(0.0, 0.0, 58.0, 30.0);
-        let (report, plan) = match run_coverage(&settings, &map, strip, None, 1, &mut |_, _| {}) {
-            Ok(r) => r,
-            Err(e) => panic!("{e}"),
-        };
+        let (report, plan) =
+            match run_coverage(&settings, &map, strip, None, 1, None, &mut |_, _| {}) {
+                Ok(r) => r,
+                Err(e) => panic!("{e}"),
+            };
         let good = StripPlan {
             report,
             path: plan.path,

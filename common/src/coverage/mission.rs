@@ -3,6 +3,7 @@
 //! The `plan` command, the `bench-coverage` command and the tests all run this.
 
 use std::path::Path;
+use std::sync::atomic::AtomicBool;
 use std::time::Instant;
 
 use serde::{Deserialize, Serialize};
@@ -53,6 +54,9 @@ pub struct TrackingReport {
     pub qp_failures: usize,
     /// Whether the simulated vehicle reached the path's end.
     pub reached_end: bool,
+    /// Whether Ctrl-C ended the simulation early: the figures cover the stretch driven so far
+    /// and say nothing about the rest of the path.
+    pub interrupted: bool,
     /// Simulated mission time, seconds.
     pub sim_time_s: f64,
     /// Wall time of the simulation, seconds.
@@ -154,12 +158,15 @@ pub fn build_map(
 }
 
 /// Runs the mission on `map` over `area`; `progress(stage, fraction)` reports the tracking.
+/// A raised `stop` (Ctrl-C) cuts the tracking simulation short (the plan itself takes well under
+/// a second and is always finished): see [`TrackingReport::interrupted`].
 pub fn run_coverage(
     settings: &CoverageSettings,
     map: &TerrainMap25,
     area: Rect,
     terrain_seed: Option<u64>,
     tracking_seed: u64,
+    stop: Option<&AtomicBool>,
     progress: &mut dyn FnMut(&str, f64),
 ) -> Result<(CoverageReport, CoveragePlan), CoverageError> {
     let params = &settings.planner;
@@ -179,6 +186,7 @@ pub fn run_coverage(
             &terrain,
             &settings.tracking_params(),
             tracking_seed,
+            stop,
             &mut |f| progress("tracking", f),
         )
         .map_err(|e| CoverageError::Tracking(e.to_string()))?;
@@ -263,6 +271,7 @@ fn tracking_report(r: &TrackingResult, wall_time_s: f64) -> TrackingReport {
         qp_solves: r.qp_solves,
         qp_failures: r.qp_failures,
         reached_end: r.reached_end,
+        interrupted: r.interrupted,
         sim_time_s: r.sim_time_s,
         wall_time_s,
     }

@@ -253,10 +253,11 @@ mod tests {
             ..CoverageSettings::default()
         };
         let area = Rect::new(0.0, 0.0, 198.0, 198.0);
-        let (report, plan) = match run_coverage(&settings, &map, area, Some(1), 1, &mut |_, _| {}) {
-            Ok(r) => r,
-            Err(e) => panic!("{e}"),
-        };
+        let (report, plan) =
+            match run_coverage(&settings, &map, area, Some(1), 1, None, &mut |_, _| {}) {
+                Ok(r) => r,
+                Err(e) => panic!("{e}"),
+            };
         assert!(!report.events.is_empty(), "no events to carry");
         let sent = AgentToCoordinator::Coverage {
             mission: "m".into(),

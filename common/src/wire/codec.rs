@@ -106,9 +106,9 @@ mod tests {
             reason: "ok".into(),
         });
         let bytes = encode(&m)?;
-        // version 3 (u16 LE) | variant 3 (u32 LE) | len 2 (u64 LE) "m1" | len 2 "ok"
+        // version 4 (u16 LE) | variant 3 (u32 LE) | len 2 (u64 LE) "m1" | len 2 "ok"
         let expected: Vec<u8> = [
-            &[3u8, 0][..],
+            &[4u8, 0][..],
             &[3, 0, 0, 0],
             &[2, 0, 0, 0, 0, 0, 0, 0],
             b"m1",
@@ -138,7 +138,7 @@ mod tests {
             decode::<AgentToCoordinator>(&v1),
             Err(DecodeError::Version {
                 found: 1,
-                expected: 3
+                expected: PROTOCOL_VERSION
             })
         );
         assert_eq!(
@@ -155,7 +155,8 @@ mod tests {
             Err(DecodeError::Malformed(_))
         ));
         // A length prefix claiming 2^60 bytes must not allocate: the limit stops it.
-        let mut huge = vec![3u8, 0, 0, 0, 0, 0];
+        let mut huge = PROTOCOL_VERSION.to_le_bytes().to_vec();
+        huge.extend_from_slice(&[0, 0, 0, 0]);
         huge.extend_from_slice(&(1u64 << 60).to_le_bytes());
         assert!(matches!(
             decode::<AgentToCoordinator>(&huge),

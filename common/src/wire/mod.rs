@@ -24,8 +24,9 @@ use crate::trajectory::Trajectory;
 /// Protocol version every message carries; a peer speaking another version is ignored.
 /// Bumped whenever a message's layout changes (bincode is not self-describing):
 /// 2 — `AgentToCoordinator::Tour` carries the tour's evaluations;
-/// 3 — and whether a stop cut its swarms short.
-pub const PROTOCOL_VERSION: u16 = 3;
+/// 3 — and whether a stop cut its swarms short;
+/// 4 — a coverage strip's tracking report says whether a stop cut the simulation short.
+pub const PROTOCOL_VERSION: u16 = 4;
 
 /// A message of either direction with its protocol version.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

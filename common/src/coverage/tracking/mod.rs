@@ -106,6 +106,9 @@ pub struct TrackingResult {
     pub qp_failures: usize,
     /// Whether the vehicle reached the end of the reference before the time limit.
     pub reached_end: bool,
+    /// Whether a stop request (Ctrl-C) ended the run before the vehicle reached the end or the
+    /// time limit: the figures then cover the stretch driven so far.
+    pub interrupted: bool,
     /// Simulated time, seconds.
     pub sim_time_s: f64,
 }

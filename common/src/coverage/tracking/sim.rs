@@ -11,6 +11,7 @@ use super::{
 };
 use rand::rngs::StdRng;
 use rand::SeedableRng;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 /// Tracks `reference` over `terrain` from its first pose; deterministic for a given `seed`.
 pub fn track(
@@ -19,19 +20,22 @@ pub fn track(
     params: &TrackingParams,
     seed: u64,
 ) -> Result<TrackingResult, TrackingError> {
-    track_from_pose(reference, terrain, params, seed, None, &mut |_| {})
+    track_from_pose(reference, terrain, params, seed, None, None, &mut |_| {})
 }
 
 /// [`track`] that reports the fraction of the reference done (0..=1, non-decreasing, about every
-/// 0.1 % and once with 1.0 at the end) to `progress`.
+/// 0.1 % and once with 1.0 at the end) to `progress`. A raised `stop` (Ctrl-C) ends the run
+/// after the current control period: the result covers the stretch driven so far and is marked
+/// [`TrackingResult::interrupted`].
 pub fn track_with_progress(
     reference: &[PathSample],
     terrain: &dyn TerrainSlope,
     params: &TrackingParams,
     seed: u64,
+    stop: Option<&AtomicBool>,
     progress: &mut dyn FnMut(f64),
 ) -> Result<TrackingResult, TrackingError> {
-    track_from_pose(reference, terrain, params, seed, None, progress)
+    track_from_pose(reference, terrain, params, seed, None, stop, progress)
 }
 
 /// [`track_with_progress`] from a given true start pose (e.g. off the path); `None` starts on the
@@ -43,6 +47,7 @@ pub fn track_from_pose(
     params: &TrackingParams,
     seed: u64,
     start: Option<Pose2>,
+    stop: Option<&AtomicBool>,
     progress: &mut dyn FnMut(f64),
 ) -> Result<TrackingResult, TrackingError> {
     params.validate()?;
@@ -99,6 +104,7 @@ pub fn track_from_pose(
     let mut qp_solves = 0usize;
     let mut qp_failures = 0usize;
     let mut reached_end = false;
+    let mut interrupted;
     let mut last_reported = -1.0;
     let mut step: u64 = 0;
     let mut t = 0.0;
@@ -119,7 +125,9 @@ pub fn track_from_pose(
         {
             reached_end = true;
         }
-        let done = reached_end || t >= t_limit;
+        interrupted =
+            !reached_end && t < t_limit && stop.is_some_and(|s| s.load(Ordering::Relaxed));
+        let done = reached_end || interrupted || t >= t_limit;
 
         let cmd = if done {
             prev
@@ -208,8 +216,12 @@ pub fn track_from_pose(
             last_reported = frac;
         }
     }
-    progress(1.0);
-    Ok(summarise(samples, qp_solves, qp_failures, reached_end, t))
+    if !interrupted {
+        progress(1.0);
+    }
+    let mut result = summarise(samples, qp_solves, qp_failures, reached_end, t);
+    result.interrupted = interrupted;
+    Ok(result)
 }
 
 /// The stages k = 0..=N_p along the predicted progress: s_(k+1) = s_k + T·η_k·v_r. At each
@@ -278,6 +290,7 @@ fn summarise(
         qp_solves,
         qp_failures,
         reached_end,
+        interrupted: false,
         sim_time_s,
     }
 }

@@ -3,6 +3,7 @@
 use super::geometry::{CoveragePath, Piece, PieceKind};
 use super::*;
 use std::f64::consts::{FRAC_PI_4, PI};
+use std::sync::atomic::{AtomicBool, Ordering};
 
 /// Two rows of `row_len` m along +x then −x, `2r` apart, joined by a left semicircle of radius r.
 pub(crate) fn two_rows_with_uturn(row_len: f64, r: f64) -> Vec<PathSample> {
@@ -187,6 +188,7 @@ fn offset_start_converges_in_the_full_loop() {
         &p,
         5,
         Some(Pose2::new(0.0, 3.0, 0.0)),
+        None,
         &mut |_| {},
     )
     .unwrap_or_else(|e| panic!("{e}"));
@@ -211,14 +213,59 @@ fn progress_is_monotone_and_ends_at_one() {
         &FlatTerrain,
         &TrackingParams::default(),
         3,
+        None,
         &mut |f| seen.push(f),
     )
     .unwrap_or_else(|e| panic!("{e}"));
     assert!(res.reached_end);
+    assert!(!res.interrupted);
     assert!(seen.len() > 10);
     assert!(seen.windows(2).all(|w| w[1] >= w[0]));
     assert!(seen.iter().all(|f| (0.0..=1.0).contains(f)));
     assert_eq!(seen.last().copied(), Some(1.0));
+}
+
+#[test]
+fn a_stop_ends_the_run_after_the_current_control_period() {
+    let path = two_rows_with_uturn(60.0, 5.0);
+    let p = TrackingParams::default();
+    let whole = track(&path, &FlatTerrain, &p, 3).unwrap_or_else(|e| panic!("{e}"));
+    // Raised from the start: only the first sample, nothing driven.
+    let stop = AtomicBool::new(true);
+    let none = track_with_progress(&path, &FlatTerrain, &p, 3, Some(&stop), &mut |_| {})
+        .unwrap_or_else(|e| panic!("{e}"));
+    assert!(none.interrupted && !none.reached_end);
+    assert_eq!(none.samples.len(), 1);
+    assert_eq!(none.qp_solves, 0);
+    assert_eq!(none.sim_time_s, 0.0);
+    // Raised once a quarter of the path is done: the run ends at the next control period
+    // with the same samples as the whole run up to there (the stop does not touch the RNG);
+    // the last one holds the previous command instead of solving for a new one.
+    let stop = AtomicBool::new(false);
+    let mut seen = Vec::new();
+    let cut = track_with_progress(&path, &FlatTerrain, &p, 3, Some(&stop), &mut |f| {
+        seen.push(f);
+        if f >= 0.25 {
+            stop.store(true, Ordering::Relaxed);
+        }
+    })
+    .unwrap_or_else(|e| panic!("{e}"));
+    assert!(cut.interrupted && !cut.reached_end);
+    assert!(cut.samples.len() > 1 && cut.samples.len() < whole.samples.len() / 2);
+    let n = cut.samples.len();
+    assert_eq!(cut.samples[..n - 1], whole.samples[..n - 1]);
+    assert_eq!(cut.samples[n - 1].truth, whole.samples[n - 1].truth);
+    assert!((cut.sim_time_s - cut.samples[cut.samples.len() - 1].t).abs() < 1e-12);
+    // No closing 1.0: the path was not finished.
+    assert!(
+        seen.last().is_some_and(|f| *f >= 0.25 && *f < 1.0),
+        "{seen:?}"
+    );
+    // Never raised: the same run as without a flag.
+    let idle = AtomicBool::new(false);
+    let same = track_with_progress(&path, &FlatTerrain, &p, 3, Some(&idle), &mut |_| {})
+        .unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(same, whole);
 }
 
 #[test]

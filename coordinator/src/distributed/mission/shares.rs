@@ -24,8 +24,9 @@ use super::{Run, Status, GONE_GRACE};
 /// Shortest time the coordinator waits for the results once every agent has joined.
 const MIN_SHARE_WAIT: Duration = Duration::from_secs(60);
 
-/// After Ctrl-C, how long the coordinator waits for the tours its `Stop` cut short before it
-/// finishes the missing ones itself (an agent needs milliseconds to end its swarms).
+/// After Ctrl-C, how long the coordinator waits for the shares its `Stop` cut short before it
+/// finishes the missing ones itself (an agent needs milliseconds to end its swarms or its
+/// tracking simulation).
 const STOP_GRACE: Duration = Duration::from_secs(2);
 
 /// What the agents of a one-shot mission plan.
@@ -49,14 +50,17 @@ pub enum Share {
 
 impl ShareJob {
     /// Plans vehicle `i`'s share in this process. A raised `stop` cuts a tour's swarms short
-    /// (the tour is still complete); a coverage strip is always planned whole.
+    /// (the tour is still complete) or a strip's tracking simulation (the strip is planned
+    /// whole).
     fn plan_here(&self, i: usize, stop: Option<&Arc<AtomicBool>>) -> Share {
         match self {
             ShareJob::Tours(job) => Share::Tour(job.plan_vehicle(i, stop)),
-            ShareJob::Strips(job, map) => match job.plan_vehicle(map, i, &mut |_, _| {}) {
-                Ok(p) => Share::Strip(Box::new(p)),
-                Err(e) => Share::Failed(e.to_string()),
-            },
+            ShareJob::Strips(job, map) => {
+                match job.plan_vehicle(map, i, stop.map(|s| &**s), &mut |_, _| {}) {
+                    Ok(p) => Share::Strip(Box::new(p)),
+                    Err(e) => Share::Failed(e.to_string()),
+                }
+            }
         }
     }
 
@@ -95,6 +99,15 @@ impl Share {
             Share::Tour(t) => t.tour_length_m,
             Share::Strip(p) => p.path.length(),
             Share::Failed(_) => 0.0,
+        }
+    }
+
+    /// Whether a stop cut it short: a tour's swarms, or a strip's tracking simulation.
+    fn interrupted(&self) -> bool {
+        match self {
+            Share::Tour(t) => t.interrupted,
+            Share::Strip(p) => p.report.tracking.as_ref().is_some_and(|t| t.interrupted),
+            Share::Failed(_) => false,
         }
     }
 }
@@ -151,9 +164,9 @@ impl Run<'_> {
                 .out_of_turn(&format!("a second {} from {vehicle}", job.noun())),
             // Cut short without this coordinator asking (its agent is shutting down): the
             // share deserves its whole budget, here.
-            Some(Ok(Share::Tour(t))) if t.interrupted && !self.stopping() => {
+            Some(Ok(share)) if share.interrupted() && !self.stopping() => {
                 self.seats[i].joined = true;
-                let why = "its agent stopped before its tour was finished".to_string();
+                let why = format!("its agent stopped before its {} was finished", job.noun());
                 self.degrade_share(i, job, why);
             }
             Some(Ok(share)) => {
@@ -195,8 +208,9 @@ impl Run<'_> {
     }
 
     /// Waits for every vehicle's share (see the module doc). On Ctrl-C the agents still
-    /// planning are told to stop; what they send within [`STOP_GRACE`] is kept (a tour cut
-    /// short), and the shares still missing are planned here, cut short as well.
+    /// planning are told to stop; what they send within [`STOP_GRACE`] is kept (a tour or a
+    /// strip's tracking cut short), and the shares still missing are planned here, cut short as
+    /// well.
     fn collect_shares(&mut self, job: &ShareJob, observe: &mut dyn FnMut(&Status)) {
         let deadline = Instant::now() + self.timing.round.max(MIN_SHARE_WAIT);
         let n = self.seats.len();
