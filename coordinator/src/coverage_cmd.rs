@@ -148,6 +148,12 @@ pub fn write_outputs(
 /// What a reader should know that the numbers alone do not say.
 pub fn notices(r: &CoverageReport) -> Vec<String> {
     let mut out = Vec::new();
+    if r.planned_path.is_empty() {
+        out.push(format!(
+            "no path was planned: no row of the area has a stretch the crawler can enter and drive {} m from impassable ground; nothing of it is covered",
+            r.safety_clearance_m
+        ));
+    }
     if r.samples_below_clearance > 0 {
         out.push(format!(
             "{} path samples are closer than {} m to impassable terrain (minimum {:.2} m)",
@@ -338,4 +344,40 @@ pub fn bench_coverage(args: &BenchCoverageArgs, stop: &AtomicBool) -> anyhow::Re
         std::fs::write(path, &table).with_context(|| format!("cannot write {}", path.display()))?;
     }
     Ok(0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use shoal_common::coverage::TerrainMap25;
+    use shoal_common::terrain::HeightGrid;
+
+    /// An `n × n` grid of 2 m cells rising 10 m per metre eastward: a 84° slope everywhere,
+    /// far steeper than any crawler climbs.
+    fn impassable_map(n: usize) -> TerrainMap25 {
+        let z = (0..n * n).map(|k| 20.0 * (k % n) as f64).collect();
+        let grid = HeightGrid::new([0.0, 0.0], 2.0, n, n, z).unwrap_or_else(|e| panic!("{e}"));
+        let settings = CoverageSettings::default();
+        TerrainMap25::from_grid(&grid, &settings.limits).unwrap_or_else(|e| panic!("{e}"))
+    }
+
+    #[test]
+    fn a_mission_without_a_path_says_so() {
+        let map = impassable_map(60);
+        let settings = CoverageSettings::default();
+        let area = Rect::new(0.0, 0.0, 118.0, 118.0);
+        let (report, _) = run_coverage(&settings, &map, area, None, 1, None, &mut |_, _| {})
+            .unwrap_or_else(|e| panic!("{e}"));
+        assert!(report.planned_path.is_empty());
+        assert!(report.tracking.is_none());
+        let notes = notices(&report);
+        assert_eq!(
+            notes.first().map(String::as_str),
+            Some("no path was planned: no row of the area has a stretch the crawler can enter and drive 8 m from impassable ground; nothing of it is covered"),
+            "{notes:?}"
+        );
+        // A path of no length prints as 0 m, not "-0".
+        let text = summary("s", &report);
+        assert!(!text.contains("-0"), "{text}");
+    }
 }

@@ -206,7 +206,8 @@ impl CoveragePath {
 
     /// Total length, metres.
     pub fn length(&self) -> f64 {
-        self.pieces.iter().map(|(_, p)| p.length()).sum()
+        // A fold from +0.0: `sum` of no floats is −0.0, which printed as "-0 m".
+        self.pieces.iter().fold(0.0, |acc, (_, p)| acc + p.length())
     }
 
     /// Length driven in each state: (straight, detour, U-turn, transit), metres.
@@ -263,6 +264,14 @@ impl CoveragePath {
 mod tests {
     use super::*;
     use approx::assert_abs_diff_eq;
+
+    #[test]
+    fn an_empty_path_is_plus_zero_metres_long() {
+        let empty = CoveragePath::default();
+        assert_eq!(empty.length(), 0.0);
+        assert!(empty.length().is_sign_positive());
+        assert_eq!(format!("{:.0}", empty.length()), "0");
+    }
 
     #[test]
     fn a_left_quarter_turn_from_the_origin_heading_east_ends_at_r_r_heading_north() {
