@@ -9,6 +9,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use anyhow::Context;
 use serde::Serialize;
 use shoal_common::coverage::boxes::Rect;
+use shoal_common::coverage::metrics::Distribution;
 use shoal_common::coverage::mission::{build_map, run_coverage, CoverageReport};
 use shoal_common::coverage::params::DetourMethod;
 use shoal_common::scenario::{CoverageSettings, Scenario};
@@ -191,6 +192,19 @@ pub fn notices(r: &CoverageReport) -> Vec<String> {
     out
 }
 
+/// The clearance figures in words. A path on a map without impassable cells has no clearance
+/// to measure (every sample's is infinite, which the distribution's order statistics leave out
+/// as NaN).
+pub fn clearance_words(d: &Distribution) -> String {
+    if d.min.is_finite() {
+        format!("min {:.2} m, median {:.1} m", d.min, d.median)
+    } else if d.count > 0 {
+        "unbounded (no impassable ground on the map)".into()
+    } else {
+        "not measured (no path)".into()
+    }
+}
+
 /// The human summary of one mission.
 pub fn summary(name: &str, r: &CoverageReport) -> String {
     let mut s = format!(
@@ -206,9 +220,8 @@ pub fn summary(name: &str, r: &CoverageReport) -> String {
         r.sweeps
     ));
     s.push_str(&format!(
-        "  clearance min {:.2} m, median {:.1} m; {} samples < {} m; slope median {:.1}°, max {:.1}°; max |κ| {:.3} 1/m\n",
-        r.clearance.min,
-        r.clearance.median,
+        "  clearance {}; {} samples < {} m; slope median {:.1}°, max {:.1}°; max |κ| {:.3} 1/m\n",
+        clearance_words(&r.clearance),
         r.samples_below_clearance,
         r.safety_clearance_m,
         r.slope.median,
@@ -376,8 +389,22 @@ mod tests {
             Some("no path was planned: no row of the area has a stretch the crawler can enter and drive 8 m from impassable ground; nothing of it is covered"),
             "{notes:?}"
         );
-        // A path of no length prints as 0 m, not "-0".
+        // A path of no length prints as 0 m, not "-0", and has no clearance to print.
         let text = summary("s", &report);
         assert!(!text.contains("-0"), "{text}");
+        assert!(text.contains("clearance not measured (no path)"), "{text}");
+    }
+
+    #[test]
+    fn clearance_in_words() {
+        let some = Distribution::new(&[12.5, f64::INFINITY, 20.0], 0.0, 40.0, 40);
+        assert_eq!(clearance_words(&some), "min 12.50 m, median 16.2 m");
+        let unbounded = Distribution::new(&[f64::INFINITY; 3], 0.0, 40.0, 40);
+        assert_eq!(
+            clearance_words(&unbounded),
+            "unbounded (no impassable ground on the map)"
+        );
+        let none = Distribution::new(&[], 0.0, 40.0, 40);
+        assert_eq!(clearance_words(&none), "not measured (no path)");
     }
 }

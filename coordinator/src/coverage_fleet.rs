@@ -15,7 +15,7 @@ use shoal_common::coverage::TerrainMap25;
 use shoal_common::plan::DistributedFigures;
 use shoal_common::scenario::Scenario;
 
-use crate::coverage_cmd::{notices, passes, write_outputs, CoverageTermination};
+use crate::coverage_cmd::{clearance_words, notices, passes, write_outputs, CoverageTermination};
 use crate::distributed::{plan_strips_distributed, DistributedOptions};
 use crate::svg_coverage::render_fleet_coverage;
 
@@ -217,8 +217,13 @@ fn fleet_summary(name: &str, r: &FleetCoverageReport) -> String {
         r.planning_time_s
     );
     s.push_str(&format!(
-        "  separation: min {:.1} m at t = {:.0} s (d_min {} m); clearance min {:.2} m, {} samples < {} m\n",
-        sep.min_distance_m, sep.at_s, sep.d_min_m, r.clearance.min, r.samples_below_clearance, r.safety_clearance_m
+        "  separation: min {:.1} m at t = {:.0} s (d_min {} m); clearance {}, {} samples < {} m\n",
+        sep.min_distance_m,
+        sep.at_s,
+        sep.d_min_m,
+        clearance_words(&r.clearance),
+        r.samples_below_clearance,
+        r.safety_clearance_m
     ));
     if let Some(c) = &r.cross_track {
         s.push_str(&format!(
