@@ -16,6 +16,7 @@ pub mod execute;
 pub mod link;
 pub mod mission;
 pub mod network;
+mod one_shot;
 
 use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
