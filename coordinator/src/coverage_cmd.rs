@@ -272,7 +272,6 @@ pub fn bench_coverage(args: &BenchCoverageArgs, stop: &AtomicBool) -> anyhow::Re
         "| seed | method | coverage % | passable % | planning s | samples < clearance | min clearance m | max abs cte m | median abs cte m | detours | virtual boundaries | transits | unreached |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     let mut sums: Vec<(DetourMethod, Vec<[f64; 5]>)> = Vec::new();
-    let mut finished = 0;
     'seeds: for seed in 1..=args.seeds {
         for method in [DetourMethod::Arcs, DetourMethod::HybridAStar] {
             if stop.load(Ordering::Relaxed) {
@@ -294,7 +293,6 @@ pub fn bench_coverage(args: &BenchCoverageArgs, stop: &AtomicBool) -> anyhow::Re
             if r.tracking.as_ref().is_some_and(|t| t.interrupted) {
                 break 'seeds;
             }
-            finished += 1;
             let (max_cte, med_cte) = r.tracking.as_ref().map_or((f64::NAN, f64::NAN), |t| {
                 (t.max_abs_cte_m, t.median_abs_cte_m)
             });
@@ -346,7 +344,10 @@ pub fn bench_coverage(args: &BenchCoverageArgs, stop: &AtomicBool) -> anyhow::Re
             rows.iter().map(|r| r[4]).sum::<f64>() / n
         ));
     }
-    let runs = 2 * args.seeds;
+    let (finished, runs) = (
+        sums.iter().map(|(_, rows)| rows.len()).sum::<usize>(),
+        2 * args.seeds as usize,
+    );
     if finished < runs {
         table.push_str(&format!(
             "\ninterrupted: {finished} of {runs} runs finished; the tables hold only those\n"

@@ -219,9 +219,14 @@ pub fn track_from_pose(
     if !interrupted {
         progress(1.0);
     }
-    let mut result = summarise(samples, qp_solves, qp_failures, reached_end, t);
-    result.interrupted = interrupted;
-    Ok(result)
+    Ok(summarise(
+        samples,
+        qp_solves,
+        qp_failures,
+        reached_end,
+        interrupted,
+        t,
+    ))
 }
 
 /// The stages k = 0..=N_p along the predicted progress: s_(k+1) = s_k + T·η_k·v_r. At each
@@ -264,6 +269,7 @@ fn summarise(
     qp_solves: usize,
     qp_failures: usize,
     reached_end: bool,
+    interrupted: bool,
     sim_time_s: f64,
 ) -> TrackingResult {
     let mut abs: Vec<f64> = samples.iter().map(|s| s.cross_track_m.abs()).collect();
@@ -290,7 +296,7 @@ fn summarise(
         qp_solves,
         qp_failures,
         reached_end,
-        interrupted: false,
+        interrupted,
         sim_time_s,
     }
 }
