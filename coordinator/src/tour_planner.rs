@@ -184,9 +184,24 @@ pub fn assemble(
         .to_string(),
         vehicles: assessment.vehicles,
         fleet: assessment.fleet,
-        convergence: Vec::new(),
+        convergence: fleet_convergence(tours),
         distributed: None,
     }
+}
+
+/// The fleet's convergence curve: entry `t` sums every tour's curve at `t`, a tour whose curve
+/// is shorter counting at its last value ([`TourPlan::convergence`]). Its last entry is the
+/// tours' summed length when no tour crosses a cage.
+pub fn fleet_convergence(tours: &[TourPlan]) -> Vec<f64> {
+    let len = tours.iter().map(|t| t.convergence.len()).max().unwrap_or(0);
+    (0..len)
+        .map(|k| {
+            tours
+                .iter()
+                .filter_map(|t| t.convergence.get(k).or(t.convergence.last()))
+                .sum()
+        })
+        .collect()
 }
 
 #[cfg(test)]
@@ -257,6 +272,31 @@ mod tests {
     }
 
     #[test]
+    fn the_fleet_curve_sums_the_tours_holding_a_short_one_at_its_last_value() {
+        let tour = |convergence: Vec<f64>| TourPlan {
+            order: vec![],
+            path: vec![],
+            leg_lengths: vec![],
+            tour_length_m: 0.0,
+            straight_tour_length_m: 0.0,
+            growth_m: 0.0,
+            growth_rate: 0.0,
+            cage_intersections: 0,
+            evaluations: 0,
+            interrupted: false,
+            convergence,
+        };
+        let tours = [
+            tour(vec![9.0, 7.0, 6.0]),
+            tour(vec![4.0]),
+            tour(vec![5.0, 3.0]),
+        ];
+        // 9 + 4 + 5, 7 + 4 + 3, 6 + 4 + 3.
+        assert_eq!(fleet_convergence(&tours), [18.0, 14.0, 13.0]);
+        assert!(fleet_convergence(&[]).is_empty());
+    }
+
+    #[test]
     fn a_stop_never_raised_changes_nothing() -> Result<(), String> {
         let s = cages_fleet(20)?;
         let lowered = Arc::new(AtomicBool::new(false));
@@ -266,6 +306,18 @@ mod tests {
         assert!(!with.notices.iter().any(|n| n.contains("interrupted")));
         assert_eq!(with.fitness, without.fitness);
         assert_eq!(with.evaluations, without.evaluations);
+        // The curve: one entry per leg-swarm iteration, ending at the tours' summed length
+        // (no tour crosses a cage here).
+        assert_eq!(with.convergence, without.convergence);
+        assert_eq!(with.convergence.len(), 20);
+        assert!(with.convergence.windows(2).all(|w| w[1] <= w[0]));
+        assert_eq!(with.penalty, 0.0);
+        let last = with.convergence.last().copied().unwrap_or(f64::NAN);
+        assert!(
+            (last - with.objective).abs() < 1e-6,
+            "{last} {}",
+            with.objective
+        );
         let (visited, points) = visited(&s, &with);
         assert_eq!(visited, points);
         Ok(())

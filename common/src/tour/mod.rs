@@ -151,6 +151,13 @@ pub struct TourPlan {
     /// The stop flag cut the order swarm or a leg swarm short: the tour is complete but was
     /// not optimised with the whole budget.
     pub interrupted: bool,
+    /// The tour's convergence curve: entry `t` is the summed cost of its legs (length plus the
+    /// leg swarms' intersection penalty, [`LegProblem::path_cost`]) when every leg swarm has run
+    /// `t + 1` iterations. A leg that needs no swarm, or whose swarm stopped early, counts at its
+    /// final cost; each leg counts at most its straight chord's cost, as [`plan_leg`] keeps the
+    /// cheaper. One entry per leg-swarm iteration run; a tour none of whose legs needed a swarm
+    /// has one entry, its cost.
+    pub convergence: Vec<f64>,
 }
 
 /// One planned leg.
@@ -162,6 +169,11 @@ pub struct Leg {
     pub evaluations: u64,
     /// The stop flag ended its swarm before the iteration budget.
     pub interrupted: bool,
+    /// Its swarm's best cost after each iteration it ran, capped at the straight chord's cost
+    /// (empty when no swarm ran).
+    pub convergence: Vec<f64>,
+    /// The cost of `path` ([`LegProblem::path_cost`]).
+    pub cost: f64,
 }
 
 /// Plans one leg with `algorithm`. `stop`, when raised, ends its swarm after the current
@@ -179,17 +191,20 @@ pub fn plan_leg(
 ) -> Leg {
     let straight = vec![problem.start, problem.end];
     if problem.waypoints == 0 || problem.feasible(&straight) {
+        let cost = problem.path_cost(&straight);
         return Leg {
             path: straight,
             evaluations: 0,
             interrupted: false,
+            convergence: Vec::new(),
+            cost,
         };
     }
     let mut ex = Executor::new(settings.iterations);
     ex.stop = stop.cloned();
     let m = settings.particles;
     let cap = settings.velocity_cap;
-    let (best, evaluations, interrupted) = match algorithm {
+    let run = match algorithm {
         LegAlgorithm::DePso => {
             best_of(ex.run(problem, &mut DePso::table5(m, seed).capped(cap), |_| {}))
         }
@@ -200,26 +215,56 @@ pub fn plan_leg(
             best_of(ex.run(problem, &mut Lcpso::table5(m, seed).capped(cap), |_| {}))
         }
     };
-    let path = problem.path(&best);
-    let path = if problem.path_cost(&path) <= problem.path_cost(&straight) {
-        path
+    let path = problem.path(&run.best);
+    let (swarm_cost, straight_cost) = (problem.path_cost(&path), problem.path_cost(&straight));
+    let (path, cost) = if swarm_cost <= straight_cost {
+        (path, swarm_cost)
     } else {
-        straight
+        (straight, straight_cost)
     };
     Leg {
         path,
-        evaluations,
-        interrupted,
+        evaluations: run.evaluations,
+        interrupted: run.interrupted,
+        convergence: run
+            .convergence
+            .into_iter()
+            .map(|c| c.min(straight_cost))
+            .collect(),
+        cost,
     }
 }
 
-/// The best position of a finished run, the evaluations it made and whether it was stopped.
-fn best_of<S: SolverState>(run: Outcome<S>) -> (Vec<f64>, u64, bool) {
-    (
-        run.state.best_position().to_vec(),
-        run.state.evaluations(),
-        run.termination == Termination::Interrupted,
-    )
+/// What [`plan_leg`] keeps of a swarm's run.
+struct LegRun {
+    best: Vec<f64>,
+    evaluations: u64,
+    interrupted: bool,
+    convergence: Vec<f64>,
+}
+
+/// The best position of a finished run, the evaluations it made, whether it was stopped and
+/// its convergence curve.
+fn best_of<S: SolverState>(run: Outcome<S>) -> LegRun {
+    LegRun {
+        best: run.state.best_position().to_vec(),
+        evaluations: run.state.evaluations(),
+        interrupted: run.termination == Termination::Interrupted,
+        convergence: run.convergence,
+    }
+}
+
+/// Adds `leg`'s curve to a tour's: entry `t` gains the leg's cost after iteration `t`, or its
+/// final cost where its swarm did not run that far (or at all). Only a leg that ran a swarm
+/// makes the tour's curve longer.
+fn add_leg_curve(curve: &mut Vec<f64>, base: &mut f64, leg: &Leg) {
+    if curve.len() < leg.convergence.len() {
+        curve.resize(leg.convergence.len(), *base);
+    }
+    *base += leg.cost;
+    for (t, c) in curve.iter_mut().enumerate() {
+        *c += leg.convergence.get(t).copied().unwrap_or(leg.cost);
+    }
 }
 
 /// Plans a closed inspection tour from `base` through every point of `points` (seed 003 §V).
@@ -261,6 +306,7 @@ pub fn plan_tour(
     let spheres = safety_spheres(cages, settings.leg.clearance_m);
     let mut path = vec![base];
     let mut leg_lengths = Vec::with_capacity(points.len() + 1);
+    let (mut convergence, mut cost_so_far) = (Vec::new(), 0.0);
     for (k, w) in tour.windows(2).enumerate() {
         let problem = LegProblem::new(
             nodes[w[0]],
@@ -278,8 +324,12 @@ pub fn plan_tour(
         );
         evaluations += leg.evaluations;
         interrupted |= leg.interrupted;
+        add_leg_curve(&mut convergence, &mut cost_so_far, &leg);
         leg_lengths.push(path_length(&leg.path));
         path.extend(leg.path.into_iter().skip(1));
+    }
+    if convergence.is_empty() {
+        convergence.push(cost_so_far);
     }
     let tour_length_m: f64 = leg_lengths.iter().sum();
     let straight_tour_length_m = tour_length(&dist, &tour);
@@ -299,248 +349,9 @@ pub fn plan_tour(
         },
         evaluations,
         interrupted,
+        convergence,
     }
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use approx::assert_abs_diff_eq;
-
-    fn small() -> TourSettings {
-        TourSettings {
-            order: SwapPso {
-                particles: 50,
-                iterations: 300,
-                ..SwapPso::table3(0)
-            },
-            leg: LegSettings {
-                particles: 30,
-                iterations: 150,
-                waypoints: 9,
-                clearance_m: LEG_CLEARANCE_M,
-                velocity_cap: None,
-            },
-            stop: None,
-        }
-    }
-
-    fn group_a_plan(algorithm: LegAlgorithm, seed: u64) -> (Vec<InspectionPoint>, TourPlan) {
-        group_a_plan_with(algorithm, seed, &small())
-    }
-
-    fn group_a_plan_with(
-        algorithm: LegAlgorithm,
-        seed: u64,
-        settings: &TourSettings,
-    ) -> (Vec<InspectionPoint>, TourPlan) {
-        let cages = cage_group_a();
-        let base = paper_base();
-        let pts = inspection_points(&cages, MONITOR_STANDOFF_M, FirstPoint::Toward(base));
-        let plan = plan_tour(
-            base,
-            &pts,
-            &cages,
-            paper_bounds(),
-            algorithm,
-            settings,
-            seed,
-        );
-        (pts, plan)
-    }
-
-    /// Every inspection point exactly once, in the tour's order along its path.
-    fn assert_visits_every_point_in_order(pts: &[InspectionPoint], plan: &TourPlan) {
-        let mut seen = plan.order.clone();
-        seen.sort_unstable();
-        assert_eq!(seen, (0..pts.len()).collect::<Vec<_>>());
-        let mut cursor = 0;
-        for &i in &plan.order {
-            let at = plan.path[cursor..]
-                .iter()
-                .position(|p| *p == pts[i].position)
-                .map(|k| k + cursor);
-            assert!(at.is_some(), "point {i} missing after {cursor}");
-            cursor = at.unwrap_or(cursor) + 1;
-        }
-        assert_eq!(plan.path.first(), Some(&paper_base()));
-        assert_eq!(plan.path.last(), Some(&paper_base()));
-    }
-
-    #[test]
-    fn de_pso_tour_of_group_a_is_safe_and_complete() {
-        let (pts, plan) = group_a_plan(LegAlgorithm::DePso, 1);
-        assert_eq!(plan.cage_intersections, 0, "{plan:?}");
-        // The order swarm's 50 × (300 + 1) tours, plus the swarms of the legs that had to bend
-        // round a cage (the tour is longer than its straight legs, so at least one did).
-        assert!(plan.growth_m > 0.0);
-        assert!(plan.evaluations > 50 * 301, "{}", plan.evaluations);
-        assert!(!plan.interrupted);
-        assert_visits_every_point_in_order(&pts, &plan);
-        // Table 6's measures are consistent.
-        assert_eq!(plan.leg_lengths.len(), pts.len() + 1);
-        assert_abs_diff_eq!(plan.tour_length_m, path_length(&plan.path), epsilon = 1e-6);
-        assert!(plan.growth_m >= 0.0, "{}", plan.growth_m);
-        assert_abs_diff_eq!(
-            plan.growth_m,
-            plan.tour_length_m - plan.straight_tour_length_m,
-            epsilon = 1e-9
-        );
-        assert_abs_diff_eq!(
-            plan.growth_rate,
-            plan.growth_m / plan.straight_tour_length_m,
-            epsilon = 1e-12
-        );
-        // The straight tour collides (the two points of a cage face each other through it), so
-        // avoiding the cages must cost something.
-        let straight: Vec<Vec3> = std::iter::once(paper_base())
-            .chain(plan.order.iter().map(|&i| pts[i].position))
-            .chain(std::iter::once(paper_base()))
-            .collect();
-        assert!(intersections(&straight, &safety_spheres(&cage_group_a(), 1.0)) > 0);
-        assert!(plan.growth_m > 1.0, "{}", plan.growth_m);
-    }
-
-    #[test]
-    fn a_raised_stop_still_gives_a_complete_tour_from_the_initial_swarms() {
-        let settings = TourSettings {
-            stop: Some(Arc::new(AtomicBool::new(true))),
-            ..small()
-        };
-        let (pts, plan) = group_a_plan_with(LegAlgorithm::DePso, 1, &settings);
-        assert!(plan.interrupted);
-        assert_visits_every_point_in_order(&pts, &plan);
-        assert_eq!(plan.leg_lengths.len(), pts.len() + 1);
-        // No iteration ran: the order swarm evaluated its 50 initial tours, and every leg that
-        // needed a swarm its 30 initial particles (at least one leg did: the straight tour
-        // crosses the cages).
-        let legs = (plan.evaluations - 50) / 30;
-        assert_eq!(plan.evaluations, 50 + 30 * legs, "{}", plan.evaluations);
-        assert!((1..=pts.len() as u64 + 1).contains(&legs), "{legs}");
-    }
-
-    /// Seed 003 §V-B at full Table 3 / Table 5 budgets on both groups (slow in a debug build:
-    /// `cargo test -p shoal-common --lib tour::tests::paper_budgets -- --ignored --nocapture`).
-    #[test]
-    #[ignore = "full Table 5 budgets; run on demand"]
-    fn paper_budgets_give_safe_de_pso_tours_on_both_groups() {
-        for (group, cages) in [("A", cage_group_a()), ("B", cage_group_b())] {
-            let base = paper_base();
-            let pts = inspection_points(&cages, MONITOR_STANDOFF_M, FirstPoint::Toward(base));
-            for alg in [
-                LegAlgorithm::LdiwPso,
-                LegAlgorithm::Lcpso,
-                LegAlgorithm::DePso,
-            ] {
-                let plan = plan_tour(
-                    base,
-                    &pts,
-                    &cages,
-                    paper_bounds(),
-                    alg,
-                    &TourSettings::paper(),
-                    1,
-                );
-                println!(
-                    "group {group} {:>8}: straight {:.1} m, tour {:.1} m, growth {:.1} m ({:.2} %), \
-                     intersections {}",
-                    alg.name(),
-                    plan.straight_tour_length_m,
-                    plan.tour_length_m,
-                    plan.growth_m,
-                    100.0 * plan.growth_rate,
-                    plan.cage_intersections
-                );
-                if alg == LegAlgorithm::DePso {
-                    assert_eq!(plan.cage_intersections, 0, "group {group}");
-                }
-            }
-        }
-    }
-
-    #[test]
-    fn plans_are_reproducible_from_the_seed() {
-        let (_, a) = group_a_plan(LegAlgorithm::DePso, 3);
-        let (_, b) = group_a_plan(LegAlgorithm::DePso, 3);
-        assert_eq!(a, b);
-    }
-
-    #[test]
-    fn every_algorithm_plans_a_complete_tour() {
-        for alg in [LegAlgorithm::LdiwPso, LegAlgorithm::Lcpso] {
-            let (pts, plan) = group_a_plan(alg, 2);
-            assert_eq!(plan.order.len(), pts.len(), "{}", alg.name());
-            assert!(plan.growth_m >= 0.0, "{}: {}", alg.name(), plan.growth_m);
-            assert_abs_diff_eq!(plan.tour_length_m, path_length(&plan.path), epsilon = 1e-6);
-        }
-    }
-
-    #[test]
-    fn a_clear_straight_leg_is_kept() {
-        let s = safety_spheres(&[Cage::new("X", 50.0, 50.0, 0.0, 10.0)], 1.0);
-        let p = LegProblem::new(
-            Vec3::zeros(),
-            Vec3::new(100.0, 0.0, 0.0),
-            s,
-            paper_bounds(),
-            5,
-        );
-        let leg = plan_leg(&p, LegAlgorithm::DePso, &small().leg, 0, None);
-        let straight = Leg {
-            path: vec![p.start, p.end],
-            evaluations: 0,
-            interrupted: false,
-        };
-        assert_eq!(leg, straight, "no swarm, no evaluation");
-        // A raised stop changes nothing for a leg that runs no swarm.
-        let raised = Arc::new(AtomicBool::new(true));
-        let leg = plan_leg(&p, LegAlgorithm::DePso, &small().leg, 0, Some(&raised));
-        assert_eq!(leg, straight);
-        assert_eq!(LegAlgorithm::Lcpso.name(), "lcpso");
-    }
-
-    #[test]
-    fn a_legs_swarm_moves_under_the_settings_velocity_cap() {
-        // The cage sits on the straight line, so the swarm has to plan.
-        let s = safety_spheres(&[Cage::new("X", 50.0, 0.0, 0.0, 10.0)], 1.0);
-        let p = LegProblem::new(
-            Vec3::zeros(),
-            Vec3::new(100.0, 0.0, 0.0),
-            s,
-            paper_bounds(),
-            5,
-        );
-        // Evaluations: 30 particles at the start, then each particle once per iteration (its
-        // move), and DE-PSO once more (its DE trial): 30 + 10 × 30 = 330, 30 + 10 × 60 = 630.
-        for (algorithm, evaluations) in [
-            (LegAlgorithm::DePso, 630),
-            (LegAlgorithm::LdiwPso, 330),
-            (LegAlgorithm::Lcpso, 330),
-        ] {
-            let with = |cap| {
-                let settings = LegSettings {
-                    iterations: 10,
-                    velocity_cap: cap,
-                    ..small().leg
-                };
-                plan_leg(&p, algorithm, &settings, 3, None)
-            };
-            let Leg {
-                path: own,
-                evaluations: spent,
-                interrupted,
-            } = with(None);
-            assert!(!interrupted);
-            assert_ne!(
-                own,
-                vec![p.start, p.end],
-                "{algorithm:?} kept a blocked leg"
-            );
-            assert_eq!(spent, evaluations, "{algorithm:?}");
-            let with = |cap| with(cap).path;
-            // Table 5's solvers' own cap is 0.2: naming it changes nothing, another cap does.
-            assert_eq!(own, with(Some(0.2)), "{algorithm:?}");
-            assert_ne!(own, with(Some(0.005)), "{algorithm:?}");
-        }
-    }
-}
+mod tests;

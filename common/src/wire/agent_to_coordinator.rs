@@ -70,6 +70,8 @@ pub enum AgentToCoordinator {
         /// A stop (the coordinator's, or the agent shutting down) cut the tour's swarms short:
         /// the tour is complete but less optimised (protocol version 3).
         interrupted: bool,
+        /// The tour's convergence curve, [`TourPlan::convergence`] (protocol version 5).
+        convergence: Vec<f64>,
     },
     /// Fleet coverage missions (seed 002 with several crawlers): the plan of the agent's strip
     /// (its figures and its exact path). Sent once, before `Done`.
@@ -98,6 +100,7 @@ impl AgentToCoordinator {
             intersections: t.cage_intersections as u32,
             evaluations: t.evaluations,
             interrupted: t.interrupted,
+            convergence: t.convergence.clone(),
         }
     }
 
@@ -139,6 +142,7 @@ pub fn tour_from_wire(
         intersections,
         evaluations,
         interrupted,
+        convergence,
         ..
     } = m
     else {
@@ -147,7 +151,8 @@ pub fn tour_from_wire(
     let straight_m = *straight_m;
     let finite = path.iter().flatten().all(|v| v.is_finite())
         && leg_lengths.iter().all(|v| v.is_finite())
-        && straight_m.is_finite();
+        && straight_m.is_finite()
+        && convergence.iter().all(|v| v.is_finite());
     if !finite || path.is_empty() {
         return Some(Err(
             "a tour with an empty path or a non-finite number".into()
@@ -175,6 +180,7 @@ pub fn tour_from_wire(
         cage_intersections: *intersections as usize,
         evaluations: *evaluations,
         interrupted: *interrupted,
+        convergence: convergence.clone(),
     }))
 }
 
@@ -195,6 +201,7 @@ mod tests {
             cage_intersections: 0,
             evaluations: 12_345,
             interrupted: false,
+            convergence: vec![12.0, 10.5, 10.0],
         };
         let m = AgentToCoordinator::tour("m", "auv1", &t);
         assert_eq!(tour_from_wire(&m, 2), Some(Ok(t.clone())));
@@ -219,12 +226,18 @@ mod tests {
             intersections: 0,
             evaluations: 0,
             interrupted: false,
+            convergence: vec![],
         };
         assert!(matches!(
             tour_from_wire(&tour(vec![[f64::NAN, 0.0, 0.0]]), 2),
             Some(Err(_))
         ));
         assert!(matches!(tour_from_wire(&tour(vec![]), 0), Some(Err(_))));
+        let mut bad_curve = tour(vec![[0.0; 3]]);
+        if let AgentToCoordinator::Tour { convergence, .. } = &mut bad_curve {
+            *convergence = vec![3.0, f64::INFINITY];
+        }
+        assert!(matches!(tour_from_wire(&bad_curve, 0), Some(Err(_))));
         let joined = AgentToCoordinator::Joined {
             mission: "m".into(),
             vehicle: "auv1".into(),

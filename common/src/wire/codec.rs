@@ -106,9 +106,9 @@ mod tests {
             reason: "ok".into(),
         });
         let bytes = encode(&m)?;
-        // version 4 (u16 LE) | variant 3 (u32 LE) | len 2 (u64 LE) "m1" | len 2 "ok"
+        // version 5 (u16 LE) | variant 3 (u32 LE) | len 2 (u64 LE) "m1" | len 2 "ok"
         let expected: Vec<u8> = [
-            &[4u8, 0][..],
+            &[5u8, 0][..],
             &[3, 0, 0, 0],
             &[2, 0, 0, 0, 0, 0, 0, 0],
             b"m1",

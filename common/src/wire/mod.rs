@@ -25,8 +25,9 @@ use crate::trajectory::Trajectory;
 /// Bumped whenever a message's layout changes (bincode is not self-describing):
 /// 2 — `AgentToCoordinator::Tour` carries the tour's evaluations;
 /// 3 — and whether a stop cut its swarms short;
-/// 4 — a coverage strip's tracking report says whether a stop cut the simulation short.
-pub const PROTOCOL_VERSION: u16 = 4;
+/// 4 — a coverage strip's tracking report says whether a stop cut the simulation short;
+/// 5 — `AgentToCoordinator::Tour` carries the tour's convergence curve.
+pub const PROTOCOL_VERSION: u16 = 5;
 
 /// A message of either direction with its protocol version.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
