@@ -271,7 +271,7 @@ pub fn bench_coverage(args: &BenchCoverageArgs, stop: &AtomicBool) -> anyhow::Re
     let mut table = String::from(
         "| seed | method | coverage % | passable % | planning s | samples < clearance | min clearance m | max abs cte m | median abs cte m | detours | virtual boundaries | transits | unreached |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
-    let mut sums: Vec<(DetourMethod, Vec<[f64; 5]>)> = Vec::new();
+    let mut sums: Vec<(DetourMethod, Vec<BenchRow>)> = Vec::new();
     'seeds: for seed in 1..=args.seeds {
         for method in [DetourMethod::Arcs, DetourMethod::HybridAStar] {
             if stop.load(Ordering::Relaxed) {
@@ -293,22 +293,23 @@ pub fn bench_coverage(args: &BenchCoverageArgs, stop: &AtomicBool) -> anyhow::Re
             if r.tracking.as_ref().is_some_and(|t| t.interrupted) {
                 break 'seeds;
             }
-            let (max_cte, med_cte) = r.tracking.as_ref().map_or((f64::NAN, f64::NAN), |t| {
-                (t.max_abs_cte_m, t.median_abs_cte_m)
-            });
+            let cte = r
+                .tracking
+                .as_ref()
+                .map(|t| (t.max_abs_cte_m, t.median_abs_cte_m));
             let name = match method {
                 DetourMethod::Arcs => "arcs",
                 DetourMethod::HybridAStar => "hybrid-a-star",
             };
             let row = format!(
-                "| {seed} | {name} | {:.2} | {:.2} | {:.3} | {} | {:.2} | {:.2} | {:.3} | {} | {} | {} | {} |\n",
+                "| {seed} | {name} | {:.2} | {:.2} | {:.3} | {} | {} | {} | {} | {} | {} | {} | {} |\n",
                 100.0 * r.coverage.ratio,
                 100.0 * r.coverage.ratio_of_passable,
                 r.planning_time_s,
                 r.samples_below_clearance,
-                r.clearance.min,
-                max_cte,
-                med_cte,
+                clearance_cell(&r.clearance),
+                cell(cte.map(|c| c.0), 2),
+                cell(cte.map(|c| c.1), 3),
                 r.event_counts[0],
                 r.event_counts[1],
                 r.event_counts[3],
@@ -316,13 +317,12 @@ pub fn bench_coverage(args: &BenchCoverageArgs, stop: &AtomicBool) -> anyhow::Re
             );
             eprint!("{row}");
             table.push_str(&row);
-            let entry = [
-                r.coverage.ratio,
-                r.planning_time_s,
-                r.samples_below_clearance as f64,
-                max_cte,
-                med_cte,
-            ];
+            let entry = BenchRow {
+                coverage: r.coverage.ratio,
+                planning_s: r.planning_time_s,
+                below_clearance: r.samples_below_clearance,
+                cte,
+            };
             match sums.iter_mut().find(|(m, _)| *m == method) {
                 Some((_, v)) => v.push(entry),
                 None => sums.push((method, vec![entry])),
@@ -331,18 +331,7 @@ pub fn bench_coverage(args: &BenchCoverageArgs, stop: &AtomicBool) -> anyhow::Re
     }
     table.push_str("\n| method | mean coverage % | min coverage % | max planning s | runs with samples < clearance | worst max abs cte m | mean median abs cte m |\n|---|---|---|---|---|---|---|\n");
     for (method, rows) in &sums {
-        let n = rows.len().max(1) as f64;
-        let worst = |k: usize| rows.iter().map(|r| r[k]).fold(f64::NEG_INFINITY, f64::max);
-        table.push_str(&format!(
-            "| {:?} | {:.2} | {:.2} | {:.3} | {} | {:.2} | {:.3} |\n",
-            method,
-            100.0 * rows.iter().map(|r| r[0]).sum::<f64>() / n,
-            100.0 * rows.iter().map(|r| r[0]).fold(f64::INFINITY, f64::min),
-            worst(1),
-            rows.iter().filter(|r| r[2] > 0.0).count(),
-            worst(3),
-            rows.iter().map(|r| r[4]).sum::<f64>() / n
-        ));
+        table.push_str(&summary_row(method, rows));
     }
     let (finished, runs) = (
         sums.iter().map(|(_, rows)| rows.len()).sum::<usize>(),
@@ -358,6 +347,56 @@ pub fn bench_coverage(args: &BenchCoverageArgs, stop: &AtomicBool) -> anyhow::Re
         std::fs::write(path, &table).with_context(|| format!("cannot write {}", path.display()))?;
     }
     Ok(0)
+}
+
+/// One finished run of `bench-coverage`, as its summary needs it.
+struct BenchRow {
+    coverage: f64,
+    planning_s: f64,
+    below_clearance: usize,
+    /// Max and median |cross-track error|, metres, when the run was tracked.
+    cte: Option<(f64, f64)>,
+}
+
+/// `value` with `decimals`, or "–" when there is none.
+fn cell(value: Option<f64>, decimals: usize) -> String {
+    value.map_or("–".into(), |v| format!("{v:.decimals$}"))
+}
+
+/// The min clearance cell: metres, "unbounded" on a map without impassable ground, "–" when
+/// there is no path (see [`clearance_words`]).
+fn clearance_cell(d: &Distribution) -> String {
+    if d.min.is_finite() {
+        format!("{:.2}", d.min)
+    } else if d.count > 0 {
+        "unbounded".into()
+    } else {
+        "–".into()
+    }
+}
+
+/// The summary line of one method over its finished runs; the tracking columns are "–" when
+/// no run was tracked (`--no-track`).
+fn summary_row(method: &DetourMethod, rows: &[BenchRow]) -> String {
+    let n = rows.len().max(1) as f64;
+    let tracked: Vec<(f64, f64)> = rows.iter().filter_map(|r| r.cte).collect();
+    let worst_cte = tracked.iter().map(|c| c.0).reduce(f64::max);
+    let mean_median_cte = (!tracked.is_empty())
+        .then(|| tracked.iter().map(|c| c.1).sum::<f64>() / tracked.len() as f64);
+    format!(
+        "| {:?} | {:.2} | {:.2} | {:.3} | {} | {} | {} |\n",
+        method,
+        100.0 * rows.iter().map(|r| r.coverage).sum::<f64>() / n,
+        100.0
+            * rows
+                .iter()
+                .map(|r| r.coverage)
+                .fold(f64::INFINITY, f64::min),
+        rows.iter().map(|r| r.planning_s).fold(0.0, f64::max),
+        rows.iter().filter(|r| r.below_clearance > 0).count(),
+        cell(worst_cte, 2),
+        cell(mean_median_cte, 3)
+    )
 }
 
 #[cfg(test)]
@@ -394,6 +433,33 @@ mod tests {
         let text = summary("s", &report);
         assert!(!text.contains("-0"), "{text}");
         assert!(text.contains("clearance not measured (no path)"), "{text}");
+    }
+
+    #[test]
+    fn bench_cells_say_what_is_missing_instead_of_nan() {
+        let some = Distribution::new(&[12.5, f64::INFINITY, 20.0], 0.0, 40.0, 40);
+        assert_eq!(clearance_cell(&some), "12.50");
+        let unbounded = Distribution::new(&[f64::INFINITY; 3], 0.0, 40.0, 40);
+        assert_eq!(clearance_cell(&unbounded), "unbounded");
+        assert_eq!(clearance_cell(&Distribution::new(&[], 0.0, 40.0, 40)), "–");
+        let run = |coverage, cte| BenchRow {
+            coverage,
+            planning_s: coverage,
+            below_clearance: 0,
+            cte,
+        };
+        // Untracked runs (`--no-track`): no cross-track figures, not -inf or NaN.
+        let rows = [run(0.5, None), run(0.7, None)];
+        assert_eq!(
+            summary_row(&DetourMethod::Arcs, &rows),
+            "| Arcs | 60.00 | 50.00 | 0.700 | 0 | – | – |\n"
+        );
+        // Tracked: worst of the maxima, mean of the medians.
+        let rows = [run(0.5, Some((2.0, 0.25))), run(0.7, Some((3.5, 0.5)))];
+        assert_eq!(
+            summary_row(&DetourMethod::HybridAStar, &rows),
+            "| HybridAStar | 60.00 | 50.00 | 0.700 | 0 | 3.50 | 0.375 |\n"
+        );
     }
 
     #[test]
