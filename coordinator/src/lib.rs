@@ -48,6 +48,14 @@ pub const EXIT_ERROR: i32 = 1;
 /// Exit status of a plan produced with constraint violations.
 pub const EXIT_VIOLATIONS: i32 = 3;
 
+/// The log filter a command uses when `RUST_LOG` is not set.
+pub fn default_log_filter(command: &Command) -> &'static str {
+    match command {
+        Command::Status(_) => status_cmd::DEFAULT_LOG_FILTER,
+        _ => "warn",
+    }
+}
+
 /// Runs one command to completion. `shutdown` ends long work early (the best result so far is
 /// still written). Returns the process exit status.
 pub fn run(command: Command, shutdown: Arc<AtomicBool>) -> anyhow::Result<i32> {

@@ -30,6 +30,10 @@ pub struct StatusArgs {
     pub json: bool,
 }
 
+/// The log filter when `RUST_LOG` is not set: Zenoh's connection warnings only repeat the
+/// error `status` prints itself (with the paths of Zenoh's source files), so they are left out.
+pub const DEFAULT_LOG_FILTER: &str = "warn,zenoh=error";
+
 /// Queries and prints; exit 1 when no mission answered.
 pub fn command(args: &StatusArgs) -> anyhow::Result<i32> {
     let key = match &args.mission {
@@ -70,9 +74,15 @@ pub fn command(args: &StatusArgs) -> anyhow::Result<i32> {
 /// warning).
 pub fn query(connect: &[String], key: &str, timeout: Duration) -> anyhow::Result<Vec<FleetStatus>> {
     let config = session::client_config(connect, false)?;
-    let s = zenoh::open(config)
-        .wait()
-        .map_err(|e| anyhow::anyhow!("cannot reach {}: {e}", connect.join(", ")))?;
+    let s = zenoh::open(config).wait().map_err(|e| {
+        // Zenoh's own text names its source files; it goes to the debug log, not to the user.
+        tracing::debug!("zenoh: {e}");
+        anyhow::anyhow!(
+            "cannot reach {}: no Zenoh router accepted the connection (is a coordinator running \
+             `run` or `serve` and listening there? set --connect or SHOAL_CONNECT)",
+            connect.join(", ")
+        )
+    })?;
     let replies = s
         .get(key)
         .timeout(timeout)
@@ -92,6 +102,11 @@ pub fn query(connect: &[String], key: &str, timeout: Duration) -> anyhow::Result
     Ok(out)
 }
 
+/// `value` with `decimals`, or "–" when there is none.
+fn cell(value: Option<f64>, decimals: usize) -> String {
+    value.map_or("–".into(), |v| format!("{v:.decimals$}"))
+}
+
 /// One mission's picture as a table.
 pub fn table(s: &FleetStatus) -> String {
     let mut t = format!(
@@ -99,20 +114,27 @@ pub fn table(s: &FleetStatus) -> String {
         s.mission, s.t_s, s.d_min_m, "vehicle", "x m", "y m", "z m", "done", "xtrack m", "ETA s", "status", "rev"
     );
     for v in &s.vehicles {
+        // A vehicle that has not reported yet has no position, progress or state: "–".
         let (p, status) = match &v.state {
-            Some(st) => (st.position, format!("{:?}", st.status).to_lowercase()),
-            None => ([f64::NAN; 3], "–".into()),
+            Some(st) => (
+                st.position.map(Some),
+                format!("{:?}", st.status).to_lowercase(),
+            ),
+            None => ([None; 3], "–".into()),
         };
         let status = if v.lost { "LOST".to_string() } else { status };
+        let done = v
+            .progress
+            .map_or("–".into(), |p| format!("{:.0}%", 100.0 * p.fraction));
         t.push_str(&format!(
-            "{:<10} {:>8.0} {:>8.0} {:>8.0} {:>5.0}% {:>9.1} {:>9.0} {:>8} {:>4}\n",
+            "{:<10} {:>8} {:>8} {:>8} {:>6} {:>9} {:>9} {:>8} {:>4}\n",
             v.vehicle,
-            p[0],
-            p[1],
-            p[2],
-            v.progress.map_or(0.0, |p| 100.0 * p.fraction),
-            v.progress.map_or(f64::NAN, |p| p.cross_track_m),
-            v.progress.map_or(f64::NAN, |p| p.eta_s),
+            cell(p[0], 0),
+            cell(p[1], 0),
+            cell(p[2], 0),
+            done,
+            cell(v.progress.map(|p| p.cross_track_m), 1),
+            cell(v.progress.map(|p| p.eta_s), 0),
             status,
             v.revision
         ));
@@ -131,4 +153,66 @@ pub fn table(s: &FleetStatus) -> String {
         ))
     ));
     t
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use shoal_common::execution::picture::Progress;
+    use shoal_common::execution::{VehicleState, VehicleStatus};
+    use shoal_common::wire::open::{VehicleStatusRow, OPEN_VERSION};
+
+    #[test]
+    fn a_vehicle_that_has_not_reported_shows_dashes_not_nan() {
+        let row = |vehicle: &str, state, progress| VehicleStatusRow {
+            vehicle: vehicle.into(),
+            state,
+            progress,
+            revision: 0,
+            silent_s: 0.0,
+            lost: false,
+        };
+        let state = VehicleState {
+            t_s: 10.0,
+            position: [100.4, 200.6, -30.0],
+            velocity: [1.0, 0.0, 0.0],
+            heading_deg: 0.0,
+            depth_m: None,
+            altitude_m: None,
+            battery: 1.0,
+            status: VehicleStatus::Underway,
+            arrived_s: None,
+        };
+        let progress = Progress {
+            along_m: 50.0,
+            fraction: 0.25,
+            plan_time_s: 10.0,
+            cross_track_m: 1.3,
+            lag_s: 0.0,
+            eta_s: 400.4,
+        };
+        let status = FleetStatus {
+            version: OPEN_VERSION,
+            mission: "m".into(),
+            t_s: 10.0,
+            d_min_m: 50.0,
+            vehicles: vec![
+                row("auv1", Some(state), Some(progress)),
+                row("auv2", None, None),
+            ],
+            current_min_separation_m: None,
+            current_pair: None,
+            predicted: None,
+            horizon_s: 60.0,
+        };
+        let text = table(&status);
+        assert!(!text.contains("NaN"), "{text}");
+        let lines: Vec<&str> = text.lines().collect();
+        let cells = |k: usize| lines[k].split_whitespace().collect::<Vec<_>>();
+        assert_eq!(
+            cells(2),
+            ["auv1", "100", "201", "-30", "25%", "1.3", "400", "underway", "0"]
+        );
+        assert_eq!(cells(3), ["auv2", "–", "–", "–", "–", "–", "–", "–", "0"]);
+    }
 }

@@ -138,3 +138,25 @@ fn compare_refuses_an_algorithm_that_does_not_fit_a_scenario_before_running_any(
     );
     Ok(())
 }
+
+#[test]
+fn status_with_no_coordinator_says_so_in_one_line() -> TestResult {
+    let endpoint = common::fleet::endpoint(common::fleet::free_port());
+    let mut cmd = std::process::Command::new(common::coordinator());
+    common::without_shoal_env(&mut cmd);
+    cmd.env_remove("RUST_LOG")
+        .args(["status", "--connect", &endpoint, "--timeout", "1"]);
+    let out = cmd.output()?;
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(
+        stderr.contains(&format!(
+            "error: cannot reach {endpoint}: no Zenoh router accepted the connection"
+        )),
+        "{stderr}"
+    );
+    // Neither Zenoh's own warnings nor the paths of its source files.
+    assert_eq!(stderr.lines().count(), 1, "{stderr}");
+    assert!(!stderr.contains(".rs:"), "{stderr}");
+    Ok(())
+}
