@@ -348,8 +348,8 @@ impl Inbound<'_> {
     fn start(self, a: Assignment) {
         let vehicle = self.args.vehicle.clone();
         let mission = a.mission.clone();
-        tracing::info!(
-            "mission {mission}: planning {vehicle} in scenario {} ({} vehicles)",
+        let what = format!(
+            "scenario {} ({} vehicles)",
             a.scenario.name,
             a.scenario.vehicles.len()
         );
@@ -371,6 +371,12 @@ impl Inbound<'_> {
                     self.session,
                     &self.args.vehicle,
                     joined(&mission, &self.args.vehicle),
+                );
+                // Logged once the thread runs and the coordinator has been told, so the log
+                // never says "planning" for a mission this agent could not start.
+                tracing::info!(
+                    "mission {mission}: joined; planning {} in {what}",
+                    self.args.vehicle
                 );
                 self.workers.insert(mission, Worker { tx, stop, handle });
             }
