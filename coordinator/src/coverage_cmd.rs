@@ -14,6 +14,7 @@ use shoal_common::coverage::mission::{build_map, run_coverage, CoverageReport};
 use shoal_common::coverage::params::DetourMethod;
 use shoal_common::scenario::{CoverageSettings, Scenario};
 
+use crate::summary::opt;
 use crate::svg_coverage::render_coverage;
 
 /// `plan.json` of a coverage mission.
@@ -308,8 +309,8 @@ pub fn bench_coverage(args: &BenchCoverageArgs, stop: &AtomicBool) -> anyhow::Re
                 r.planning_time_s,
                 r.samples_below_clearance,
                 clearance_cell(&r.clearance),
-                cell(cte.map(|c| c.0), 2),
-                cell(cte.map(|c| c.1), 3),
+                opt(cte.map(|c| c.0), 2),
+                opt(cte.map(|c| c.1), 3),
                 r.event_counts[0],
                 r.event_counts[1],
                 r.event_counts[3],
@@ -358,11 +359,6 @@ struct BenchRow {
     cte: Option<(f64, f64)>,
 }
 
-/// `value` with `decimals`, or "–" when there is none.
-fn cell(value: Option<f64>, decimals: usize) -> String {
-    value.map_or("–".into(), |v| format!("{v:.decimals$}"))
-}
-
 /// The min clearance cell: metres, "unbounded" on a map without impassable ground, "–" when
 /// there is no path (see [`clearance_words`]).
 fn clearance_cell(d: &Distribution) -> String {
@@ -394,8 +390,8 @@ fn summary_row(method: &DetourMethod, rows: &[BenchRow]) -> String {
                 .fold(f64::INFINITY, f64::min),
         rows.iter().map(|r| r.planning_s).fold(0.0, f64::max),
         rows.iter().filter(|r| r.below_clearance > 0).count(),
-        cell(worst_cte, 2),
-        cell(mean_median_cte, 3)
+        opt(worst_cte, 2),
+        opt(mean_median_cte, 3)
     )
 }
 

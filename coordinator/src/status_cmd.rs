@@ -8,6 +8,8 @@ use shoal_common::wire::topics::{self, OpenKey};
 use shoal_common::wire::{codec, session};
 use zenoh::Wait;
 
+use crate::summary::opt;
+
 /// `shoal-coordinator status`.
 #[derive(Debug, Clone, clap::Args)]
 pub struct StatusArgs {
@@ -102,11 +104,6 @@ pub fn query(connect: &[String], key: &str, timeout: Duration) -> anyhow::Result
     Ok(out)
 }
 
-/// `value` with `decimals`, or "–" when there is none.
-fn cell(value: Option<f64>, decimals: usize) -> String {
-    value.map_or("–".into(), |v| format!("{v:.decimals$}"))
-}
-
 /// One mission's picture as a table.
 pub fn table(s: &FleetStatus) -> String {
     let mut t = format!(
@@ -129,12 +126,12 @@ pub fn table(s: &FleetStatus) -> String {
         t.push_str(&format!(
             "{:<10} {:>8} {:>8} {:>8} {:>6} {:>9} {:>9} {:>8} {:>4}\n",
             v.vehicle,
-            cell(p[0], 0),
-            cell(p[1], 0),
-            cell(p[2], 0),
+            opt(p[0], 0),
+            opt(p[1], 0),
+            opt(p[2], 0),
             done,
-            cell(v.progress.map(|p| p.cross_track_m), 1),
-            cell(v.progress.map(|p| p.eta_s), 0),
+            opt(v.progress.map(|p| p.cross_track_m), 1),
+            opt(v.progress.map(|p| p.eta_s), 0),
             status,
             v.revision
         ));

@@ -4,8 +4,10 @@ use std::fmt::Write;
 
 use shoal_common::plan::Plan;
 
-fn opt(v: Option<f64>, digits: usize) -> String {
-    v.map_or_else(|| "-".to_string(), |x| format!("{x:.digits$}"))
+/// `v` with `digits` decimals, or "–" when there is none (the tables of `plan`, `status` and
+/// `bench-coverage`).
+pub(crate) fn opt(v: Option<f64>, digits: usize) -> String {
+    v.map_or_else(|| "–".to_string(), |x| format!("{x:.digits$}"))
 }
 
 /// Renders the per-vehicle table, the fleet figures, notices and violations.
