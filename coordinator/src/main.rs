@@ -8,7 +8,19 @@ use clap::Parser;
 use shoal_coordinator::cli::Cli;
 
 fn main() -> ExitCode {
-    let cli = Cli::parse();
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => {
+            let _ = e.print();
+            // `--help` and `--version` are not errors; a bad command line is, and every error
+            // exits 1 (README), not clap's own 2.
+            return if e.use_stderr() {
+                ExitCode::from(shoal_coordinator::EXIT_ERROR as u8)
+            } else {
+                ExitCode::SUCCESS
+            };
+        }
+    };
     tracing_subscriber::fmt()
         .with_env_filter(
             tracing_subscriber::EnvFilter::try_from_default_env().unwrap_or_else(|_| {

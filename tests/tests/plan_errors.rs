@@ -67,10 +67,8 @@ fn missing_scenario_file_is_reported() -> TestResult {
 fn unknown_algorithm_is_refused() -> TestResult {
     let dir = tempfile::tempdir()?;
     let r = plan(&scenario("amp-pso-1"), dir.path(), &["--algorithm", "nope"]);
-    assert!(
-        r.code().is_some_and(|c| c != 0),
-        "expected a non-zero exit:\n{r}"
-    );
+    // A bad command line is an error like any other: exit 1 (clap's own would be 2).
+    assert_eq!(r.code(), Some(1), "{r}");
     assert!(
         r.stderr.contains("nope"),
         "stderr does not name the bad value:\n{r}"
@@ -158,5 +156,28 @@ fn status_with_no_coordinator_says_so_in_one_line() -> TestResult {
     // Neither Zenoh's own warnings nor the paths of its source files.
     assert_eq!(stderr.lines().count(), 1, "{stderr}");
     assert!(!stderr.contains(".rs:"), "{stderr}");
+    Ok(())
+}
+
+#[test]
+fn a_bad_command_line_exits_1_and_help_exits_0() -> TestResult {
+    for (program, args, code) in [
+        (
+            common::coordinator(),
+            vec!["plan", "x.toml", "--seed", "-1"],
+            1,
+        ),
+        (common::coordinator(), vec!["no-such-command"], 1),
+        (common::coordinator(), vec!["plan", "--help"], 0),
+        (common::agent(), vec!["--no-such-flag"], 1),
+        (common::agent(), vec!["--version"], 0),
+    ] {
+        let mut cmd = std::process::Command::new(program);
+        common::without_shoal_env(&mut cmd);
+        let out = cmd.args(&args).output()?;
+        let text = String::from_utf8_lossy(if code == 0 { &out.stdout } else { &out.stderr });
+        assert_eq!(out.status.code(), Some(code), "{args:?}: {text}");
+        assert!(!text.is_empty(), "{args:?} printed nothing");
+    }
     Ok(())
 }

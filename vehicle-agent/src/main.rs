@@ -8,7 +8,18 @@ use clap::Parser;
 use shoal_agent::AgentArgs;
 
 fn main() -> ExitCode {
-    let args = AgentArgs::parse();
+    let args = match AgentArgs::try_parse() {
+        Ok(args) => args,
+        Err(e) => {
+            let _ = e.print();
+            // As the coordinator: a bad command line exits 1 like any other error.
+            return if e.use_stderr() {
+                ExitCode::FAILURE
+            } else {
+                ExitCode::SUCCESS
+            };
+        }
+    };
     tracing_subscriber::fmt()
         .with_env_filter(
             tracing_subscriber::EnvFilter::try_from_default_env()
