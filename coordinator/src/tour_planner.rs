@@ -15,7 +15,7 @@ use std::time::Instant;
 use shoal_common::plan::{assess, Plan};
 use shoal_common::scenario::Scenario;
 use shoal_common::swarm::IterationReport;
-use shoal_common::tour::{FleetTours, TourFigures, TourPlan};
+use shoal_common::tour::{summed_curve, FleetTours, TourFigures, TourPlan};
 use shoal_common::trajectory::Trajectory;
 
 use crate::energy_planner::unplannable;
@@ -193,15 +193,10 @@ pub fn assemble(
 /// is shorter counting at its last value ([`TourPlan::convergence`]). Its last entry is the
 /// tours' summed length when no tour crosses a cage.
 pub fn fleet_convergence(tours: &[TourPlan]) -> Vec<f64> {
-    let len = tours.iter().map(|t| t.convergence.len()).max().unwrap_or(0);
-    (0..len)
-        .map(|k| {
-            tours
-                .iter()
-                .filter_map(|t| t.convergence.get(k).or(t.convergence.last()))
-                .sum()
-        })
-        .collect()
+    summed_curve(tours.iter().map(|t| {
+        let held = t.convergence.last().copied().unwrap_or(0.0);
+        (t.convergence.as_slice(), held)
+    }))
 }
 
 #[cfg(test)]

@@ -254,17 +254,25 @@ fn best_of<S: SolverState>(run: Outcome<S>) -> LegRun {
     }
 }
 
-/// Adds `leg`'s curve to a tour's: entry `t` gains the leg's cost after iteration `t`, or its
-/// final cost where its swarm did not run that far (or at all). Only a leg that ran a swarm
-/// makes the tour's curve longer.
-fn add_leg_curve(curve: &mut Vec<f64>, base: &mut f64, leg: &Leg) {
-    if curve.len() < leg.convergence.len() {
-        curve.resize(leg.convergence.len(), *base);
-    }
-    *base += leg.cost;
-    for (t, c) in curve.iter_mut().enumerate() {
-        *c += leg.convergence.get(t).copied().unwrap_or(leg.cost);
-    }
+/// The sum of several convergence curves, each given with the value it holds after its last
+/// entry (or throughout, when it is empty): entry `t` sums every curve's entry `t`, or that
+/// value where a curve is shorter. As long as the longest curve; empty when every curve is.
+pub fn summed_curve<'a>(parts: impl IntoIterator<Item = (&'a [f64], f64)> + Clone) -> Vec<f64> {
+    let len = parts
+        .clone()
+        .into_iter()
+        .map(|(c, _)| c.len())
+        .max()
+        .unwrap_or(0);
+    (0..len)
+        .map(|t| {
+            parts
+                .clone()
+                .into_iter()
+                .map(|(c, held)| c.get(t).copied().unwrap_or(held))
+                .sum()
+        })
+        .collect()
 }
 
 /// Plans a closed inspection tour from `base` through every point of `points` (seed 003 §V).
@@ -306,7 +314,8 @@ pub fn plan_tour(
     let spheres = safety_spheres(cages, settings.leg.clearance_m);
     let mut path = vec![base];
     let mut leg_lengths = Vec::with_capacity(points.len() + 1);
-    let (mut convergence, mut cost_so_far) = (Vec::new(), 0.0);
+    // Each leg's curve and its final cost, for the tour's curve.
+    let mut curves = Vec::with_capacity(points.len() + 1);
     for (k, w) in tour.windows(2).enumerate() {
         let problem = LegProblem::new(
             nodes[w[0]],
@@ -324,12 +333,13 @@ pub fn plan_tour(
         );
         evaluations += leg.evaluations;
         interrupted |= leg.interrupted;
-        add_leg_curve(&mut convergence, &mut cost_so_far, &leg);
+        curves.push((leg.convergence, leg.cost));
         leg_lengths.push(path_length(&leg.path));
         path.extend(leg.path.into_iter().skip(1));
     }
+    let mut convergence = summed_curve(curves.iter().map(|(c, cost)| (c.as_slice(), *cost)));
     if convergence.is_empty() {
-        convergence.push(cost_so_far);
+        convergence.push(curves.iter().map(|(_, cost)| cost).sum());
     }
     let tour_length_m: f64 = leg_lengths.iter().sum();
     let straight_tour_length_m = tour_length(&dist, &tour);

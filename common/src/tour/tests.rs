@@ -277,19 +277,14 @@ fn a_tours_curve_sums_its_legs_holding_each_at_its_final_cost() {
         leg_with(12.0, vec![12.0]),
         leg_with(5.0, vec![]),
     ];
-    let (mut curve, mut base) = (Vec::new(), 0.0);
-    for leg in &legs {
-        add_leg_curve(&mut curve, &mut base, leg);
-    }
-    // 10 + 30 + 12 + 5, 10 + 25 + 12 + 5, 10 + 20 + 12 + 5.
-    assert_eq!(curve, [57.0, 52.0, 47.0]);
-    assert_eq!(base, 47.0);
+    let curve =
+        |legs: &[Leg]| summed_curve(legs.iter().map(|l| (l.convergence.as_slice(), l.cost)));
+    // 10 + 30 + 12 + 5, 10 + 25 + 12 + 5, 10 + 20 + 12 + 5: the last entry is the sum of the
+    // legs' final costs.
+    assert_eq!(curve(&legs), [57.0, 52.0, 47.0]);
     // Order does not matter: the short curve first, the long one last.
-    let (mut curve, mut base) = (Vec::new(), 0.0);
-    for leg in legs.iter().rev() {
-        add_leg_curve(&mut curve, &mut base, leg);
-    }
-    assert_eq!(curve, [57.0, 52.0, 47.0]);
+    let reversed: Vec<Leg> = legs.iter().rev().cloned().collect();
+    assert_eq!(curve(&reversed), [57.0, 52.0, 47.0]);
 }
 
 #[test]
