@@ -80,8 +80,10 @@ pub fn replay(path: &Path) -> anyhow::Result<Replayed> {
                 for (id, s) in &p.trajectories {
                     if let Some(i) = fleet.index(id) {
                         if p.changed.contains(id) {
+                            // As live: a new plan ends a hold.
                             fleet.vehicles[i].plan = Trajectory::from_samples(s);
                             fleet.vehicles[i].revision = p.revision;
+                            fleet.vehicles[i].holding = false;
                         }
                     }
                 }
@@ -93,10 +95,14 @@ pub fn replay(path: &Path) -> anyhow::Result<Replayed> {
                 fleet.report(telemetry.clone(), *received_unix_us);
             }
             Record::Event(e) => {
-                if e.kind == "vehicle_lost" {
-                    for v in &e.vehicles {
-                        if let Some(i) = fleet.index(v) {
-                            fleet.vehicles[i].lost = true;
+                // The live run marks a vehicle lost or holding just before it logs the event,
+                // and a holding vehicle's distance from its plan is no tracking error.
+                for v in &e.vehicles {
+                    if let Some(i) = fleet.index(v) {
+                        match e.kind.as_str() {
+                            log::EVENT_LOST => fleet.vehicles[i].lost = true,
+                            log::EVENT_HOLD => fleet.vehicles[i].holding = true,
+                            _ => {}
                         }
                     }
                 }
@@ -249,4 +255,118 @@ pub fn render(r: &Replayed) -> anyhow::Result<String> {
         root.present().map_err(fail("document"))?;
     }
     Ok(buf)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::execute::log::{LogWriter, Start};
+    use shoal_common::execution::{VehicleState, VehicleStatus};
+    use shoal_common::wire::open::{PlanNotice, Telemetry};
+
+    fn plan(revision: u32, changed: &[&str], tracks: &[(&str, Vec<[f64; 4]>)]) -> Record {
+        Record::Plan(PlanNotice {
+            version: 1,
+            mission: "m".into(),
+            revision,
+            changed: changed.iter().map(|s| s.to_string()).collect(),
+            trajectories: tracks
+                .iter()
+                .map(|(v, s)| (v.to_string(), s.clone()))
+                .collect(),
+        })
+    }
+
+    fn report(seq: u64, revision: u32, t_s: f64, position: [f64; 3]) -> Record {
+        Record::Telemetry {
+            received_unix_us: 1_000_000 + seq,
+            telemetry: Telemetry {
+                version: 1,
+                mission: "m".into(),
+                vehicle: "auv1".into(),
+                seq,
+                revision,
+                sent_unix_us: 1_000_000,
+                state: VehicleState {
+                    t_s,
+                    position,
+                    velocity: [1.0, 0.0, 0.0],
+                    heading_deg: 90.0,
+                    depth_m: None,
+                    altitude_m: None,
+                    battery: 1.0,
+                    status: VehicleStatus::Underway,
+                    arrived_s: None,
+                },
+            },
+        }
+    }
+
+    /// A vehicle told to hold drifts 40 m off its plan before its replan arrives: as in the live
+    /// run, that is not tracking error, so the replayed cross-track stays the 3 m measured on
+    /// the new plan (before the fix the replay counted the 40 m and disagreed with the log).
+    #[test]
+    fn a_hold_is_not_tracking_error_in_the_replay() -> anyhow::Result<()> {
+        let dir = std::env::temp_dir().join(format!("shoal-replay-hold-{}", std::process::id()));
+        std::fs::create_dir_all(&dir)?;
+        let path = dir.join("m.ndjson");
+        let auv2 = vec![[0.0, 0.0, 500.0, 0.0], [1000.0, 1000.0, 500.0, 0.0]];
+        let mut w = LogWriter::create(&path)?;
+        for r in [
+            Record::Start(Start {
+                mission: "m".into(),
+                scenario_toml: include_str!("../../scenarios/amp-pso-1.toml").into(),
+                common_arrival_s: 1000.0,
+                arrival_window_s: 30.0,
+                horizon_s: 180.0,
+                time_scale: 50.0,
+                epoch_unix_ms: 0,
+            }),
+            plan(
+                0,
+                &["auv1", "auv2"],
+                &[
+                    (
+                        "auv1",
+                        vec![[0.0, 0.0, 0.0, 0.0], [1000.0, 1000.0, 0.0, 0.0]],
+                    ),
+                    ("auv2", auv2.clone()),
+                ],
+            ),
+            report(1, 0, 100.0, [100.0, 1.0, 0.0]),
+            Record::Event(MissionEvent {
+                version: 1,
+                mission: "m".into(),
+                t_s: 150.0,
+                kind: log::EVENT_HOLD.into(),
+                vehicles: vec!["auv1".into()],
+                detail: "auv1 told to hold".into(),
+            }),
+            report(2, 0, 200.0, [150.0, 40.0, 0.0]),
+            plan(
+                1,
+                &["auv1"],
+                &[
+                    (
+                        "auv1",
+                        vec![[200.0, 150.0, 40.0, 0.0], [1050.0, 1000.0, 40.0, 0.0]],
+                    ),
+                    ("auv2", auv2),
+                ],
+            ),
+            report(3, 1, 300.0, [250.0, 43.0, 0.0]),
+        ] {
+            w.write(&r);
+        }
+        w.flush();
+        let r = replay(&path)?;
+        std::fs::remove_dir_all(&dir)?;
+        let v = &r.figures.vehicles[0];
+        assert_eq!(v.vehicle, "auv1");
+        assert_eq!(v.revision, 1);
+        // Reports 1 and 3 count (1 m and 3 m off); report 2, while holding, does not.
+        assert!((v.max_cross_track_m - 3.0).abs() < 1e-6, "{v:?}");
+        assert!((v.median_cross_track_m - 2.0).abs() < 1e-6, "{v:?}");
+        Ok(())
+    }
 }

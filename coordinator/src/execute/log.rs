@@ -16,6 +16,11 @@ use shoal_common::wire::open::{MissionEvent, PlanNotice, Telemetry};
 
 use super::fleet::ExecutionFigures;
 
+/// The event kind of a vehicle declared lost (its `vehicles` names it).
+pub const EVENT_LOST: &str = "vehicle_lost";
+/// The event kind of a vehicle told to hold (its `vehicles` names it).
+pub const EVENT_HOLD: &str = "hold";
+
 /// What starts a log.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Start {

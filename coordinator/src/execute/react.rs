@@ -17,7 +17,7 @@ use shoal_common::wire::coordinator_to_agent::CoordinatorToAgent;
 use shoal_common::wire::open::{FleetStatus, Telemetry, OPEN_VERSION};
 use shoal_common::wire::WireTrajectory;
 
-use super::log::Record;
+use super::log::{Record, EVENT_HOLD, EVENT_LOST};
 use super::repair;
 use super::replan::{self, Request};
 use super::Exec;
@@ -205,7 +205,7 @@ pub(super) fn lose(x: &mut Exec, id: &str, why: &str) {
     }
     x.fleet.vehicles[i].lost = true;
     x.event(
-        "vehicle_lost",
+        EVENT_LOST,
         vec![id.to_string()],
         format!("{id} is lost: {why}; the others treat its last position as an obstacle"),
     );
@@ -395,7 +395,7 @@ pub(super) fn replan_vehicle(x: &mut Exec, i: usize, why: &str) -> bool {
             x.fleet.vehicles[i].holding = true;
             x.holds += 1;
             x.event(
-                "hold",
+                EVENT_HOLD,
                 vec![id.clone()],
                 format!(
                     "{id} told to hold ({why}): no safe replan in {:.0} ms ({} obstacle intrusions, closest vehicle {:.1} m)",
