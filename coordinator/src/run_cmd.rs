@@ -322,15 +322,9 @@ pub fn execution_summary(r: &ExecutionReport) -> String {
     ));
     if !r.obstacle_decision_ms.is_empty() || !r.update_delivery_ms.is_empty() {
         s.push_str(&format!(
-            "  replans: obstacle → update sent {:?} ms; update → first report on it {:?} ms\n",
-            r.obstacle_decision_ms
-                .iter()
-                .map(|v| v.round())
-                .collect::<Vec<_>>(),
-            r.update_delivery_ms
-                .iter()
-                .map(|v| v.round())
-                .collect::<Vec<_>>()
+            "  replans: obstacle → update sent {}; update → first report on it {}\n",
+            ms_list(&r.obstacle_decision_ms),
+            ms_list(&r.update_delivery_ms)
         ));
     }
     let failures = execution_failures(r);
@@ -342,9 +336,26 @@ pub fn execution_summary(r: &ExecutionReport) -> String {
     s
 }
 
+/// Durations as `12, 336 ms`, or "–" for none (e.g. every vehicle an obstacle blocked was held
+/// first, so no update went out at once).
+fn ms_list(ms: &[f64]) -> String {
+    if ms.is_empty() {
+        return "–".to_string();
+    }
+    let each: Vec<String> = ms.iter().map(|v| format!("{v:.0}")).collect();
+    format!("{} ms", each.join(", "))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn durations_read_as_a_list_of_milliseconds() {
+        assert_eq!(ms_list(&[]), "–");
+        assert_eq!(ms_list(&[336.0]), "336 ms");
+        assert_eq!(ms_list(&[12.4, 336.6]), "12, 337 ms");
+    }
 
     #[test]
     fn the_separation_buffer_defaults_to_a_fifth_of_d_min_and_bad_ones_are_named() {
