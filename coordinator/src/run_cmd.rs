@@ -30,7 +30,8 @@ pub struct RunArgs {
     /// Prediction horizon of the separation check, mission seconds.
     #[arg(long, env = "SHOAL_HORIZON", default_value_t = 180.0)]
     pub horizon: f64,
-    /// Cross-track error that triggers a replan, metres (default: d_min / 2).
+    /// Cross-track error that triggers a replan, metres (default: d_min / 2; 10 m for a lone
+    /// vehicle, d_min = 0).
     #[arg(long, env = "SHOAL_DEVIATION")]
     pub deviation: Option<f64>,
     /// Metres over d_min a replan keeps from the other vehicles, for their tracking error and
@@ -95,6 +96,20 @@ fn parse_injection(s: &str) -> Result<(f64, Place, f64), String> {
     Ok((num(t)?, place, r))
 }
 
+/// Cross-track tolerance for a lone vehicle (d_min = 0, nothing to keep apart), metres: the
+/// simulated AUV tracks to within 2–9 m in seed 001's current, so 10 m means it is really off.
+pub const LONE_DEVIATION_M: f64 = 10.0;
+
+/// `--deviation`'s default: half of d_min, so that two vehicles each off by less cannot close
+/// the gap between them, or [`LONE_DEVIATION_M`] when the mission keeps no separation.
+fn default_deviation(d_min: f64) -> f64 {
+    if d_min > 0.0 {
+        d_min / 2.0
+    } else {
+        LONE_DEVIATION_M
+    }
+}
+
 /// A positive number of seconds, or an error naming the flag.
 fn positive(flag: &str, v: f64) -> anyhow::Result<f64> {
     if v.is_finite() && v > 0.0 {
@@ -142,7 +157,7 @@ pub fn run_command(args: &RunArgs, shutdown: Arc<AtomicBool>) -> anyhow::Result<
     let d_min = scenario.fleet.d_min_m;
     let deviation = positive(
         "--deviation (SHOAL_DEVIATION)",
-        args.deviation.unwrap_or(d_min / 2.0),
+        args.deviation.unwrap_or(default_deviation(d_min)),
     )?;
     let buffer = separation_buffer(args.separation_buffer, d_min)?;
     std::fs::create_dir_all(&p.out)
@@ -349,6 +364,15 @@ fn ms_list(ms: &[f64]) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_deviation_defaults_to_half_of_d_min_or_ten_metres_alone() {
+        assert!((default_deviation(50.0) - 25.0).abs() < 1e-12);
+        assert!((default_deviation(20.0) - 10.0).abs() < 1e-12);
+        // seed 001's lone AUV (d_min 0) gets a tolerance, not an error about a flag.
+        assert!((default_deviation(0.0) - LONE_DEVIATION_M).abs() < 1e-12);
+        assert!(positive("--deviation", default_deviation(0.0)).is_ok());
+    }
 
     #[test]
     fn durations_read_as_a_list_of_milliseconds() {
