@@ -172,8 +172,9 @@ pub struct Vehicle {
     pub max_turn_deg: f64,
     /// Largest |pitch| of a leg, degrees (seed 004: 20°).
     pub max_pitch_deg: f64,
-    /// Turning radius when executing, metres (the simulated vehicle's; none of the seeds'
-    /// planners uses one). Absent: the simulator's default of 20 m, a mid-size survey AUV.
+    /// Turning radius when executing, metres (the simulated vehicle's). Absent: seed 001's
+    /// R_AUV (`energy.min_turn_radius_m`) in an energy mission, whose planner keeps to it, else
+    /// the simulator's default of 20 m, a mid-size survey AUV.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub turn_radius_m: Option<f64>,
 }
@@ -525,6 +526,20 @@ impl Scenario {
             max_slope_deg: v.max_pitch_deg,
             weights: c.weights,
             penalty_weight: self.optimizer.penalty_weight,
+        })
+    }
+
+    /// The turning radius vehicle `i` executes with, metres: its own `turn_radius_m`, else for
+    /// a seed 001 energy mission the R_AUV its plan was made for (`energy.min_turn_radius_m`:
+    /// the plan's climbing turns are that tight, and a wider-turning vehicle cannot fly them),
+    /// else `None` (the simulator's default).
+    pub fn execution_turn_radius_m(&self, i: usize) -> Option<f64> {
+        let v = self.vehicles.get(i)?;
+        v.turn_radius_m.or_else(|| {
+            self.optimizer
+                .algorithm
+                .is_energy_planner()
+                .then_some(self.energy.min_turn_radius_m)
         })
     }
 

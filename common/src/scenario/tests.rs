@@ -175,3 +175,24 @@ fn the_velocity_cap_is_the_algorithms_own_unless_the_file_sets_one() -> Result<(
     }
     Ok(())
 }
+
+#[test]
+fn a_vehicle_executes_with_its_own_turn_radius_else_the_energy_plans_r_auv(
+) -> Result<(), ScenarioError> {
+    // A fleet scenario with no turn radius leaves the simulator's default.
+    let fleet = parse(GOOD)?;
+    assert_eq!(fleet.execution_turn_radius_m(0), None);
+    assert_eq!(fleet.execution_turn_radius_m(1), None);
+    let own = parse(&GOOD.replace(
+        "max_pitch_deg = 20.0",
+        "max_pitch_deg = 20.0\nturn_radius_m = 12.5",
+    ))?;
+    assert_eq!(own.execution_turn_radius_m(0), Some(12.5));
+    // The shipped seed 001 mission: R_AUV = 8 m (Table 2) is what its plan turns on.
+    let epa = Scenario::parse(
+        include_str!("../../../scenarios/epa-pso.toml"),
+        Path::new("scenarios/epa-pso.toml"),
+    )?;
+    assert_eq!(epa.execution_turn_radius_m(0), Some(8.0));
+    Ok(())
+}

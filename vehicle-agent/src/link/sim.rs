@@ -54,7 +54,9 @@ impl SimLink {
         let settings = SimSettings {
             position_noise_m,
             seed,
-            turn_radius_m: vehicle.turn_radius_m.unwrap_or(defaults.turn_radius_m),
+            turn_radius_m: scenario
+                .execution_turn_radius_m(index)
+                .unwrap_or(defaults.turn_radius_m),
             ..defaults
         };
         Ok(SimLink {
