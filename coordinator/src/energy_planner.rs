@@ -107,6 +107,15 @@ pub fn to_plan(scenario: &Scenario, problem: &EnergyProblem, run: RunResult) -> 
             -terms.terrain_margin_m, m.terrain_clearance_m, terms.terrain_violations
         ));
     }
+    // The plan holds the ground speed of §2.2 whatever the current; the vehicle must make the
+    // difference through the water, and cannot beyond its top speed.
+    let top = scenario.vehicles[0].speed_max_mps;
+    if terms.max_water_speed_mps > top + 1e-9 {
+        assessment.violations.push(format!(
+            "{id} must make up to {:.2} m/s through the water to hold {speed:.2} m/s over ground against the current, over its top speed of {top:.2} m/s (vehicles[0].speed_max_mps)",
+            terms.max_water_speed_mps
+        ));
+    }
     if let Some(v) = assessment.vehicles.first_mut() {
         v.energy = Some(terms);
     }

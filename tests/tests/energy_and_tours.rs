@@ -65,6 +65,33 @@ fn epa_pso_saves_energy_and_keeps_the_mobility_limits() -> TestResult {
 }
 
 #[test]
+fn a_plan_that_needs_more_than_the_top_speed_through_the_water_is_infeasible() -> TestResult {
+    // The plan holds 1.5 m/s over ground; against the 1.41 m/s surface current that takes up
+    // to ~2.9 m/s through the water, which a vehicle of 1.5 m/s top speed cannot make.
+    let dir = tempfile::tempdir()?;
+    let toml = std::fs::read_to_string(scenario("epa-pso"))?;
+    let slow = toml.replacen("speed_max_mps = 3.0", "speed_max_mps = 1.5", 1);
+    assert_ne!(slow, toml, "the shipped scenario's top speed moved");
+    let file = dir.path().join("slow.toml");
+    std::fs::write(&file, slow)?;
+    let r = plan(&file, dir.path(), &["--iterations", "10", "-q"]);
+    assert_eq!(r.code(), Some(3), "{r}");
+    let json: Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("plan.json"))?)?;
+    let violations = key(&json, "violations").to_string();
+    assert!(
+        violations.contains("through the water")
+            && violations.contains("vehicles[0].speed_max_mps"),
+        "{violations}"
+    );
+    // The shipped vehicle (3 m/s through the water) flies the same plan.
+    let dir = tempfile::tempdir()?;
+    let json = plan_and_check("epa-pso", dir.path(), &["--iterations", "10"])?;
+    assert_eq!(key(&json, "feasible").as_bool(), Some(true), "{json}");
+    Ok(())
+}
+
+#[test]
 fn energy_planners_refuse_a_distributed_run_and_fleets() -> TestResult {
     let dir = tempfile::tempdir()?;
     // Without --in-process the coordinator would wait for agents: it refuses at once instead.
