@@ -51,7 +51,7 @@ pub struct RunArgs {
     #[arg(long, env = "SHOAL_POSITION_NOISE", default_value_t = 1.0)]
     pub position_noise: f64,
     /// Publish a hard obstacle at mission time T, as a client would: `T:X,Y,Z,R` (seconds,
-    /// metres; inflation d_min), or `T:VEHICLE,R` to put it on that vehicle's planned path
+    /// metres; inflation d_min, at least the --deviation tolerance), or `T:VEHICLE,R` to put it on that vehicle's planned path
     /// 150 s of mission time after T. Repeatable.
     #[arg(long = "inject-obstacle", value_parser = parse_injection)]
     pub inject: Vec<(f64, Place, f64)>,
@@ -108,6 +108,13 @@ fn default_deviation(d_min: f64) -> f64 {
     } else {
         LONE_DEVIATION_M
     }
+}
+
+/// The margin of an injected obstacle: d_min, as the scenario's own obstacles keep, but never
+/// less than the cross-track error a vehicle may have before it is replanned (a lone vehicle's
+/// d_min is 0, and a way round the bare sphere let its track graze 1.3 m into it).
+fn injected_inflation(d_min: f64, deviation: f64) -> f64 {
+    d_min.max(deviation)
 }
 
 /// A positive number of seconds, or an error naming the flag.
@@ -237,7 +244,7 @@ pub fn run_command(args: &RunArgs, shutdown: Arc<AtomicBool>) -> anyhow::Result<
                         kind: ObstacleKind::Hard,
                         centre,
                         radius_m: *r,
-                        inflation_m: d_min,
+                        inflation_m: injected_inflation(d_min, deviation),
                     },
                 ))
             })
@@ -372,6 +379,13 @@ mod tests {
         // seed 001's lone AUV (d_min 0) gets a tolerance, not an error about a flag.
         assert!((default_deviation(0.0) - LONE_DEVIATION_M).abs() < 1e-12);
         assert!(positive("--deviation", default_deviation(0.0)).is_ok());
+    }
+
+    #[test]
+    fn an_injected_obstacle_keeps_d_min_or_the_deviation_tolerance() {
+        assert!((injected_inflation(50.0, 25.0) - 50.0).abs() < 1e-12);
+        assert!((injected_inflation(0.0, LONE_DEVIATION_M) - 10.0).abs() < 1e-12);
+        assert!((injected_inflation(20.0, 30.0) - 30.0).abs() < 1e-12);
     }
 
     #[test]

@@ -254,6 +254,56 @@ fn a_lone_auv_flies_its_energy_plan_in_the_current() -> TestResult {
     // wide in a turn); with the default 20 m turning radius p95 was 21 m and max 40 m.
     assert!(num(v, "p95_cross_track_m") < 8.0, "{v}");
     assert!(num(v, "max_cross_track_m") < 20.0, "{v}");
+
+    // An obstacle on its path: the energy path is repaired (kept, with a way round the
+    // obstacle), not replaced by seed 004's replan, which knows neither the seabed nor R_AUV
+    // (it sent this AUV on an 85-point loop to the edge of the map). The lone vehicle's
+    // obstacle keeps the 10 m deviation tolerance as its margin (d_min is 0).
+    let out = fleet.dir().join("out-obstacle");
+    let planning = ["--iterations", "40", "--seed", "2"];
+    let inject = ["--inject-obstacle", "20:68,62,67,6"];
+    let c = fleet.spawn(
+        "coordinator-obstacle",
+        run_scenario("epa-pso", &planning, &out, "20", &inject),
+    );
+    let r = fleet.wait(c, Instant::now() + LIMIT);
+    assert_eq!(r.code(), Some(0), "{}\n{}", r.stdout, r.stderr);
+    let log = std::fs::read_to_string(out.join("mission.ndjson"))?;
+    assert!(
+        log.contains("radius 6 + 10 m: blocks auv1"),
+        "the obstacle is no longer on the plan"
+    );
+    let plans: Vec<Value> = log
+        .lines()
+        .filter_map(|l| serde_json::from_str::<Value>(l).ok())
+        .filter(|r| r["record"] == "plan")
+        .collect();
+    let points = |k: usize| -> Vec<[f64; 3]> {
+        plans[k]["trajectories"][0][1]
+            .as_array()
+            .map(|a| {
+                a.iter()
+                    .map(|s| [1, 2, 3].map(|i| s[i].as_f64().unwrap_or(f64::NAN)))
+                    .collect()
+            })
+            .unwrap_or_default()
+    };
+    let (planned, repaired) = (points(0), points(1));
+    let kept = repaired
+        .iter()
+        .filter(|q| {
+            planned
+                .iter()
+                .any(|p| (0..3).all(|i| (p[i] - q[i]).abs() < 1e-6))
+        })
+        .count();
+    assert!(
+        kept * 10 >= repaired.len() * 7,
+        "{kept} of {} repaired points are the plan's",
+        repaired.len()
+    );
+    let v = &execution_report(&out)?["figures"]["vehicles"][0];
+    assert!(num(v, "min_obstacle_clearance_m") > 0.0, "{v}");
     fleet.passed();
     Ok(())
 }

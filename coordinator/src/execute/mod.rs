@@ -3,8 +3,8 @@
 //! fleet picture ([`fleet`]), publishes it on the open JSON keys, logs everything ([`log`]) and
 //! reacts ([`react`]): a predicted loss of separation, a deviation beyond the tolerance, a
 //! vehicle that stops reporting or a new obstacle makes it replan the affected vehicles
-//! ([`replan`]; an inspection tour is repaired instead, [`repair`]) or, when no safe replan
-//! comes in time, command a hold.
+//! ([`replan`]; an inspection tour or an energy plan is repaired instead, [`repair`]) or, when
+//! no safe replan comes in time, command a hold.
 
 mod detour;
 pub mod fleet;

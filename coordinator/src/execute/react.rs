@@ -321,8 +321,11 @@ pub(super) fn replan_vehicle(x: &mut Exec, i: usize, why: &str) -> bool {
         separation_buffer_m: o.separation_buffer_m,
         seed,
     };
-    // A tour must still pass its remaining inspection points: it is repaired, not replanned.
-    let result = if x.scenario.optimizer.algorithm.is_tour_planner() {
+    // A tour must still pass its remaining inspection points, and an energy plan (seed 001)
+    // keeps the path its cost chose over the seabed, its turning radius and the current, none
+    // of which seed 004's replan models: both are repaired, not replanned.
+    let algorithm = x.scenario.optimizer.algorithm;
+    let result = if algorithm.is_tour_planner() || algorithm.is_energy_planner() {
         repair::repair(&request)
     } else {
         replan::replan(&request)

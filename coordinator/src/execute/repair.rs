@@ -1,6 +1,8 @@
 //! Repairing the rest of an inspection tour while the fleet drives (issue 8). A tour's path is
 //! not "any way to the goal": it must still pass every remaining inspection point in order, so
-//! the point-to-point replan of [`super::replan`] would be wrong for it. A repair keeps the
+//! the point-to-point replan of [`super::replan`] would be wrong for it. The same holds for an
+//! energy plan (seed 001), whose path points were chosen for the seabed, the AUV's turning
+//! radius and the current, none of which the replan models. A repair keeps the
 //! rest of the tour and changes only what must change:
 //!
 //! - the vehicle goes from where it will be back onto its tour (directly: after a deviation or a
