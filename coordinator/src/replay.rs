@@ -113,11 +113,7 @@ pub fn replay(path: &Path) -> anyhow::Result<Replayed> {
             Record::Start(_) | Record::Plan(_) => {}
         }
     }
-    let figures = fleet.figures(
-        start.common_arrival_s,
-        start.arrival_window_s,
-        &scenario.obstacles,
-    );
+    let figures = fleet.figures_for(&scenario, start.common_arrival_s, start.arrival_window_s);
     let tracks = fleet.vehicles.iter().map(|v| v.track.clone()).collect();
     Ok(Replayed {
         scenario,

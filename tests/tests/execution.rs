@@ -254,6 +254,8 @@ fn a_lone_auv_flies_its_energy_plan_in_the_current() -> TestResult {
     // wide in a turn); with the default 20 m turning radius p95 was 21 m and max 40 m.
     assert!(num(v, "p95_cross_track_m") < 8.0, "{v}");
     assert!(num(v, "max_cross_track_m") < 20.0, "{v}");
+    // Its simulator does not stop at the seabed: the figure says whether it stayed off it.
+    assert!(num(v, "min_seabed_clearance_m") > 0.0, "{v}");
 
     // An obstacle on its path: the energy path is repaired (kept, with a way round the
     // obstacle), not replaced by seed 004's replan, which knows neither the seabed nor R_AUV

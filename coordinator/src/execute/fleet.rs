@@ -10,13 +10,13 @@ use serde::{Deserialize, Serialize};
 use shoal_common::execution::picture::{self, Conflict, Progress};
 use shoal_common::execution::VehicleStatus;
 use shoal_common::geometry::Vec3;
-use shoal_common::scenario::Obstacle;
+use shoal_common::scenario::{Obstacle, Scenario, VehicleKind};
 use shoal_common::separation;
 use shoal_common::stats::quantile;
 use shoal_common::trajectory::Trajectory;
 use shoal_common::wire::open::{FleetStatus, Telemetry, VehicleStatusRow, OPEN_VERSION};
 
-use super::track::{along_plan, obstacle_clearance};
+use super::track::{along_plan, obstacle_clearance, seabed_clearance};
 
 /// How far either side of the mission time a report's nearest plan point is searched,
 /// mission seconds (a path that passes near itself must not make progress jump).
@@ -259,6 +259,32 @@ impl Fleet {
         }
     }
 
+    /// [`Fleet::figures`] against `scenario` (its obstacles, the published ones included, and
+    /// its seabed): what the live run and `replay` both report. The vehicles are the
+    /// scenario's, in its order.
+    pub fn figures_for(
+        &self,
+        scenario: &Scenario,
+        common_arrival_s: f64,
+        window_s: f64,
+    ) -> ExecutionFigures {
+        let mut f = self.figures(common_arrival_s, window_s, &scenario.obstacles);
+        if let Some(seabed) = scenario.terrain() {
+            // A crawler drives on the seabed; an AUV must keep off it.
+            for ((fig, v), s) in f
+                .vehicles
+                .iter_mut()
+                .zip(&self.vehicles)
+                .zip(&scenario.vehicles)
+            {
+                if s.kind == VehicleKind::Auv {
+                    fig.min_seabed_clearance_m = seabed_clearance(&v.track, seabed);
+                }
+            }
+        }
+        f
+    }
+
     /// The figures of the execution so far.
     /// `obstacles`: every obstacle known at the end (the scenario's and the published ones).
     pub fn figures(
@@ -293,6 +319,7 @@ impl Fleet {
                     .is_some_and(|t| (t - common_arrival_s).abs() <= window_s),
                 max_cross_track_m: v.cross_track.iter().copied().fold(0.0, f64::max),
                 min_obstacle_clearance_m: obstacle_clearance(&v.track, obstacles),
+                min_seabed_clearance_m: None,
                 median_cross_track_m: quantile(&v.cross_track, 0.5),
                 p95_cross_track_m: quantile(&v.cross_track, 0.95),
                 revision: v.revision,
@@ -332,6 +359,10 @@ pub struct VehicleFigures {
     /// surface, metres (negative: a collision; below its inflation margin: inside the keep-out
     /// sphere); `None` without hard obstacles or fixes.
     pub min_obstacle_clearance_m: Option<f64>,
+    /// Lowest height of an AUV's executed track above the scenario's seabed, metres (negative:
+    /// through it); absent for a crawler, or without a seabed.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub min_seabed_clearance_m: Option<f64>,
     /// Median cross-track error, metres.
     pub median_cross_track_m: f64,
     /// 95th percentile, metres.
@@ -370,204 +401,5 @@ pub struct ExecutionFigures {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use shoal_common::execution::VehicleState;
-    use shoal_common::scenario::ObstacleKind;
-
-    fn straight(y: f64) -> Trajectory {
-        Trajectory {
-            times: vec![0.0, 100.0],
-            points: vec![Vec3::new(0.0, y, 0.0), Vec3::new(100.0, y, 0.0)],
-        }
-    }
-
-    fn report(vehicle: &str, seq: u64, t: f64, p: [f64; 3], status: VehicleStatus) -> Telemetry {
-        Telemetry {
-            version: OPEN_VERSION,
-            mission: "m".into(),
-            vehicle: vehicle.into(),
-            seq,
-            revision: 0,
-            sent_unix_us: 1_000_000,
-            state: VehicleState {
-                t_s: t,
-                position: p,
-                velocity: [1.0, 0.0, 0.0],
-                heading_deg: 0.0,
-                depth_m: None,
-                altitude_m: None,
-                battery: 1.0,
-                status,
-                arrived_s: (status == VehicleStatus::Arrived).then_some(100.0),
-            },
-        }
-    }
-
-    #[test]
-    fn between_two_fixes_the_track_follows_the_plan_round_its_corners() {
-        // East 100 m then north 100 m at 1 m/s; an obstacle of 10 m inside the corner.
-        let p = |x: f64, y: f64| Vec3::new(x, y, 0.0);
-        let plan = Trajectory {
-            times: vec![0.0, 100.0, 200.0],
-            points: vec![p(0.0, 0.0), p(100.0, 0.0), p(100.0, 100.0)],
-        };
-        let ids = vec!["a".to_string()];
-        let mut f = Fleet::new(&ids, std::slice::from_ref(&plan), 50.0, 60.0);
-        // Fixes 2 m left of the plan at t = 50 and 2 m short of it at t = 150.
-        f.report(
-            report("a", 0, 50.0, [50.0, 2.0, 0.0], VehicleStatus::Underway),
-            1,
-        );
-        f.report(
-            report("a", 1, 150.0, [98.0, 50.0, 0.0], VehicleStatus::Underway),
-            2,
-        );
-        // The corner (100, 0) at plan time 100, halfway: offset (0, 2) + ½ ((−2, 0) − (0, 2)).
-        let track = &f.vehicles[0].track;
-        assert_eq!(track.times, vec![50.0, 100.0, 150.0]);
-        assert!((track.points[1] - p(99.0, 1.0)).norm() < 1e-9, "{track:?}");
-        assert_eq!(f.vehicles[0].fixes, 2);
-        let cage = Obstacle {
-            id: "o".into(),
-            kind: ObstacleKind::Hard,
-            centre: [75.0, 25.0, 0.0],
-            radius_m: 10.0,
-            inflation_m: 1.0,
-        };
-        // Both legs pass the centre at |49·23 + 25| / √2402 = 23.5053 m: 13.5053 m clear. The
-        // chord (50, 2)–(98, 50) would pass 1.414 m from the centre, 8.6 m inside.
-        let fig = f.figures(200.0, 10.0, std::slice::from_ref(&cage));
-        let clearance = fig.vehicles[0].min_obstacle_clearance_m.unwrap_or(f64::NAN);
-        assert!((clearance - 13.505_309_691).abs() < 1e-6, "{clearance}");
-        assert_eq!(fig.vehicles[0].reports, 2);
-        // A fix 10 s later that matches the plan 110 s further on (past the corner) is joined
-        // directly: plan time ran more than twice as fast as mission time.
-        let mut f = Fleet::new(&ids, std::slice::from_ref(&plan), 50.0, 60.0);
-        f.report(
-            report("a", 0, 50.0, [50.0, 2.0, 0.0], VehicleStatus::Underway),
-            1,
-        );
-        f.report(
-            report("a", 1, 60.0, [100.0, 60.0, 0.0], VehicleStatus::Underway),
-            2,
-        );
-        assert_eq!(f.vehicles[0].track.times, vec![50.0, 60.0]);
-        // Nor is one on a new revision of the plan.
-        let mut f = Fleet::new(&ids, std::slice::from_ref(&plan), 50.0, 60.0);
-        f.report(
-            report("a", 0, 50.0, [50.0, 2.0, 0.0], VehicleStatus::Underway),
-            1,
-        );
-        f.vehicles[0].revision = 1;
-        f.report(
-            report("a", 1, 150.0, [98.0, 50.0, 0.0], VehicleStatus::Underway),
-            2,
-        );
-        assert_eq!(f.vehicles[0].track.times, vec![50.0, 150.0]);
-    }
-
-    #[test]
-    fn reports_give_progress_separation_and_figures() {
-        let ids = vec!["a".to_string(), "b".to_string()];
-        let mut f = Fleet::new(&ids, &[straight(0.0), straight(60.0)], 50.0, 60.0);
-        // a is 3 m off its line at x = 50 when the plan has it at x = 50: cross-track 3.
-        assert!(f.report(
-            report("a", 0, 50.0, [50.0, 3.0, 0.0], VehicleStatus::Underway),
-            1_002_000
-        ));
-        assert!(f.report(
-            report("b", 0, 50.0, [50.0, 60.0, 0.0], VehicleStatus::Underway),
-            1_001_000
-        ));
-        // An older report is ignored.
-        assert!(!f.report(
-            report("a", 0, 40.0, [40.0, 0.0, 0.0], VehicleStatus::Underway),
-            1_001_000
-        ));
-        let p = f.vehicles[0]
-            .progress
-            .unwrap_or_else(|| panic!("no progress"));
-        assert!((p.cross_track_m - 3.0).abs() < 1e-9 && (p.fraction - 0.5).abs() < 1e-9);
-        // 57 m apart now (60 − 3).
-        assert!((f.live_min_separation - 57.0).abs() < 1e-9);
-        let s = f.status("m", 50.0);
-        assert!((s.current_min_separation_m.unwrap_or(0.0) - 57.0).abs() < 1e-9);
-        assert_eq!(s.current_pair, Some(["a".to_string(), "b".to_string()]));
-        f.report(
-            report("a", 1, 100.0, [100.0, 0.0, 0.0], VehicleStatus::Arrived),
-            1_004_000,
-        );
-        f.report(
-            report("b", 1, 100.0, [100.0, 60.0, 0.0], VehicleStatus::Arrived),
-            1_003_000,
-        );
-        let wall = Obstacle {
-            id: "o".into(),
-            kind: ObstacleKind::Hard,
-            centre: [50.0, 30.0, 0.0],
-            radius_m: 10.0,
-            inflation_m: 5.0,
-        };
-        let fig = f.figures(100.0, 10.0, &[wall]);
-        // Tracks: a from (50,3) to (100,0), b along y = 60: closest 57 m at t = 50.
-        assert!(
-            (fig.min_separation_m.unwrap_or(0.0) - 57.0).abs() < 1e-9,
-            "{fig:?}"
-        );
-        assert!(fig.all_arrived_in_window);
-        assert_eq!(fig.vehicles[0].arrived_s, Some(100.0));
-        // a's track passes (50, 3): 27 m from the centre, 17 m from the surface.
-        assert!((fig.vehicles[0].min_obstacle_clearance_m.unwrap_or(0.0) - 17.0).abs() < 1e-9);
-        assert!((fig.vehicles[1].min_obstacle_clearance_m.unwrap_or(0.0) - 20.0).abs() < 1e-9);
-        // Latencies 2, 1, 4, 3 ms: median 2.5.
-        assert!((fig.latency_median_ms - 2.5).abs() < 1e-9, "{fig:?}");
-        assert_eq!(fig.reports, 4);
-    }
-
-    #[test]
-    fn a_vehicle_predicted_into_a_lost_one_is_a_conflict() {
-        let ids = vec!["a".to_string(), "b".to_string()];
-        let b_plan = Trajectory {
-            times: vec![0.0, 100.0],
-            points: vec![Vec3::new(100.0, 0.0, 0.0), Vec3::new(100.0, 100.0, 0.0)],
-        };
-        let mut f = Fleet::new(&ids, &[straight(0.0), b_plan], 50.0, 120.0);
-        f.report(
-            report("a", 0, 10.0, [10.0, 0.0, 0.0], VehicleStatus::Underway),
-            1_000_000,
-        );
-        f.report(
-            report("b", 0, 10.0, [100.0, 10.0, 0.0], VehicleStatus::Underway),
-            1_000_000,
-        );
-        // Both on plan: a reaches (100, 0) at t = 100, b is at (100, 100) by then.
-        assert!(f.conflicts(10.0).is_empty());
-        // b is lost where it was last seen: a drives into it.
-        f.vehicles[1].lost = true;
-        let c = f.conflicts(10.0);
-        assert_eq!(c.len(), 1);
-        assert!((c[0].min_distance_m - 10.0).abs() < 1e-6, "{c:?}");
-    }
-
-    #[test]
-    fn a_prediction_starts_from_the_fix_carried_forward_to_now() {
-        let ids = vec!["a".to_string()];
-        let mut f = Fleet::new(&ids, &[straight(0.0)], 50.0, 60.0);
-        // On its plan at x = 40 at t = 40; at t = 65 it is predicted at x = 65, not left at 40.
-        f.report(
-            report("a", 0, 40.0, [40.0, 0.0, 0.0], VehicleStatus::Underway),
-            1_000_000,
-        );
-        let p = &f.predictions_over(65.0, 20.0)[0];
-        assert_eq!(p.times.first(), Some(&65.0));
-        assert!(
-            (p.position_at(65.0) - Vec3::new(65.0, 0.0, 0.0)).norm() < 1e-9,
-            "{p:?}"
-        );
-        assert!(
-            (p.position_at(85.0) - Vec3::new(85.0, 0.0, 0.0)).norm() < 1e-9,
-            "{p:?}"
-        );
-    }
-}
+#[path = "fleet_tests.rs"]
+mod tests;

@@ -306,11 +306,9 @@ pub fn execute_trajectories(
         );
     }
     x.event("mission_end", Vec::new(), ended.clone());
-    let figures = x.fleet.figures(
-        common_arrival_s,
-        options.arrival_window_s,
-        &x.scenario.obstacles,
-    );
+    let figures = x
+        .fleet
+        .figures_for(&x.scenario, common_arrival_s, options.arrival_window_s);
     x.log.write(&Record::End(figures.clone()));
     x.log.flush();
     let report = ExecutionReport {

@@ -3,7 +3,12 @@
 
 use shoal_common::geometry::{segment_point_distance, Vec3};
 use shoal_common::scenario::{Obstacle, ObstacleKind};
+use shoal_common::terrain::Terrain;
 use shoal_common::trajectory::Trajectory;
+
+/// Spacing of the seabed samples along a track, metres: finer than the sensor height or
+/// clearance of any shipped scenario, coarse enough for kilometres of track.
+const SEABED_STEP_M: f64 = 0.5;
 
 /// The executed track between two fixes `(mission time, plan time, offset from the plan)`:
 /// the plan's corners between the two plan times, each shifted by the offset interpolated
@@ -52,4 +57,58 @@ pub(super) fn obstacle_clearance(track: &Trajectory, obstacles: &[Obstacle]) -> 
         best = Some(best.map_or(clearance, |b: f64| b.min(clearance)));
     }
     best
+}
+
+/// Lowest height of `track` above `seabed`, metres (negative: through it), sampled every
+/// [`SEABED_STEP_M`] along each segment; `None` without fixes. An AUV's simulator does not
+/// stop at the seabed, so this is how a run learns that a vehicle would have hit it.
+pub(super) fn seabed_clearance(track: &Trajectory, seabed: &Terrain) -> Option<f64> {
+    let height = |p: &Vec3| p.z - seabed.elevation(p.x, p.y);
+    let mut best = height(track.points.first()?);
+    for w in track.points.windows(2) {
+        let n = ((w[1] - w[0]).norm() / SEABED_STEP_M).ceil().max(1.0) as usize;
+        for k in 1..=n {
+            best = best.min(height(&(w[0] + (w[1] - w[0]) * (k as f64 / n as f64))));
+        }
+    }
+    Some(best)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use shoal_common::terrain::Mountain;
+
+    fn line(z: f64) -> Trajectory {
+        Trajectory {
+            times: vec![0.0, 100.0],
+            points: vec![Vec3::new(0.0, 0.0, z), Vec3::new(100.0, 0.0, z)],
+        }
+    }
+
+    #[test]
+    fn seabed_clearance_finds_the_hill_between_two_fixes() {
+        // One hill of 10 m at x = 50 (spread 10 m); the track's ends are over flat seabed
+        // (10·e⁻²⁵ ≈ 0), so only the samples between them see it.
+        let seabed = Terrain::Hills(vec![Mountain {
+            centre: [50.0, 0.0],
+            height_m: 10.0,
+            spread_m: [10.0, 10.0],
+        }]);
+        let over = seabed_clearance(&line(15.0), &seabed).unwrap_or(f64::NAN);
+        assert!((over - 5.0).abs() < 1e-9, "{over}");
+        let through = seabed_clearance(&line(8.0), &seabed).unwrap_or(f64::NAN);
+        assert!((through + 2.0).abs() < 1e-9, "{through}");
+        // A single fix is its own height; no fix, no figure.
+        let one = Trajectory {
+            times: vec![0.0],
+            points: vec![Vec3::new(50.0, 0.0, 12.5)],
+        };
+        assert!((seabed_clearance(&one, &seabed).unwrap_or(f64::NAN) - 2.5).abs() < 1e-9);
+        let none = Trajectory {
+            times: vec![],
+            points: vec![],
+        };
+        assert_eq!(seabed_clearance(&none, &seabed), None);
+    }
 }
