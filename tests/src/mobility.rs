@@ -30,6 +30,38 @@ fn five() -> f64 {
     5.0
 }
 
+/// `[currents]` as far as the checker reads it: seed 001's depth-decay model (eq. (2)); a
+/// gridded field (`model = "grid"`, a file) is not recomputed.
+#[derive(Debug, Clone, Deserialize)]
+pub struct CurrentsSection {
+    /// `depth-decay` (the default) or `grid`.
+    #[serde(default)]
+    pub model: Option<String>,
+    /// `(u, v)` at the surface, m/s.
+    #[serde(default)]
+    pub surface_velocity_mps: Option<[f64; 2]>,
+}
+
+impl CurrentsSection {
+    /// The current at `p` under seed 001 eq. (2): the surface value scaled by
+    /// `(ζ_bd − ζ) / ζ_bd`, the surface being the top of the box and ζ_bd its height; `None`
+    /// for a gridded field.
+    fn depth_decay(&self, bounds: &crate::model::Bounds, p: [f64; 3]) -> Option<[f64; 3]> {
+        if self.model.as_deref().is_some_and(|m| m != "depth-decay") {
+            return None;
+        }
+        let [u, v] = self.surface_velocity_mps.unwrap_or([0.0, 0.0]);
+        let max_depth = bounds.max[2] - bounds.min[2];
+        let depth = (bounds.max[2] - p[2]).clamp(0.0, max_depth);
+        let s = if max_depth > 0.0 {
+            (max_depth - depth) / max_depth
+        } else {
+            0.0
+        };
+        Some([u * s, v * s, 0.0])
+    }
+}
+
 /// `[inspection]` as far as the checker reads it.
 #[derive(Debug, Clone, Deserialize)]
 pub struct InspectionSection {
@@ -52,6 +84,9 @@ pub struct PlanEnergy {
     pub q_a: f64,
     /// Reported tightest turn.
     pub min_turn_radius_m: f64,
+    /// Reported fastest speed through the water, m/s.
+    #[serde(default)]
+    pub max_water_speed_mps: Option<f64>,
 }
 
 /// `vehicles[].tour` of `plan.json`.
@@ -162,6 +197,37 @@ pub fn check_energy(scenario: &Scenario, v: &Vehicle, traj: &[[f64; 4]], e: &Pla
         f.broken.push(format!(
             "{id} turns on a {tightest:.3} m radius, below R_AUV = {r_min} m"
         ));
+    }
+    // Speed through the water on each timed segment: ground velocity minus the current at the
+    // segment's midpoint (seed 001 eq. (3)), against the vehicle's top speed.
+    if let Some(currents) = &scenario.currents {
+        let mut fastest: Option<f64> = None;
+        for w in traj.windows(2) {
+            let dt = w[1][0] - w[0][0];
+            if dt <= 0.0 {
+                continue;
+            }
+            let mid = [1, 2, 3].map(|k| 0.5 * (w[0][k] + w[1][k]));
+            let Some(c) = currents.depth_decay(&scenario.bounds, mid) else {
+                fastest = None;
+                break;
+            };
+            let water = [1, 2, 3].map(|k| (w[1][k] - w[0][k]) / dt - c[k - 1]);
+            fastest = Some(fastest.unwrap_or(0.0).max(norm(water)));
+        }
+        if let Some(fastest) = fastest {
+            if let Some(reported) = e.max_water_speed_mps.filter(|r| differs(*r, fastest)) {
+                f.mismatches.push(format!(
+                    "{id}.energy.max_water_speed_mps: reported {reported} but recomputed {fastest}"
+                ));
+            }
+            if fastest > v.speed_max_mps + TOL {
+                f.broken.push(format!(
+                    "{id} needs {fastest:.3} m/s through the water, over its top speed of {} m/s",
+                    v.speed_max_mps
+                ));
+            }
+        }
     }
     // Seabed of Gaussian hills alone (seed 001 eq. (1)); other seabeds are the crawler check's.
     if let Some(seabed) = scenario.seabed.as_ref().filter(|s| s.relief.is_none()) {

@@ -33,6 +33,9 @@ pub struct Scenario {
     /// Inspection tours (seed 003).
     #[serde(default)]
     pub inspection: Option<crate::mobility::InspectionSection>,
+    /// Ocean current (seed 001).
+    #[serde(default)]
+    pub currents: Option<crate::mobility::CurrentsSection>,
 }
 
 /// Axis-aligned box, metres.

@@ -84,6 +84,33 @@ fn a_plan_that_needs_more_than_the_top_speed_through_the_water_is_infeasible() -
             && violations.contains("vehicles[0].speed_max_mps"),
         "{violations}"
     );
+    // The independent checker recomputes the water speed from the trajectory and eq. (2): it
+    // agrees with the verdict, refuses the same plan claimed feasible ...
+    let text = std::fs::read_to_string(&file)?;
+    let report = shoal_tests::check(&text, &json.to_string())?;
+    assert!(report.is_clean(), "{report:?}");
+    let mut claimed = json.clone();
+    claimed["feasible"] = Value::from(true);
+    claimed["violations"] = serde_json::json!([]);
+    let report = shoal_tests::check(&text, &claimed.to_string())?;
+    assert!(
+        report
+            .failures
+            .iter()
+            .any(|f| f.contains("through the water")),
+        "{report:?}"
+    );
+    // ... and a reported water speed that is not the trajectory's.
+    let mut lied = json.clone();
+    lied["vehicles"][0]["energy"]["max_water_speed_mps"] = Value::from(1.2);
+    let report = shoal_tests::check(&text, &lied.to_string())?;
+    assert!(
+        report
+            .mismatches
+            .iter()
+            .any(|m| m.contains("max_water_speed_mps")),
+        "{report:?}"
+    );
     // The shipped vehicle (3 m/s through the water) flies the same plan.
     let dir = tempfile::tempdir()?;
     let json = plan_and_check("epa-pso", dir.path(), &["--iterations", "10"])?;
