@@ -273,8 +273,8 @@ pub fn run_command(args: &RunArgs, shutdown: Arc<AtomicBool>) -> anyhow::Result<
 }
 
 /// Why the execution falls short, in plain words: d_min broken, an executed track inside a hard
-/// obstacle (its physical sphere: the inflation is the planner's margin) or an AUV's through
-/// the seabed, a vehicle that did not arrive in the window. Empty when it met all of them.
+/// obstacle (its physical sphere: the inflation is the planner's margin), an AUV's through
+/// the seabed or a crawler's into a hazard, a vehicle that did not arrive in the window. Empty when it met all of them.
 pub fn execution_failures(r: &ExecutionReport) -> Vec<String> {
     let f = &r.figures;
     let mut out = Vec::new();
@@ -288,6 +288,12 @@ pub fn execution_failures(r: &ExecutionReport) -> Vec<String> {
         if let Some(c) = v.min_obstacle_clearance_m.filter(|c| *c <= 0.0) {
             out.push(format!(
                 "{}'s track entered a hard obstacle ({:.1} m inside its surface)",
+                v.vehicle, -c
+            ));
+        }
+        if let Some(c) = v.min_hazard_clearance_m.filter(|c| *c < 0.0) {
+            out.push(format!(
+                "{}'s track entered a soft-substrate hazard ({:.1} m inside it)",
                 v.vehicle, -c
             ));
         }
@@ -318,7 +324,7 @@ pub fn execution_summary(r: &ExecutionReport) -> String {
     let mut s = format!("Execution: {}\n", r.ended);
     for v in &f.vehicles {
         s.push_str(&format!(
-            "  {:<8} arrived {:>8} {} | cross-track median {:.2} m, p95 {:.2} m, max {:.2} m | obstacle clearance {}{} | {} reports, revision {}{}\n",
+            "  {:<8} arrived {:>8} {} | cross-track median {:.2} m, p95 {:.2} m, max {:.2} m | obstacle clearance {}{}{} | {} reports, revision {}{}\n",
             v.vehicle,
             v.arrived_s.map_or("never".to_string(), |t| format!("{t:.0} s")),
             if v.in_window { "(in window)" } else { "(OUT of window)" },
@@ -329,6 +335,8 @@ pub fn execution_summary(r: &ExecutionReport) -> String {
                 .map_or("–".to_string(), |c| format!("{c:.1} m")),
             v.min_seabed_clearance_m
                 .map_or(String::new(), |c| format!(", above the seabed {c:.1} m")),
+            v.min_hazard_clearance_m
+                .map_or(String::new(), |c| format!(", hazard clearance {c:.1} m")),
             v.reports,
             v.revision,
             if v.lost { ", LOST" } else { "" }
@@ -360,7 +368,7 @@ pub fn execution_summary(r: &ExecutionReport) -> String {
     let failures = execution_failures(r);
     if failures.is_empty() {
         s.push_str(
-            "  MET: d_min kept, no hard obstacle (or seabed) entered, every vehicle in the window\n",
+            "  MET: d_min kept, no hard obstacle, seabed or hazard entered, every vehicle in the window\n",
         );
     } else {
         s.push_str(&format!("  NOT MET: {}\n", failures.join("; ")));

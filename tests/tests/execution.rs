@@ -311,6 +311,30 @@ fn a_lone_auv_flies_its_energy_plan_in_the_current() -> TestResult {
 }
 
 #[test]
+fn crawlers_report_hazard_clearance_and_the_auv_its_height_above_the_seabed() -> TestResult {
+    // Two crawlers and an AUV on one seabed: each kind gets the figure that concerns it.
+    let mut fleet = Fleet::new();
+    let out = fleet.dir().join("out");
+    let cmd = run_scenario("seabed-fleet", &["--iterations", "40"], &out, "50", &[]);
+    let c = fleet.spawn("coordinator", cmd);
+    let r = fleet.wait(c, Instant::now() + LIMIT);
+    assert_eq!(r.code(), Some(0), "{}\n{}", r.stdout, r.stderr);
+    let report = execution_report(&out)?;
+    let vehicles = &report["figures"]["vehicles"];
+    for k in 0..2 {
+        let v = &vehicles[k];
+        assert!(num(v, "min_hazard_clearance_m") > 0.0, "{v}");
+        assert_eq!(v["min_seabed_clearance_m"], Value::Null, "{v}");
+    }
+    let auv = &vehicles[2];
+    assert_eq!(auv["vehicle"], "auv1");
+    assert!(num(auv, "min_seabed_clearance_m") > 0.0, "{auv}");
+    assert_eq!(auv["min_hazard_clearance_m"], Value::Null, "{auv}");
+    fleet.passed();
+    Ok(())
+}
+
+#[test]
 fn a_vehicle_with_no_safe_replan_is_told_to_hold() -> TestResult {
     let mut fleet = Fleet::new();
     let out = fleet.dir().join("out");

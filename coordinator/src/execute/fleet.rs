@@ -16,7 +16,7 @@ use shoal_common::stats::quantile;
 use shoal_common::trajectory::Trajectory;
 use shoal_common::wire::open::{FleetStatus, Telemetry, VehicleStatusRow, OPEN_VERSION};
 
-use super::track::{along_plan, obstacle_clearance, seabed_clearance};
+use super::track::{along_plan, hazard_clearance, obstacle_clearance, seabed_clearance};
 
 /// How far either side of the mission time a report's nearest plan point is searched,
 /// mission seconds (a path that passes near itself must not make progress jump).
@@ -259,8 +259,8 @@ impl Fleet {
         }
     }
 
-    /// [`Fleet::figures`] against `scenario` (its obstacles, the published ones included, and
-    /// its seabed): what the live run and `replay` both report. The vehicles are the
+    /// [`Fleet::figures`] against `scenario` (its obstacles, the published ones included, its
+    /// seabed and its hazards): what the live run and `replay` both report. The vehicles are the
     /// scenario's, in its order.
     pub fn figures_for(
         &self,
@@ -269,16 +269,21 @@ impl Fleet {
         window_s: f64,
     ) -> ExecutionFigures {
         let mut f = self.figures(common_arrival_s, window_s, &scenario.obstacles);
-        if let Some(seabed) = scenario.terrain() {
-            // A crawler drives on the seabed; an AUV must keep off it.
-            for ((fig, v), s) in f
-                .vehicles
-                .iter_mut()
-                .zip(&self.vehicles)
-                .zip(&scenario.vehicles)
-            {
-                if s.kind == VehicleKind::Auv {
-                    fig.min_seabed_clearance_m = seabed_clearance(&v.track, seabed);
+        let seabed = scenario.terrain();
+        for ((fig, v), s) in f
+            .vehicles
+            .iter_mut()
+            .zip(&self.vehicles)
+            .zip(&scenario.vehicles)
+        {
+            match s.kind {
+                // An AUV must keep off the seabed ...
+                VehicleKind::Auv => {
+                    fig.min_seabed_clearance_m = seabed.and_then(|t| seabed_clearance(&v.track, t));
+                }
+                // ... a crawler drives on it, and must keep out of the soft-substrate hazards.
+                VehicleKind::Crawler => {
+                    fig.min_hazard_clearance_m = hazard_clearance(&v.track, &scenario.hazards);
                 }
             }
         }
@@ -320,6 +325,7 @@ impl Fleet {
                 max_cross_track_m: v.cross_track.iter().copied().fold(0.0, f64::max),
                 min_obstacle_clearance_m: obstacle_clearance(&v.track, obstacles),
                 min_seabed_clearance_m: None,
+                min_hazard_clearance_m: None,
                 median_cross_track_m: quantile(&v.cross_track, 0.5),
                 p95_cross_track_m: quantile(&v.cross_track, 0.95),
                 revision: v.revision,
@@ -363,6 +369,10 @@ pub struct VehicleFigures {
     /// through it); absent for a crawler, or without a seabed.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub min_seabed_clearance_m: Option<f64>,
+    /// Closest a crawler's executed track came to a soft-substrate hazard (seed 000 eq. (4)),
+    /// horizontally, metres (negative: inside it); absent for an AUV, or without hazards.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub min_hazard_clearance_m: Option<f64>,
     /// Median cross-track error, metres.
     pub median_cross_track_m: f64,
     /// 95th percentile, metres.

@@ -3,7 +3,7 @@
 
 use shoal_common::geometry::{segment_point_distance, Vec3};
 use shoal_common::scenario::{Obstacle, ObstacleKind};
-use shoal_common::terrain::Terrain;
+use shoal_common::terrain::{path_min_hazard_clearance, Hazard, Terrain};
 use shoal_common::trajectory::Trajectory;
 
 /// Spacing of the seabed samples along a track, metres: finer than the sensor height or
@@ -74,6 +74,16 @@ pub(super) fn seabed_clearance(track: &Trajectory, seabed: &Terrain) -> Option<f
     Some(best)
 }
 
+/// Closest `track` came to any of `hazards` horizontally, metres (negative: inside one); `None`
+/// without hazards or fixes.
+pub(super) fn hazard_clearance(track: &Trajectory, hazards: &[Hazard]) -> Option<f64> {
+    if hazards.is_empty() || track.points.is_empty() {
+        return None;
+    }
+    let xy: Vec<[f64; 2]> = track.points.iter().map(|p| [p.x, p.y]).collect();
+    Some(path_min_hazard_clearance(hazards, &xy))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -110,5 +120,25 @@ mod tests {
             points: vec![],
         };
         assert_eq!(seabed_clearance(&none, &seabed), None);
+    }
+
+    #[test]
+    fn hazard_clearance_is_horizontal_and_signed() {
+        // A 10 m hazard centred 15 m off the track's line: 5 m clear; centred 4 m off it, the
+        // track is 6 m inside. The track's height does not matter (a cylinder).
+        let hazard = |y: f64| Hazard {
+            id: "h".into(),
+            centre: [50.0, y],
+            radius_m: 10.0,
+            height_m: 3.0,
+        };
+        let clear = hazard_clearance(&line(40.0), &[hazard(15.0)]).unwrap_or(f64::NAN);
+        assert!((clear - 5.0).abs() < 1e-9, "{clear}");
+        let inside = hazard_clearance(&line(0.0), &[hazard(15.0), hazard(-4.0)]);
+        assert!(
+            (inside.unwrap_or(f64::NAN) + 6.0).abs() < 1e-9,
+            "{inside:?}"
+        );
+        assert_eq!(hazard_clearance(&line(0.0), &[]), None);
     }
 }
