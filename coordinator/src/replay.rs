@@ -1,6 +1,7 @@
 //! `shoal-coordinator replay LOG`: reads a mission log back, recomputes the execution's figures
 //! from its records alone (the same [`Fleet`] the live run used), lists the decisions, and
-//! draws the planned and executed tracks (`<LOG>.svg`: top view).
+//! draws the planned and executed tracks (`<LOG>.svg`: top view, over the seabed and its hazards
+//! when the scenario has them). Its verdict and exit status are `run`'s.
 
 use std::path::{Path, PathBuf};
 
@@ -14,6 +15,7 @@ use shoal_common::wire::open::MissionEvent;
 
 use crate::execute::fleet::{ExecutionFigures, Fleet};
 use crate::execute::log::{self, Record};
+use crate::execute::verdict;
 use crate::svg::fail;
 
 /// `shoal-coordinator replay`.
@@ -146,14 +148,9 @@ pub fn command(args: &ReplayArgs) -> anyhow::Result<i32> {
         f.latency_p99_ms
     ));
     for v in &f.vehicles {
-        out.push_str(&format!(
-            "  {:<8} arrived {:>8}  cross-track median {:.2} m, max {:.2} m\n",
-            v.vehicle,
-            v.arrived_s.map_or("never".into(), |t| format!("{t:.0} s")),
-            v.median_cross_track_m,
-            v.max_cross_track_m
-        ));
+        out.push_str(&verdict::vehicle_line(v));
     }
+    out.push_str(&verdict::verdict_line(f));
     match &r.logged {
         Some(l) if l == f => out.push_str("the figures match the log's end record\n"),
         Some(_) => {
@@ -170,7 +167,12 @@ pub fn command(args: &ReplayArgs) -> anyhow::Result<i32> {
         .with_context(|| format!("cannot write {}", svg_path.display()))?;
     out.push_str(&format!("Wrote {}\n", svg_path.display()));
     crate::say(&out);
-    Ok(crate::EXIT_FEASIBLE)
+    // As `run`: 0 when the execution met its figures, 3 when it did not.
+    Ok(if verdict::failures(f).is_empty() {
+        crate::EXIT_FEASIBLE
+    } else {
+        crate::EXIT_VIOLATIONS
+    })
 }
 
 /// Top view: obstacles (filled: radius; ring: inflated), planned paths dashed, executed tracks
@@ -206,6 +208,12 @@ pub fn render(r: &Replayed) -> anyhow::Result<String> {
             .build_cartesian_2d(b.min[0]..b.max[0], b.min[1]..b.max[1])
             .map_err(fail("axes"))?;
         chart.configure_mesh().draw().map_err(fail("mesh"))?;
+        // Crawler and seabed scenarios: the shaded seabed and its hazards under the tracks.
+        crate::svg_terrain::draw_seabed(
+            &mut chart,
+            &r.scenario,
+            (b.min[0], b.max[0], b.min[1], b.max[1]),
+        )?;
         let circle = |o: &Obstacle, r: f64| -> Vec<(f64, f64)> {
             (0..=72)
                 .map(|k| {
@@ -274,12 +282,16 @@ mod tests {
     }
 
     fn report(seq: u64, revision: u32, t_s: f64, position: [f64; 3]) -> Record {
+        report_of("auv1", seq, revision, t_s, position)
+    }
+
+    fn report_of(vehicle: &str, seq: u64, revision: u32, t_s: f64, position: [f64; 3]) -> Record {
         Record::Telemetry {
             received_unix_us: 1_000_000 + seq,
             telemetry: Telemetry {
                 version: 1,
                 mission: "m".into(),
-                vehicle: "auv1".into(),
+                vehicle: vehicle.into(),
                 seq,
                 revision,
                 sent_unix_us: 1_000_000,
@@ -363,6 +375,66 @@ mod tests {
         // Reports 1 and 3 count (1 m and 3 m off); report 2, while holding, does not.
         assert!((v.max_cross_track_m - 3.0).abs() < 1e-6, "{v:?}");
         assert!((v.median_cross_track_m - 2.0).abs() < 1e-6, "{v:?}");
+        Ok(())
+    }
+
+    /// A crawler whose fixes cross the soft-substrate hazard `soft1` of `seabed-fleet` (centre
+    /// (120, 140), radius 12 m; the fixes run through its centre, so 12 m inside): the replay
+    /// names it, exits 3 as `run` would, and draws the hazard under the tracks.
+    #[test]
+    fn a_replayed_crawler_track_into_a_hazard_is_not_met() -> anyhow::Result<()> {
+        let dir = std::env::temp_dir().join(format!("shoal-replay-hazard-{}", std::process::id()));
+        std::fs::create_dir_all(&dir)?;
+        let path = dir.join("m.ndjson");
+        let line =
+            |a: [f64; 2], b: [f64; 2], z: f64| vec![[0.0, a[0], a[1], z], [420.0, b[0], b[1], z]];
+        let mut w = LogWriter::create(&path)?;
+        for r in [
+            Record::Start(Start {
+                mission: "m".into(),
+                scenario_toml: include_str!("../../scenarios/seabed-fleet.toml").into(),
+                common_arrival_s: 420.0,
+                arrival_window_s: 30.0,
+                horizon_s: 180.0,
+                time_scale: 50.0,
+                epoch_unix_ms: 0,
+            }),
+            plan(
+                0,
+                &["crawler1", "crawler2", "auv1"],
+                &[
+                    ("crawler1", line([10.0, 150.0], [290.0, 150.0], 0.0)),
+                    ("crawler2", line([150.0, 10.0], [150.0, 290.0], 0.0)),
+                    ("auv1", line([10.0, 10.0], [290.0, 290.0], 40.0)),
+                ],
+            ),
+            report_of("crawler1", 1, 0, 10.0, [10.0, 150.0, 0.0]),
+            report_of("crawler1", 2, 0, 120.0, [120.0, 140.0, 0.0]),
+        ] {
+            w.write(&r);
+        }
+        w.flush();
+        let r = replay(&path)?;
+        let c = &r.figures.vehicles[0];
+        assert_eq!(c.vehicle, "crawler1");
+        let clearance = c.min_hazard_clearance_m.unwrap_or(f64::NAN);
+        assert!((clearance + 12.0).abs() < 1e-6, "{c:?}");
+        assert!(
+            verdict::failures(&r.figures)
+                .iter()
+                .any(|f| f == "crawler1's track entered a soft-substrate hazard (12.0 m inside it)"),
+            "{:?}",
+            verdict::failures(&r.figures)
+        );
+        let svg = dir.join("m.svg");
+        let code = command(&ReplayArgs {
+            log: path,
+            svg: Some(svg.clone()),
+        })?;
+        assert_eq!(code, crate::EXIT_VIOLATIONS);
+        let drawn = std::fs::read_to_string(&svg)?;
+        std::fs::remove_dir_all(&dir)?;
+        assert!(drawn.contains("soft1"), "the hazard is not drawn");
         Ok(())
     }
 }

@@ -11,7 +11,7 @@ use anyhow::{bail, Context as _};
 use shoal_common::scenario::{Obstacle, ObstacleKind};
 
 use crate::cli::PlanArgs;
-use crate::execute::{self, ExecOptions, ExecutionReport};
+use crate::execute::{self, verdict, ExecOptions, ExecutionReport};
 use crate::{distributed, planner, say, summary, write_outputs, write_svg, Progress};
 use crate::{EXIT_FEASIBLE, EXIT_VIOLATIONS};
 
@@ -272,50 +272,9 @@ pub fn run_command(args: &RunArgs, shutdown: Arc<AtomicBool>) -> anyhow::Result<
     })
 }
 
-/// Why the execution falls short, in plain words: d_min broken, an executed track inside a hard
-/// obstacle (its physical sphere: the inflation is the planner's margin), an AUV's through
-/// the seabed or a crawler's into a hazard, a vehicle that did not arrive in the window. Empty when it met all of them.
-pub fn execution_failures(r: &ExecutionReport) -> Vec<String> {
-    let f = &r.figures;
-    let mut out = Vec::new();
-    if let Some(d) = f.min_separation_m.filter(|d| *d < f.d_min_m) {
-        out.push(format!(
-            "separation fell to {d:.1} m, under d_min {:.0} m",
-            f.d_min_m
-        ));
-    }
-    for v in &f.vehicles {
-        if let Some(c) = v.min_obstacle_clearance_m.filter(|c| *c <= 0.0) {
-            out.push(format!(
-                "{}'s track entered a hard obstacle ({:.1} m inside its surface)",
-                v.vehicle, -c
-            ));
-        }
-        if let Some(c) = v.min_hazard_clearance_m.filter(|c| *c < 0.0) {
-            out.push(format!(
-                "{}'s track entered a soft-substrate hazard ({:.1} m inside it)",
-                v.vehicle, -c
-            ));
-        }
-        if let Some(c) = v.min_seabed_clearance_m.filter(|c| *c < 0.0) {
-            out.push(format!(
-                "{}'s track went {:.1} m into the seabed",
-                v.vehicle, -c
-            ));
-        }
-        if !v.in_window {
-            out.push(match v.arrived_s {
-                Some(t) => format!("{} arrived at {t:.0} s, outside the window", v.vehicle),
-                None => format!("{} never arrived", v.vehicle),
-            });
-        }
-    }
-    out
-}
-
-/// Whether the execution met everything [`execution_failures`] checks.
+/// Whether the execution met everything [`verdict::failures`] checks.
 pub fn execution_ok(r: &ExecutionReport) -> bool {
-    execution_failures(r).is_empty()
+    verdict::failures(&r.figures).is_empty()
 }
 
 /// The human summary of an execution.
@@ -323,24 +282,7 @@ pub fn execution_summary(r: &ExecutionReport) -> String {
     let f = &r.figures;
     let mut s = format!("Execution: {}\n", r.ended);
     for v in &f.vehicles {
-        s.push_str(&format!(
-            "  {:<8} arrived {:>8} {} | cross-track median {:.2} m, p95 {:.2} m, max {:.2} m | obstacle clearance {}{}{} | {} reports, revision {}{}\n",
-            v.vehicle,
-            v.arrived_s.map_or("never".to_string(), |t| format!("{t:.0} s")),
-            if v.in_window { "(in window)" } else { "(OUT of window)" },
-            v.median_cross_track_m,
-            v.p95_cross_track_m,
-            v.max_cross_track_m,
-            v.min_obstacle_clearance_m
-                .map_or("–".to_string(), |c| format!("{c:.1} m")),
-            v.min_seabed_clearance_m
-                .map_or(String::new(), |c| format!(", above the seabed {c:.1} m")),
-            v.min_hazard_clearance_m
-                .map_or(String::new(), |c| format!(", hazard clearance {c:.1} m")),
-            v.reports,
-            v.revision,
-            if v.lost { ", LOST" } else { "" }
-        ));
+        s.push_str(&verdict::vehicle_line(v));
     }
     s.push_str(&format!(
         "  fleet: min separation {} (d_min {:.0} m){}, arrival window {:.0} ± {:.0} s, {} replans, {} holds\n",
@@ -365,14 +307,7 @@ pub fn execution_summary(r: &ExecutionReport) -> String {
             ms_list(&r.update_delivery_ms)
         ));
     }
-    let failures = execution_failures(r);
-    if failures.is_empty() {
-        s.push_str(
-            "  MET: d_min kept, no hard obstacle, seabed or hazard entered, every vehicle in the window\n",
-        );
-    } else {
-        s.push_str(&format!("  NOT MET: {}\n", failures.join("; ")));
-    }
+    s.push_str(&verdict::verdict_line(f));
     s
 }
 

@@ -166,6 +166,7 @@ fn a_fleet_executes_its_plan_replans_around_a_new_obstacle_and_replays() -> Test
         "{}",
         rp.stdout
     );
+    assert!(rp.stdout.contains("  MET: "), "{}", rp.stdout);
     let svg = std::fs::read_to_string(out.join("mission.svg"))?;
     assert!(
         svg.contains("auv2") && svg.contains("executed"),

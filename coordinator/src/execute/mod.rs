@@ -13,6 +13,7 @@ mod react;
 mod repair;
 pub mod replan;
 mod track;
+pub mod verdict;
 
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};

@@ -1,0 +1,165 @@
+//! Whether an execution met its figures, in plain words: one place for the live run's summary
+//! (`run`) and for `replay`, so the two say the same of the same figures.
+
+use super::fleet::{ExecutionFigures, VehicleFigures};
+
+/// Why the execution falls short: d_min broken, an executed track inside a hard obstacle (its
+/// physical sphere: the inflation is the planner's margin), an AUV's through the seabed or a
+/// crawler's into a soft-substrate hazard, a vehicle that did not arrive in the window. Empty
+/// when it met all of them.
+pub fn failures(f: &ExecutionFigures) -> Vec<String> {
+    let mut out = Vec::new();
+    if let Some(d) = f.min_separation_m.filter(|d| *d < f.d_min_m) {
+        out.push(format!(
+            "separation fell to {d:.1} m, under d_min {:.0} m",
+            f.d_min_m
+        ));
+    }
+    for v in &f.vehicles {
+        if let Some(c) = v.min_obstacle_clearance_m.filter(|c| *c <= 0.0) {
+            out.push(format!(
+                "{}'s track entered a hard obstacle ({:.1} m inside its surface)",
+                v.vehicle,
+                0.0 - c
+            ));
+        }
+        if let Some(c) = v.min_hazard_clearance_m.filter(|c| *c < 0.0) {
+            out.push(format!(
+                "{}'s track entered a soft-substrate hazard ({:.1} m inside it)",
+                v.vehicle, -c
+            ));
+        }
+        if let Some(c) = v.min_seabed_clearance_m.filter(|c| *c < 0.0) {
+            out.push(format!(
+                "{}'s track went {:.1} m into the seabed",
+                v.vehicle, -c
+            ));
+        }
+        if !v.in_window {
+            out.push(match v.arrived_s {
+                Some(t) => format!("{} arrived at {t:.0} s, outside the window", v.vehicle),
+                None => format!("{} never arrived", v.vehicle),
+            });
+        }
+    }
+    out
+}
+
+/// The verdict line: `  MET: …` or `  NOT MET: <every failure>`.
+pub fn verdict_line(f: &ExecutionFigures) -> String {
+    let failures = failures(f);
+    if failures.is_empty() {
+        "  MET: d_min kept, no hard obstacle, seabed or hazard entered, every vehicle in the window\n"
+            .to_string()
+    } else {
+        format!("  NOT MET: {}\n", failures.join("; "))
+    }
+}
+
+/// One vehicle's line of a summary: arrival, tracking error, clearances, reports.
+pub fn vehicle_line(v: &VehicleFigures) -> String {
+    format!(
+        "  {:<8} arrived {:>8} {} | cross-track median {:.2} m, p95 {:.2} m, max {:.2} m | obstacle clearance {}{}{} | {} reports, revision {}{}\n",
+        v.vehicle,
+        v.arrived_s.map_or("never".to_string(), |t| format!("{t:.0} s")),
+        if v.in_window { "(in window)" } else { "(OUT of window)" },
+        v.median_cross_track_m,
+        v.p95_cross_track_m,
+        v.max_cross_track_m,
+        v.min_obstacle_clearance_m
+            .map_or("–".to_string(), |c| format!("{c:.1} m")),
+        v.min_seabed_clearance_m
+            .map_or(String::new(), |c| format!(", above the seabed {c:.1} m")),
+        v.min_hazard_clearance_m
+            .map_or(String::new(), |c| format!(", hazard clearance {c:.1} m")),
+        v.reports,
+        v.revision,
+        if v.lost { ", LOST" } else { "" }
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn vehicle(id: &str) -> VehicleFigures {
+        VehicleFigures {
+            vehicle: id.to_string(),
+            reports: 10,
+            arrived_s: Some(420.0),
+            in_window: true,
+            max_cross_track_m: 2.0,
+            p95_cross_track_m: 1.5,
+            min_obstacle_clearance_m: None,
+            min_seabed_clearance_m: None,
+            min_hazard_clearance_m: None,
+            median_cross_track_m: 1.0,
+            revision: 0,
+            lost: false,
+        }
+    }
+
+    fn figures(vehicles: Vec<VehicleFigures>) -> ExecutionFigures {
+        ExecutionFigures {
+            d_min_m: 10.0,
+            min_separation_m: Some(15.0),
+            min_separation_at_s: Some(200.0),
+            min_separation_pair: None,
+            common_arrival_s: 420.0,
+            arrival_window_s: 30.0,
+            all_arrived_in_window: true,
+            vehicles,
+            reports: 20,
+            latency_median_ms: 0.2,
+            latency_p99_ms: 0.4,
+        }
+    }
+
+    #[test]
+    fn a_clean_execution_is_met() {
+        let f = figures(vec![vehicle("auv1"), vehicle("crawler1")]);
+        assert!(failures(&f).is_empty());
+        assert!(verdict_line(&f).starts_with("  MET: "));
+    }
+
+    #[test]
+    fn every_shortfall_is_named() {
+        let mut a = vehicle("auv1");
+        a.min_seabed_clearance_m = Some(-2.0);
+        a.min_obstacle_clearance_m = Some(0.0);
+        let mut c = vehicle("crawler1");
+        c.min_hazard_clearance_m = Some(-6.0);
+        c.in_window = false;
+        c.arrived_s = None;
+        let mut f = figures(vec![a, c]);
+        f.min_separation_m = Some(8.25);
+        let got = failures(&f);
+        assert_eq!(
+            got,
+            vec![
+                "separation fell to 8.2 m, under d_min 10 m",
+                "auv1's track entered a hard obstacle (0.0 m inside its surface)",
+                "auv1's track went 2.0 m into the seabed",
+                "crawler1's track entered a soft-substrate hazard (6.0 m inside it)",
+                "crawler1 never arrived",
+            ]
+        );
+        assert!(verdict_line(&f).starts_with("  NOT MET: separation fell"));
+    }
+
+    #[test]
+    fn a_vehicle_line_shows_only_the_clearances_it_has() {
+        let mut c = vehicle("crawler1");
+        c.min_hazard_clearance_m = Some(10.14);
+        let line = vehicle_line(&c);
+        assert!(line.contains("hazard clearance 10.1 m"), "{line}");
+        assert!(line.contains("obstacle clearance –"), "{line}");
+        assert!(!line.contains("seabed"), "{line}");
+        let mut a = vehicle("auv1");
+        a.min_seabed_clearance_m = Some(37.46);
+        a.lost = true;
+        let line = vehicle_line(&a);
+        assert!(line.contains("above the seabed 37.5 m"), "{line}");
+        assert!(line.ends_with(", LOST\n"), "{line}");
+    }
+}
