@@ -21,6 +21,7 @@ use crate::crawler::{CrawlerModel, CrawlerTerms};
 use crate::geometry::{chord_inside_sphere, pitch, Vec3, CONTACT_GUARD_M, MIN_HEADING_EXTENT};
 use crate::scenario::{Scenario, Vehicle};
 use crate::separation::{motion_separation, Motion};
+use crate::terrain::Terrain;
 use crate::trajectory::{common_arrival, retime_legs, Layout, Path, Trajectory};
 
 /// A sphere the cost functions test against: centre and radius already inflated.
@@ -160,6 +161,29 @@ pub fn hard_penalty(points: &[Vec3], hard: &[Sphere]) -> (f64, usize) {
     (t.hard_penalty, t.hard_hits)
 }
 
+/// Sample spacing of the seabed check along a swimmer's leg, metres (the cost's and the plan
+/// check's: a plan the swarm found clear is checked at the same points). Hills of Shoal's
+/// scenarios spread over 15 m or more; between samples 1 m apart such a hill's summit can rise
+/// less than a centimetre above the nearer sample.
+pub const SEABED_STEP_M: f64 = 1.0;
+
+/// Seabed penalty of a swimmer (an AUV over a seabed; seed 004 has none, so Shoal adds it as a
+/// hard constraint like the obstacles): for every leg whose lowest height above the seabed
+/// ([`Terrain::lowest_height_along`], every [`SEABED_STEP_M`]) is under `clearance`,
+/// `1 + shortfall / max(clearance, 1 m)`. Returns the penalty and the number of such legs.
+pub fn seabed_penalty(points: &[Vec3], terrain: &Terrain, clearance: f64) -> (f64, usize) {
+    let mut penalty = 0.0;
+    let mut legs = 0;
+    for w in points.windows(2) {
+        let (height, _) = terrain.lowest_height_along(&w[0], &w[1], SEABED_STEP_M);
+        if height < clearance {
+            penalty += 1.0 + (clearance - height) / clearance.max(1.0);
+            legs += 1;
+        }
+    }
+    (penalty, legs)
+}
+
 /// Turn penalty: for every heading change (see [`crate::geometry::turns`]) that exceeds `max_turn` (radians),
 /// `1 + excess / max_turn`. The cosine is compared first so only violations pay for `atan2`.
 pub fn turn_penalty(points: &[Vec3], max_turn: f64) -> f64 {
@@ -255,7 +279,8 @@ pub struct VehicleTerms {
     pub time: f64,
     /// F_i(S).
     pub space: f64,
-    /// Hard-obstacle penalty (see [`hard_penalty`]).
+    /// Hard-obstacle penalty (see [`hard_penalty`]), plus a swimmer's [`seabed_penalty`]
+    /// (a crawler's: its hazard penalty).
     pub hard: f64,
     /// Turn plus pitch penalty.
     pub motion: f64,
@@ -385,6 +410,9 @@ impl FleetModel {
         let surface = s.bounds.max[2];
         let column = s.bounds.max[2] - s.bounds.min[2];
         let spheres = sphere_terms(&path.points, &self.hard, &self.soft);
+        let seabed = s
+            .swimmer_seabed()
+            .map_or(0.0, |(t, c)| seabed_penalty(&path.points, t, c).0);
         VehicleTerms {
             length: length_term(length, self.straight[i]),
             depth: depth_term(&path.points, surface, column),
@@ -392,7 +420,7 @@ impl FleetModel {
             time: time_term(length, v, s.fleet.mission_time_s),
             space: 0.0,
             separation: 0.0,
-            hard: spheres.hard_penalty,
+            hard: spheres.hard_penalty + seabed,
             motion: turn_penalty(&path.points, v.max_turn_deg.to_radians())
                 + pitch_penalty(&path.points, v.max_pitch_deg.to_radians()),
             hard_hits: spheres.hard_hits,

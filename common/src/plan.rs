@@ -42,6 +42,11 @@ pub struct VehiclePlan {
     /// Metres of path inside inflated soft obstacles.
     pub soft_exposure_m: f64,
     /// Crawlers only: the seed 000 figures of the path on the seabed.
+    /// An AUV over a seabed: the lowest height of its path above the seabed, metres (sampled
+    /// every [`crate::cost::SEABED_STEP_M`]; under the scenario's clearance is a violation).
+    /// Absent for a crawler or without a seabed.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub min_seabed_clearance_m: Option<f64>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub crawler: Option<crate::crawler::CrawlerFigures>,
     /// Energy-planned AUVs only: seed 001's figures (q_path, q_e, q_r, q_a, f_f, …).
@@ -168,6 +173,32 @@ pub fn assess(scenario: &Scenario, trajectories: &[Trajectory]) -> Assessment {
                 v.id, min_speed, max_speed, v.speed_min_mps, v.speed_max_mps
             ));
         }
+        let seabed = match (&crawler, scenario.swimmer_seabed()) {
+            (None, Some((terrain, keep))) => {
+                let lowest = lowest_over_seabed(pts, terrain);
+                if let Some((h, p)) = lowest.filter(|(h, _)| *h < keep - TOL) {
+                    let how = if h < 0.0 {
+                        format!("goes {:.1} m into", -h)
+                    } else {
+                        format!("passes {h:.1} m above")
+                    };
+                    violations.push(format!(
+                        "{} {how} the seabed at ({:.0}, {:.0}) m; it must keep {:.1} m above it ({})",
+                        v.id,
+                        p.x,
+                        p.y,
+                        keep,
+                        if scenario.optimizer.algorithm.is_energy_planner() {
+                            "energy.terrain_clearance_m"
+                        } else {
+                            "seabed.auv_clearance_m"
+                        }
+                    ));
+                }
+                lowest.map(|(h, _)| h)
+            }
+            _ => None,
+        };
         let out_of_bounds = pts.iter().any(|p| {
             (0..3)
                 .any(|a| p[a] < scenario.bounds.min[a] - TOL || p[a] > scenario.bounds.max[a] + TOL)
@@ -202,6 +233,7 @@ pub fn assess(scenario: &Scenario, trajectories: &[Trajectory]) -> Assessment {
             min_clearance_m: clearance,
             hard_collisions,
             soft_exposure_m: soft_exposure,
+            min_seabed_clearance_m: seabed,
             crawler,
             energy: None,
             tour: None,
@@ -254,6 +286,21 @@ pub fn assess(scenario: &Scenario, trajectories: &[Trajectory]) -> Assessment {
         fleet,
         violations,
     }
+}
+
+/// Lowest height of the polyline `points` above `terrain` and where, every
+/// [`crate::cost::SEABED_STEP_M`] along each leg (the planner's cost samples the same points);
+/// `None` without points.
+fn lowest_over_seabed(
+    points: &[crate::geometry::Vec3],
+    terrain: &crate::terrain::Terrain,
+) -> Option<(f64, crate::geometry::Vec3)> {
+    let first = points.first()?;
+    let legs = points
+        .windows(2)
+        .map(|w| terrain.lowest_height_along(&w[0], &w[1], crate::cost::SEABED_STEP_M));
+    let one = terrain.lowest_height_along(first, first, 1.0);
+    Some(legs.fold(one, |a, b| if b.0 < a.0 { b } else { a }))
 }
 
 /// Plain-words notes that are not violations: why the common arrival differs from the mission
@@ -397,150 +444,5 @@ pub struct DegradedVehicle {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::geometry::Vec3;
-
-    fn scenario() -> Result<Scenario, crate::scenario::ScenarioError> {
-        Scenario::parse(
-            r#"
-name = "p"
-[bounds]
-min = [0.0, 0.0, 0.0]
-max = [1000.0, 1000.0, 1000.0]
-[[obstacles]]
-id = "H"
-kind = "hard"
-centre = [500.0, 25.0, 0.0]
-radius_m = 20.0
-inflation_m = 10.0
-[[vehicles]]
-id = "a"
-kind = "auv"
-start = [0.0, 0.0, 0.0]
-goal = [1000.0, 0.0, 0.0]
-speed_min_mps = 0.5
-speed_max_mps = 2.0
-max_turn_deg = 35.0
-max_pitch_deg = 20.0
-[[vehicles]]
-id = "b"
-kind = "auv"
-start = [1000.0, 100.0, 0.0]
-goal = [0.0, 100.0, 0.0]
-speed_min_mps = 0.5
-speed_max_mps = 2.0
-max_turn_deg = 35.0
-max_pitch_deg = 20.0
-[fleet]
-d_min_m = 150.0
-mission_time_s = 1000.0
-"#,
-            std::path::Path::new("p.toml"),
-        )
-    }
-
-    fn line(a: [f64; 3], b: [f64; 3], t: f64) -> Trajectory {
-        Trajectory {
-            times: vec![0.0, t],
-            points: vec![Vec3::from(a), Vec3::from(b)],
-        }
-    }
-
-    #[test]
-    fn figures_by_hand() -> Result<(), crate::scenario::ScenarioError> {
-        let s = scenario()?;
-        // a along y = 0, b back along y = 100, both at 1 m/s: they pass 100 m apart at t = 500,
-        // below d_min = 150 while the x gap is under √(150² − 100²) = 111.8 m: 111.8 s.
-        // a passes 25 m from H's centre: clearance 25 − 20 = 5 m, inside the 30 m inflated sphere.
-        let t = [
-            line(s.vehicles[0].start, s.vehicles[0].goal, 1000.0),
-            line(s.vehicles[1].start, s.vehicles[1].goal, 1000.0),
-        ];
-        let a = assess(&s, &t);
-        assert!((a.vehicles[0].length_m - 1000.0).abs() < 1e-9);
-        assert_eq!(
-            a.vehicles[0]
-                .min_clearance_m
-                .map(|c| (c * 1e6).round() / 1e6),
-            Some(5.0)
-        );
-        assert_eq!(a.vehicles[0].hard_collisions, 1);
-        assert_eq!(a.vehicles[1].hard_collisions, 0);
-        assert_eq!(a.fleet.hard_collisions, 1);
-        let sep = a.fleet.min_separation_m.unwrap_or(f64::NAN);
-        assert!((sep - 100.0).abs() < 1e-9);
-        assert!((a.fleet.min_separation_time_s.unwrap_or(f64::NAN) - 500.0).abs() < 1e-9);
-        // x gap closes at 2 m/s from +111.8 to −111.8 m: 111.8 s.
-        let expect = (150f64.powi(2) - 100f64.powi(2)).sqrt();
-        assert!((a.fleet.separation_breach_s - expect).abs() < 1e-6);
-        assert_eq!(a.fleet.arrival_spread_s, 0.0);
-        assert_eq!(a.violations.len(), 2, "{:?}", a.violations);
-        assert!(a.violations[0].contains("hard obstacle H"));
-        assert!(a.violations[1].contains("a and b"));
-        Ok(())
-    }
-
-    #[test]
-    fn speed_turn_pitch_and_arrival_violations_are_worded(
-    ) -> Result<(), crate::scenario::ScenarioError> {
-        let s = scenario()?;
-        // a at 2.5 m/s (above 2.0), b arrives 400 s later than a and climbs 45° on a hook.
-        let a = line(s.vehicles[0].start, s.vehicles[0].goal, 400.0);
-        let b = Trajectory {
-            times: vec![0.0, 100.0, 800.0],
-            points: vec![
-                Vec3::new(1000.0, 100.0, 0.0),
-                Vec3::new(950.0, 150.0, 50.0 * 2f64.sqrt()),
-                Vec3::new(0.0, 100.0, 0.0),
-            ],
-        };
-        let out = assess(&s, &[a, b]);
-        let all = out.violations.join("\n");
-        assert!(all.contains("a flies legs at 2.500"), "{all}");
-        assert!(all.contains("b pitches 45.0°"), "{all}");
-        assert!(all.contains("b turns"), "{all}");
-        assert!(all.contains("not synchronised"), "{all}");
-        assert!((out.fleet.arrival_spread_s - 400.0).abs() < 1e-9);
-        Ok(())
-    }
-
-    #[test]
-    fn late_arrival_is_explained() -> Result<(), crate::scenario::ScenarioError> {
-        let mut s = scenario()?;
-        s.fleet.mission_time_s = 300.0;
-        let t = [
-            line(s.vehicles[0].start, s.vehicles[0].goal, 500.0),
-            line(s.vehicles[1].start, s.vehicles[1].goal, 500.0),
-        ];
-        // Both fly 1000 m flat at 2 m/s at best: no path makes 300 s.
-        let n = notices(&s, &t, 500.0);
-        assert_eq!(n.len(), 2);
-        assert!(
-            n[0].contains("a cannot arrive by the mission time of 300 s whatever its path"),
-            "{}",
-            n[0]
-        );
-        assert!(
-            n[0].contains("even the 1000 m straight line is too long, 500 s"),
-            "{}",
-            n[0]
-        );
-        // With 600 s the mission is possible; a detour of two 750 m legs (750 s) is the plan's
-        // doing.
-        s.fleet.mission_time_s = 600.0;
-        let detour = Trajectory {
-            times: vec![0.0, 375.0, 750.0],
-            points: vec![
-                Vec3::new(0.0, 0.0, 0.0),
-                Vec3::new(500.0, (750f64.powi(2) - 500f64.powi(2)).sqrt(), 0.0),
-                Vec3::new(1000.0, 0.0, 0.0),
-            ],
-        };
-        let n = notices(&s, &[detour, t[1].clone()], 750.0);
-        assert_eq!(n.len(), 1, "{n:?}");
-        assert!(n[0].starts_with("a's planned path of 1500 m"), "{}", n[0]);
-        assert!(n[0].contains("would take 500 s"), "{}", n[0]);
-        Ok(())
-    }
-}
+#[path = "plan_tests.rs"]
+mod tests;

@@ -213,6 +213,24 @@ pub fn check_parsed(scenario: &Scenario, plan: &Plan) -> Report {
             mismatches.extend(c.mismatches);
             crawler_broken.extend(c.broken);
         }
+        if !v.is_crawler() {
+            // An energy plan keeps its own clearance (seed 001); a fleet AUV the seabed's.
+            let required = match (&pv.energy, &scenario.energy, &scenario.seabed) {
+                (Some(_), Some(e), _) => e.terrain_clearance_m,
+                (Some(_), None, _) => 2.0,
+                (None, _, Some(s)) => s.auv_clearance_m.unwrap_or(2.0),
+                (None, _, None) => 2.0,
+            };
+            let c = crate::crawler::check_swimmer_seabed(
+                scenario,
+                id,
+                traj,
+                required,
+                pv.min_seabed_clearance_m,
+            );
+            mismatches.extend(c.mismatches);
+            crawler_broken.extend(c.broken);
+        }
         if let Some(e) = &pv.energy {
             let c = crate::mobility::check_energy(scenario, v, traj, e);
             mismatches.extend(c.mismatches);

@@ -18,6 +18,12 @@ pub struct Seabed {
     /// Eq. (3) mountains.
     #[serde(default)]
     pub mountains: Vec<Mountain>,
+    /// A measured grid (not re-evaluated here: its presence is all the checker reads).
+    #[serde(default)]
+    pub grid: Option<serde::de::IgnoredAny>,
+    /// Height an AUV of a fleet mission keeps above the seabed, metres (default 2).
+    #[serde(default)]
+    pub auv_clearance_m: Option<f64>,
 }
 
 /// Eq. (2).
@@ -166,6 +172,58 @@ impl<'a> Seafloor<'a> {
     }
 }
 
+/// Checks an AUV's trajectory against the seabed: its lowest height above it, every 0.5 m
+/// along each leg (the seabed is not straight under a straight leg), must be at least
+/// `required` (minus 5 cm: the planner samples every 1 m), and must match the reported
+/// `min_seabed_clearance_m` to 5 cm. Analytic seabeds only (eq. (2) + (3), or seed 001's
+/// hills alone); a measured grid is not re-evaluated.
+pub fn check_swimmer_seabed(
+    scenario: &Scenario,
+    id: &str,
+    traj: &[[f64; 4]],
+    required: f64,
+    reported: Option<f64>,
+) -> CrawlerFindings {
+    const STEP: f64 = 0.5;
+    const SLACK: f64 = 0.05;
+    let mut out = CrawlerFindings::default();
+    let Some(seabed) = scenario.seabed.as_ref().filter(|s| s.grid.is_none()) else {
+        return out;
+    };
+    let floor = Seafloor::of(scenario);
+    let z = |x: f64, y: f64| match &floor {
+        Some(f) => f.z(x, y),
+        None => seabed.hills_elevation(x, y),
+    };
+    let mut lowest = traj.first().map_or(f64::INFINITY, |s| s[3] - z(s[1], s[2]));
+    for w in traj.windows(2) {
+        let d = [w[1][1] - w[0][1], w[1][2] - w[0][2], w[1][3] - w[0][3]];
+        let n = ((d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt() / STEP)
+            .ceil()
+            .max(1.0) as usize;
+        for k in 1..=n {
+            let u = k as f64 / n as f64;
+            let p = [w[0][1] + u * d[0], w[0][2] + u * d[1], w[0][3] + u * d[2]];
+            lowest = lowest.min(p[2] - z(p[0], p[1]));
+        }
+    }
+    if traj.is_empty() {
+        return out;
+    }
+    if lowest < required - SLACK {
+        out.broken.push(format!(
+            "{id} is {lowest:.3} m above the seabed at its lowest; it must keep {required} m"
+        ));
+    }
+    match reported {
+        Some(r) if (r - lowest).abs() <= SLACK => {}
+        r => out.mismatches.push(format!(
+            "{id}.min_seabed_clearance_m: reported {r:?} but recomputed {lowest:.3}"
+        )),
+    }
+    out
+}
+
 /// Horizontal distance from segment a→b to point c.
 fn segment_distance_2d(a: [f64; 2], b: [f64; 2], c: [f64; 2]) -> f64 {
     let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
@@ -311,5 +369,42 @@ mod tests {
             height_scale_m: 2.0,
         };
         assert!((r.raw(0.0, 0.0) - 2.0 * 1.75).abs() < 1e-12);
+    }
+
+    /// A 100 m hill (σ = 100 m, hills only) under the middle of a 1000 m leg: at z = 50 the
+    /// leg is 50 m into it (broken, required 2 m); at z = 102.5 it keeps 2.5 m; a reported
+    /// figure 1 m off is a mismatch; a measured grid is not judged.
+    #[test]
+    fn an_auv_is_checked_against_the_seabed_between_its_samples() -> Result<(), String> {
+        let text = |extra: &str| {
+            format!(
+                "name = \"s\"\n[bounds]\nmin = [0.0, 0.0, 0.0]\nmax = [1000.0, 1000.0, 500.0]\n\
+                 [[vehicles]]\nid = \"a\"\nkind = \"auv\"\nstart = [0.0, 500.0, 50.0]\n\
+                 goal = [1000.0, 500.0, 50.0]\nspeed_min_mps = 0.5\nspeed_max_mps = 1.5\n\
+                 max_turn_deg = 35.0\nmax_pitch_deg = 20.0\n[fleet]\nd_min_m = 50.0\n\
+                 mission_time_s = 1000.0\n{extra}"
+            )
+        };
+        let hill = "[[seabed.mountains]]\ncentre = [500.0, 500.0]\nheight_m = 100.0\nspread_m = [100.0, 100.0]\n";
+        let s = crate::model::parse_scenario(&text(hill))?;
+        let leg = |z: f64| [[0.0, 0.0, 500.0, z], [1000.0, 1000.0, 500.0, z]];
+        let low = check_swimmer_seabed(&s, "a", &leg(50.0), 2.0, Some(-50.0));
+        assert_eq!(low.broken.len(), 1, "{:?}", low.broken);
+        assert!(
+            low.broken[0].contains("-50.000 m above the seabed"),
+            "{:?}",
+            low.broken
+        );
+        assert!(low.mismatches.is_empty(), "{:?}", low.mismatches);
+        let high = check_swimmer_seabed(&s, "a", &leg(102.5), 2.0, Some(2.5));
+        assert!(high.broken.is_empty() && high.mismatches.is_empty());
+        let off = check_swimmer_seabed(&s, "a", &leg(102.5), 2.0, Some(3.5));
+        assert_eq!(off.mismatches.len(), 1, "{:?}", off.mismatches);
+        let unreported = check_swimmer_seabed(&s, "a", &leg(102.5), 2.0, None);
+        assert_eq!(unreported.mismatches.len(), 1);
+        let grid = crate::model::parse_scenario(&text("[seabed.grid]\nfile = \"x.asc\"\n"))?;
+        let g = check_swimmer_seabed(&grid, "a", &leg(50.0), 2.0, None);
+        assert!(g.broken.is_empty() && g.mismatches.is_empty());
+        Ok(())
     }
 }

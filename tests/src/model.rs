@@ -181,6 +181,9 @@ pub struct PlanVehicle {
     pub hard_collisions: usize,
     /// Reported metres inside inflated soft obstacles.
     pub soft_exposure_m: f64,
+    /// AUVs over a seabed: reported lowest height above it, metres.
+    #[serde(default)]
+    pub min_seabed_clearance_m: Option<f64>,
     /// Crawlers: reported seabed figures.
     #[serde(default)]
     pub crawler: Option<crate::crawler::PlanCrawler>,

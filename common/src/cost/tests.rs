@@ -196,3 +196,51 @@ fn separation_penalty_by_hand() {
     assert_abs_diff_eq!(separation_penalty(50.0, 50.0), 0.0);
     assert_abs_diff_eq!(space_term(12.5), 12.5);
 }
+
+/// The hill of `terrain::tests` (10 m, σ = 10 m, at x = 50): a leg at z = 8 goes 2 m into it,
+/// 4 m short of a 2 m clearance: 1 + 4 / 2 = 3. At z = 12 it keeps exactly 2 m: no penalty. A
+/// clearance under 1 m is measured against 1 m: 0.5 m required, 2 m in, 1 + 2.5 / 1.
+#[test]
+fn seabed_penalty_by_hand() {
+    let hill = Terrain::Hills(vec![crate::terrain::Mountain {
+        centre: [50.0, 0.0],
+        height_m: 10.0,
+        spread_m: [10.0, 10.0],
+    }]);
+    let low = [v(0., 0., 8.), v(100., 0., 8.)];
+    let (p, legs) = seabed_penalty(&low, &hill, 2.0);
+    assert_abs_diff_eq!(p, 3.0, epsilon = 1e-9);
+    assert_eq!(legs, 1);
+    assert_eq!(
+        seabed_penalty(&[v(0., 0., 12.), v(100., 0., 12.)], &hill, 2.0),
+        (0.0, 0)
+    );
+    assert_abs_diff_eq!(seabed_penalty(&low, &hill, 0.5).0, 3.5, epsilon = 1e-9);
+    // Two legs, each over half of the hill, each short.
+    let (p, legs) = seabed_penalty(&[low[0], v(50., 0., 8.), low[1]], &hill, 2.0);
+    assert_abs_diff_eq!(p, 6.0, epsilon = 1e-9);
+    assert_eq!(legs, 2);
+}
+
+/// An AUV of a fleet scenario whose straight line runs through a seabed hill pays the seabed
+/// penalty; over it, it does not; a crawler's seabed is not a swimmer's.
+#[test]
+fn a_swimmer_through_the_seabed_pays_for_it() -> Result<(), crate::scenario::ScenarioError> {
+    use crate::fixtures::{scenario, straight_particle, vehicle_toml};
+    let hill = "[[seabed.mountains]]\ncentre = [500.0, 500.0]\nheight_m = 100.0\nspread_m = [100.0, 100.0]\n";
+    let at = |z: f64| vehicle_toml("a", [0.0, 500.0, z], [1000.0, 500.0, z]);
+    let through = FleetModel::new(&scenario(2000.0, hill, &[at(50.0)])?);
+    let e = through.evaluate(&straight_particle(&through));
+    assert!(e.vehicles[0].hard > 1.0, "{:?}", e.vehicles[0]);
+    assert_eq!(e.vehicles[0].hard_hits, 0, "no obstacle was hit");
+    let over = FleetModel::new(&scenario(2000.0, hill, &[at(300.0)])?);
+    let e = over.evaluate(&straight_particle(&over));
+    assert_eq!(e.vehicles[0].hard, 0.0, "{:?}", e.vehicles[0]);
+    // Without a seabed the low line is clear.
+    let open = FleetModel::new(&scenario(2000.0, "", &[at(50.0)])?);
+    assert_eq!(
+        open.evaluate(&straight_particle(&open)).vehicles[0].hard,
+        0.0
+    );
+    Ok(())
+}

@@ -543,6 +543,19 @@ impl Scenario {
         })
     }
 
+    /// The seabed a swimming vehicle must keep off, with the height it keeps above it: an
+    /// energy mission's `energy.terrain_clearance_m` (seed 001), else `seabed.auv_clearance_m`;
+    /// `None` without a seabed.
+    pub fn swimmer_seabed(&self) -> Option<(&crate::terrain::Terrain, f64)> {
+        let seabed = self.seabed.as_ref()?;
+        let clearance = if self.optimizer.algorithm.is_energy_planner() {
+            self.energy.terrain_clearance_m
+        } else {
+            seabed.auv_clearance_m
+        };
+        Some((seabed.terrain.as_ref()?, clearance))
+    }
+
     /// Hard obstacles only.
     pub fn hard_obstacles(&self) -> impl Iterator<Item = &Obstacle> {
         self.obstacles

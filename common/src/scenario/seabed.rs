@@ -9,7 +9,7 @@ use super::ScenarioError;
 use crate::terrain::{BaseRelief, HeightGrid, Mountain, Terrain};
 
 /// The seabed: the analytic model of eq. (2) + (3), or a measured height grid from a file.
-#[derive(Debug, Clone, Serialize, Deserialize, PartialEq, Default)]
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct Seabed {
     /// Base relief of eq. (2) (analytic model).
@@ -21,9 +21,34 @@ pub struct Seabed {
     /// Measured bathymetry instead of the analytic model.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub grid: Option<SeabedGrid>,
+    /// Height an AUV of a fleet mission keeps above this seabed, metres: a plan that comes
+    /// closer is infeasible (an energy mission keeps `energy.terrain_clearance_m` instead).
+    #[serde(default = "auv_clearance")]
+    pub auv_clearance_m: f64,
     /// The terrain built from the above when the scenario was loaded (grids are read then).
     #[serde(skip)]
     pub terrain: Option<Terrain>,
+}
+
+/// `seabed.auv_clearance_m`'s default: 2 m, the altitude a DVL-aided survey AUV holds when it
+/// follows the bottom (none of the seeds gives one; seed 001's energy missions also keep 2 m),
+/// and well above the ±1 m position noise of the simulated fixes.
+pub const AUV_CLEARANCE_M: f64 = 2.0;
+
+fn auv_clearance() -> f64 {
+    AUV_CLEARANCE_M
+}
+
+impl Default for Seabed {
+    fn default() -> Self {
+        Seabed {
+            relief: None,
+            mountains: Vec::new(),
+            grid: None,
+            auv_clearance_m: AUV_CLEARANCE_M,
+            terrain: None,
+        }
+    }
 }
 
 /// A height-grid file: ESRI ASCII grid (`.asc`, georeferenced by its header) or CSV (`.csv`,
@@ -93,6 +118,13 @@ impl Seabed {
         file: &Path,
         bad: Bad,
     ) -> Result<(), ScenarioError> {
+        if !(self.auv_clearance_m.is_finite() && self.auv_clearance_m >= 0.0) {
+            return Err(bad(
+                "seabed.auv_clearance_m".into(),
+                self.auv_clearance_m.to_string(),
+                "must be a non-negative number of metres",
+            ));
+        }
         if let Some(r) = &self.relief {
             let coefficients = [r.a, r.b, r.c, r.d, r.e, r.f, r.g];
             for (name, v) in ["a", "b", "c", "d", "e", "f", "g"].iter().zip(coefficients) {
@@ -335,6 +367,10 @@ mission_time_s = 200.0
             (
                 "[seabed]\n".to_string(),
                 "`seabed`",
+            ),
+            (
+                RELIEF.replace("[seabed.relief]", "[seabed]\nauv_clearance_m = -1.0\n[seabed.relief]"),
+                "`seabed.auv_clearance_m` = -1",
             ),
         ];
         for (extra, field) in cases {

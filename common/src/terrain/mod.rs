@@ -6,6 +6,8 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::geometry::Vec3;
+
 mod grid;
 pub use grid::{HeightGrid, Problem, TerrainError};
 
@@ -212,6 +214,21 @@ impl Terrain {
     pub fn crawler_z(&self, x: f64, y: f64, sensor_height_m: f64) -> f64 {
         self.elevation(x, y) + sensor_height_m
     }
+
+    /// Lowest height above the seabed of the straight leg `a→b` (negative: through it) and
+    /// where it is, sampled at both ends and at `⌈|ab| / step⌉ − 1` evenly spaced points
+    /// between them. A swimmer's leg is straight but the seabed under it is not, so its ends
+    /// alone would miss a hill between two waypoints.
+    pub fn lowest_height_along(&self, a: &Vec3, b: &Vec3, step: f64) -> (f64, Vec3) {
+        let n = ((b - a).norm() / step.max(1e-6)).ceil().max(1.0) as usize;
+        (0..=n)
+            .map(|k| a + (b - a) * (k as f64 / n as f64))
+            .map(|p| (p.z - self.elevation(p.x, p.y), p))
+            .fold(
+                (f64::INFINITY, *a),
+                |best, h| if h.0 < best.0 { h } else { best },
+            )
+    }
 }
 
 /// Horizontal clearance of segment `a→b` from hazard `h` (seed 000 eq. (4)): distance from the
@@ -249,6 +266,33 @@ mod tests {
     use std::f64::consts::{E, FRAC_PI_2};
 
     type TestResult = Result<(), Box<dyn std::error::Error>>;
+
+    /// A 10 m Gaussian hill (σ = 10 m) at x = 50 under a leg at z = 12 from x = 0 to 100: the
+    /// ends are 12 m up (the hill is e^-12.5 ≈ 0 there), the lowest point is over the summit,
+    /// 12 − 10 = 2 m up; at z = 8 the leg goes 2 m into it.
+    #[test]
+    fn the_lowest_height_of_a_leg_is_over_the_hill_between_its_ends() {
+        let hill = Terrain::Hills(vec![Mountain {
+            centre: [50.0, 0.0],
+            height_m: 10.0,
+            spread_m: [10.0, 10.0],
+        }]);
+        let at = |z: f64| (Vec3::new(0.0, 0.0, z), Vec3::new(100.0, 0.0, z));
+        let (a, b) = at(12.0);
+        let (h, p) = hill.lowest_height_along(&a, &b, 1.0);
+        assert_abs_diff_eq!(h, 2.0, epsilon = 1e-9);
+        assert_abs_diff_eq!(p.x, 50.0, epsilon = 1e-9);
+        let (a, b) = at(8.0);
+        assert_abs_diff_eq!(
+            hill.lowest_height_along(&a, &b, 1.0).0,
+            -2.0,
+            epsilon = 1e-9
+        );
+        // Only the ends (a step longer than the leg): the hill is missed.
+        assert!(hill.lowest_height_along(&a, &b, 200.0).0 > 7.9);
+        // A zero-length leg is its one point.
+        assert_abs_diff_eq!(hill.lowest_height_along(&a, &a, 1.0).0, 8.0, epsilon = 1e-4);
+    }
 
     fn relief() -> BaseRelief {
         BaseRelief {
