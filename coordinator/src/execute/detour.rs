@@ -10,6 +10,10 @@
 //! [`SHORTCUT_GROW`], keep a little margin that resampling onto the swarm's waypoints (chords
 //! between points of the path) then spends.
 //!
+//! A swimmer over a seabed keeps off it as it does off the obstacles: cells whose centre is less
+//! than its clearance plus one layer above the seabed are blocked, and shortcuts keep the
+//! clearance plus [`SEABED_MARGIN_M`] all along (sampled as the planner's cost samples it).
+//!
 //! The way must be one the vehicle can fly: its pitch limit (±20° in seed 004) is built into
 //! the grid. Layers are `cell · tan(φ_max)` apart (a little less; a cell at most), every move
 //! goes one cell sideways and at most one layer up or down, so no grid move is steeper than the
@@ -17,14 +21,36 @@
 
 use std::collections::BinaryHeap;
 
+use shoal_common::cost::SEABED_STEP_M;
 use shoal_common::geometry::{segment_hits_sphere, Vec3};
 use shoal_common::queue::Cheapest;
 use shoal_common::scenario::Scenario;
+use shoal_common::terrain::Terrain;
+
+/// The seabed a vehicle keeps off and the height it keeps above it; `None` for a crawler (it
+/// drives on it) or without a seabed.
+pub type KeepOff<'a> = Option<(&'a Terrain, f64)>;
+
+/// What vehicle `i` of `scenario` keeps off: the seabed, for a swimmer.
+pub fn keep_off(scenario: &Scenario, i: usize) -> KeepOff<'_> {
+    let crawler = scenario
+        .vehicles
+        .get(i)
+        .is_none_or(|v| v.kind == shoal_common::scenario::VehicleKind::Crawler);
+    if crawler {
+        None
+    } else {
+        scenario.swimmer_seabed()
+    }
+}
 
 /// Blocked cells: centre within this × the inflated radius of a hard obstacle.
 const GROW: f64 = 1.15;
 /// Line-of-sight shortcuts keep out of the inflated spheres grown by this.
 const SHORTCUT_GROW: f64 = 1.08;
+/// Metres over its clearance a line-of-sight shortcut keeps above the seabed, for the
+/// resampling onto the swarm's waypoints.
+const SEABED_MARGIN_M: f64 = 1.0;
 /// Cells along the longer horizontal side of the bounds.
 const CELLS: f64 = 40.0;
 /// Layers are this fraction of the height a one-cell move may climb.
@@ -39,7 +65,7 @@ struct Grid {
 }
 
 impl Grid {
-    fn new(scenario: &Scenario, max_pitch: f64) -> Grid {
+    fn new(scenario: &Scenario, max_pitch: f64, seabed: KeepOff) -> Grid {
         let min = Vec3::from(scenario.bounds.min);
         let extent = Vec3::from(scenario.bounds.max) - min;
         let cell = (extent.x.max(extent.y) / CELLS).max(1.0);
@@ -57,7 +83,8 @@ impl Grid {
             let c = g.centre(k);
             g.blocked[k] = scenario
                 .hard_obstacles()
-                .any(|o| (c - o.centre()).norm() < GROW * o.inflated_radius());
+                .any(|o| (c - o.centre()).norm() < GROW * o.inflated_radius())
+                || seabed.is_some_and(|(t, keep)| c.z - t.elevation(c.x, c.y) < keep + layer);
         }
         g
     }
@@ -163,22 +190,33 @@ fn clear(scenario: &Scenario, a: &Vec3, b: &Vec3, grow: f64) -> bool {
         .any(|o| segment_hits_sphere(a, b, &o.centre(), grow * o.inflated_radius()))
 }
 
-/// Whether the segment `a`–`b` is flyable as one leg: clear (with the shortcut margin) and no
-/// steeper than `max_pitch` radians.
-fn flyable(scenario: &Scenario, a: &Vec3, b: &Vec3, max_pitch: f64) -> bool {
+/// Whether the segment `a`–`b` is flyable as one leg: clear (with the shortcut margin), no
+/// steeper than `max_pitch` radians, and as high over the seabed as the vehicle keeps plus
+/// [`SEABED_MARGIN_M`].
+fn flyable(scenario: &Scenario, a: &Vec3, b: &Vec3, max_pitch: f64, seabed: KeepOff) -> bool {
     let d = b - a;
-    d.z.abs() <= max_pitch.tan() * d.x.hypot(d.y) + 1e-9 && clear(scenario, a, b, SHORTCUT_GROW)
+    d.z.abs() <= max_pitch.tan() * d.x.hypot(d.y) + 1e-9
+        && clear(scenario, a, b, SHORTCUT_GROW)
+        && seabed.is_none_or(|(t, keep)| {
+            t.lowest_height_along(a, b, SEABED_STEP_M).0 >= keep + SEABED_MARGIN_M
+        })
 }
 
-/// A way from `from` to `to` round the scenario's hard obstacles, no steeper than
-/// `max_pitch_deg` (see the module doc): the corners of the shortened grid path, from `from` to
-/// `to`. `None` when the grid has no way.
-pub fn detour(scenario: &Scenario, from: Vec3, to: Vec3, max_pitch_deg: f64) -> Option<Vec<Vec3>> {
+/// A way from `from` to `to` round the scenario's hard obstacles (and over the seabed a
+/// swimmer keeps off, [`keep_off`]), no steeper than `max_pitch_deg` (see the module doc): the
+/// corners of the shortened grid path, from `from` to `to`. `None` when the grid has no way.
+pub fn detour(
+    scenario: &Scenario,
+    from: Vec3,
+    to: Vec3,
+    max_pitch_deg: f64,
+    seabed: KeepOff,
+) -> Option<Vec<Vec3>> {
     let max_pitch = max_pitch_deg.to_radians();
-    if flyable(scenario, &from, &to, max_pitch) {
+    if flyable(scenario, &from, &to, max_pitch, seabed) {
         return Some(vec![from, to]);
     }
-    let grid = Grid::new(scenario, max_pitch);
+    let grid = Grid::new(scenario, max_pitch, seabed);
     let cells = grid.search(grid.nearest(from), grid.nearest(to))?;
     let mut raw = vec![from];
     // The end nodes stand for `from` and `to` themselves.
@@ -193,7 +231,7 @@ pub fn detour(scenario: &Scenario, from: Vec3, to: Vec3, max_pitch_deg: f64) -> 
     let mut i = 0;
     while i + 1 < raw.len() {
         let mut j = raw.len() - 1;
-        while j > i + 1 && !flyable(scenario, &raw[i], &raw[j], max_pitch) {
+        while j > i + 1 && !flyable(scenario, &raw[i], &raw[j], max_pitch, seabed) {
             j -= 1;
         }
         out.push(raw[j]);
@@ -256,7 +294,7 @@ mod tests {
             Vec3::new(100.0, 500.0, 200.0),
             Vec3::new(1900.0, 500.0, 200.0),
         );
-        assert_eq!(detour(&s, a, b, 20.0), Some(vec![a, b]));
+        assert_eq!(detour(&s, a, b, 20.0, None), Some(vec![a, b]));
         Ok(())
     }
 
@@ -268,7 +306,7 @@ mod tests {
         // spheres' centres, the inflated wall ends at y = 1250 + √(200² − 100²) ≈ 1423.
         let s = scenario(&wall(6, 250.0))?;
         let (a, b) = across();
-        let path = detour(&s, a, b, 20.0).ok_or("no detour")?;
+        let path = detour(&s, a, b, 20.0, None).ok_or("no detour")?;
         assert_eq!(path.first(), Some(&a));
         assert_eq!(path.last(), Some(&b));
         for w in path.windows(2) {
@@ -288,7 +326,7 @@ mod tests {
         // Spheres every 200 m along x = 1000, at both heights, over the whole width.
         let s = scenario(&wall(11, 200.0))?;
         let (a, b) = across();
-        assert_eq!(detour(&s, a, b, 20.0), None);
+        assert_eq!(detour(&s, a, b, 20.0, None), None);
         Ok(())
     }
 
@@ -302,7 +340,7 @@ mod tests {
             Vec3::new(100.0, 1000.0, 0.0),
             Vec3::new(300.0, 1000.0, 400.0),
         );
-        let path = detour(&s, a, b, 20.0).ok_or("no way up")?;
+        let path = detour(&s, a, b, 20.0, None).ok_or("no way up")?;
         assert_eq!((path.first(), path.last()), (Some(&a), Some(&b)));
         let legs = path.len() - 1;
         for (k, w) in path.windows(2).enumerate() {
@@ -315,6 +353,39 @@ mod tests {
         }
         let l = length(&path);
         assert!((1150.0..2500.0).contains(&l), "{l} m: {path:?}");
+        Ok(())
+    }
+
+    /// A 250 m hill (σ = 300 m) under the line from (0, 1000, 100) to (2000, 1000, 100), in the
+    /// 400 m box with no obstacle: a swimmer keeping 2 m off the seabed gets a way over or
+    /// round it whose every leg keeps 3 m (its clearance plus the shortcut margin) and its
+    /// 20° pitch limit; a crawler's (nothing to keep off) is the straight line.
+    #[test]
+    fn a_swimmer_goes_over_or_round_the_seabed() -> Result<(), Box<dyn std::error::Error>> {
+        let hill = Terrain::Hills(vec![shoal_common::terrain::Mountain {
+            centre: [1000.0, 1000.0],
+            height_m: 250.0,
+            spread_m: [300.0, 300.0],
+        }]);
+        let s = scenario(&[])?;
+        let (a, b) = (
+            Vec3::new(0.0, 1000.0, 100.0),
+            Vec3::new(2000.0, 1000.0, 100.0),
+        );
+        assert!(hill.lowest_height_along(&a, &b, 1.0).0 < -100.0);
+        let way = detour(&s, a, b, 20.0, Some((&hill, 2.0))).ok_or("no way over the hill")?;
+        assert!(way.len() > 2, "{way:?}");
+        assert_eq!((way[0], way[way.len() - 1]), (a, b));
+        for w in way.windows(2) {
+            let (h, p) = hill.lowest_height_along(&w[0], &w[1], 1.0);
+            assert!(h >= 3.0 - 1e-9, "{h} m above the seabed at {p:?}: {way:?}");
+            let d = w[1] - w[0];
+            assert!(
+                d.z.abs() <= 20f64.to_radians().tan() * d.x.hypot(d.y) + 1e-6,
+                "{way:?}"
+            );
+        }
+        assert_eq!(detour(&s, a, b, 20.0, None), Some(vec![a, b]));
         Ok(())
     }
 }

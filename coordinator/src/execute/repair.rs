@@ -69,6 +69,7 @@ fn repaired_path(r: &Request) -> Option<(Vec<Vec3>, Vec<f64>)> {
             pts[k],
             pts[j + 1],
             scenario.vehicles[r.vehicle].max_pitch_deg,
+            super::detour::keep_off(scenario, r.vehicle),
         )?;
         let run_length: f64 = (k..=j).map(|i| (pts[i + 1] - pts[i]).norm()).sum();
         let run_time: f64 = (k..=j)

@@ -304,7 +304,13 @@ pub fn replan(r: &Request) -> Replanned {
                 .all(|o| (q - o.centre()).norm() > o.inflated_radius())
         });
     let from = lead.unwrap_or(r.p0);
-    if let Some(mut way) = super::detour::detour(&scenario, from, v.goal(), v.max_pitch_deg) {
+    if let Some(mut way) = super::detour::detour(
+        &scenario,
+        from,
+        v.goal(),
+        v.max_pitch_deg,
+        super::detour::keep_off(&scenario, r.vehicle),
+    ) {
         if lead.is_some() {
             way.insert(0, r.p0);
         }
