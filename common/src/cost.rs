@@ -174,7 +174,12 @@ pub const SEABED_STEP_M: f64 = 1.0;
 pub fn seabed_penalty(points: &[Vec3], terrain: &Terrain, clearance: f64) -> (f64, usize) {
     let mut penalty = 0.0;
     let mut legs = 0;
+    // Legs wholly above the highest seabed plus the clearance cannot be short of it.
+    let safe = terrain.ceiling() + clearance;
     for w in points.windows(2) {
+        if w[0].z.min(w[1].z) >= safe {
+            continue;
+        }
         let (height, _) = terrain.lowest_height_along(&w[0], &w[1], SEABED_STEP_M);
         if height < clearance {
             penalty += 1.0 + (clearance - height) / clearance.max(1.0);

@@ -168,6 +168,15 @@ impl HeightGrid {
         (z, tx, ty, in_x, in_y)
     }
 
+    /// The highest node: no bilinear patch, and no clamped position outside the grid, is
+    /// higher.
+    pub fn max_height(&self) -> f64 {
+        self.heights
+            .iter()
+            .copied()
+            .fold(f64::NEG_INFINITY, f64::max)
+    }
+
     /// Bilinear height at `(x, y)`, clamped to the edge outside the grid.
     pub fn elevation(&self, x: f64, y: f64) -> f64 {
         let ([z00, z10, z01, z11], tx, ty, _, _) = self.patch(x, y);

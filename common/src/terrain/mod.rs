@@ -215,6 +215,21 @@ impl Terrain {
         self.elevation(x, y) + sensor_height_m
     }
 
+    /// An upper bound of the elevation anywhere: eq. (2)'s five terms at their largest
+    /// (`height_scale · (1 + |b| + |c| + |e| + |f|)` over the datum) plus every mountain's peak,
+    /// or the grid's highest node. A leg above it plus a clearance needs no sampling.
+    pub fn ceiling(&self) -> f64 {
+        let peaks = |m: &[Mountain]| m.iter().map(|m| m.height_m.max(0.0)).sum::<f64>();
+        match self {
+            Terrain::Analytic { base, mountains } => {
+                let amplitude = 1.0 + base.b.abs() + base.c.abs() + base.e.abs() + base.f.abs();
+                base.datum_m + base.height_scale_m.abs() * amplitude + peaks(mountains)
+            }
+            Terrain::Hills(hills) => peaks(hills),
+            Terrain::Grid(grid) => grid.max_height(),
+        }
+    }
+
     /// Lowest height above the seabed of the straight leg `a→b` (negative: through it) and
     /// where it is, sampled at both ends and at `⌈|ab| / step⌉ − 1` evenly spaced points
     /// between them. A swimmer's leg is straight but the seabed under it is not, so its ends
@@ -266,6 +281,47 @@ mod tests {
     use std::f64::consts::{E, FRAC_PI_2};
 
     type TestResult = Result<(), Box<dyn std::error::Error>>;
+
+    /// The ceiling is above every sampled elevation of an analytic seabed with mountains (one
+    /// a pit) and equals a lone hill's peak; a grid's is its highest node.
+    #[test]
+    fn the_ceiling_bounds_the_seabed() -> TestResult {
+        let mut base = relief();
+        base.datum_m = 1.5;
+        let mountains = vec![
+            Mountain {
+                centre: [30.0, 40.0],
+                height_m: 4.0,
+                spread_m: [8.0, 6.0],
+            },
+            Mountain {
+                centre: [60.0, 20.0],
+                height_m: -3.0,
+                spread_m: [5.0, 5.0],
+            },
+        ];
+        let t = Terrain::Analytic { base, mountains };
+        let top = t.ceiling();
+        let b = relief();
+        let expect = 1.5 + b.height_scale_m * (1.0 + b.b + b.c + b.e + b.f) + 4.0;
+        assert_abs_diff_eq!(top, expect, epsilon = 1e-12);
+        for i in 0..=100 {
+            for j in 0..=100 {
+                let z = t.elevation(i as f64, j as f64);
+                assert!(z <= top, "{z} over {top} at ({i}, {j})");
+            }
+        }
+        let hill = Terrain::Hills(vec![Mountain {
+            centre: [0.0, 0.0],
+            height_m: 7.0,
+            spread_m: [3.0, 3.0],
+        }]);
+        assert_abs_diff_eq!(hill.ceiling(), 7.0);
+        assert_abs_diff_eq!(hill.ceiling(), hill.elevation(0.0, 0.0));
+        let grid = HeightGrid::new([0.0, 0.0], 1.0, 2, 2, vec![1.0, 5.0, -2.0, 3.0])?;
+        assert_abs_diff_eq!(Terrain::Grid(grid).ceiling(), 5.0);
+        Ok(())
+    }
 
     /// A 10 m Gaussian hill (σ = 10 m) at x = 50 under a leg at z = 12 from x = 0 to 100: the
     /// ends are 12 m up (the hill is e^-12.5 ≈ 0 there), the lowest point is over the summit,
