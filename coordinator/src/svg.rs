@@ -191,8 +191,8 @@ fn draw_view(
     if exag > 1.05 {
         title.push_str(&format!(", z stretched ×{exag:.1}"));
     }
-    if b == 1 && scenario.terrain().is_some() {
-        title.push_str(" on the seabed (dark = high)");
+    if let Some(c) = crate::svg_terrain::caption(scenario, b == 1) {
+        title.push_str(c);
     }
     if let Some(c) = crate::svg_current::caption(scenario, b == 1) {
         title.push_str(&c);
@@ -276,6 +276,9 @@ fn draw_view(
         chart.draw_series(goals).map_err(fail("goal marker"))?;
     }
 
+    if b == 2 {
+        crate::svg_terrain::draw_seabed_under_paths(&mut chart, scenario, plan, a, &colour)?;
+    }
     crate::svg_tour::draw_inspection_points(&mut chart, plan, (a, b), &colour)?;
 
     // Obstacle ids last, so no fill or path hides them; ids of spheres whose centres coincide in

@@ -6,7 +6,8 @@
 
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
-use shoal_common::scenario::Scenario;
+use shoal_common::plan::Plan;
+use shoal_common::scenario::{Scenario, VehicleKind};
 use shoal_common::terrain::Terrain;
 
 use crate::svg::{fail, Chart};
@@ -121,6 +122,67 @@ pub fn draw_seabed(
     Ok(Some((lo, hi)))
 }
 
+/// What the seabed adds to a view's title: the top view's shading, the side view's dots.
+pub fn caption(scenario: &Scenario, top: bool) -> Option<&'static str> {
+    if top {
+        scenario.terrain().map(|_| " on the seabed (dark = high)")
+    } else {
+        has_swimmer_over_seabed(scenario).then_some(", dots: seabed")
+    }
+}
+
+/// Whether `scenario` has a seabed and an AUV over it (whose side view gets the seabed under
+/// its path).
+pub fn has_swimmer_over_seabed(scenario: &Scenario) -> bool {
+    scenario.swimmer_seabed().is_some()
+        && scenario
+            .vehicles
+            .iter()
+            .any(|v| v.kind != VehicleKind::Crawler)
+}
+
+/// Side view: under each AUV's path, the seabed elevation at every metre of it, plotted against
+/// the path's horizontal axis `a`, dotted in the vehicle's colour; how high the AUV keeps above
+/// the seabed is the gap between its line and its dots. (A crawler's path is the seabed.)
+pub fn draw_seabed_under_paths(
+    chart: &mut Chart,
+    scenario: &Scenario,
+    plan: &Plan,
+    a: usize,
+    colour: &dyn Fn(usize) -> RGBColor,
+) -> anyhow::Result<()> {
+    let Some((terrain, _)) = scenario.swimmer_seabed() else {
+        return Ok(());
+    };
+    for (i, v) in plan.vehicles.iter().enumerate() {
+        let swimmer = scenario
+            .vehicles
+            .iter()
+            .any(|s| s.id == v.id && s.kind != VehicleKind::Crawler);
+        if !swimmer {
+            continue;
+        }
+        let mut dots = Vec::new();
+        for w in v.trajectory.windows(2) {
+            let (p, q) = ([w[0][1], w[0][2]], [w[1][1], w[1][2]]);
+            let n = ((q[0] - p[0]).hypot(q[1] - p[1]).ceil() as usize).max(1);
+            for k in 0..n {
+                let u = k as f64 / n as f64;
+                let (x, y) = (p[0] + u * (q[0] - p[0]), p[1] + u * (q[1] - p[1]));
+                dots.push(([x, y][a.min(1)], terrain.elevation(x, y)));
+            }
+        }
+        let c = colour(i);
+        chart
+            .draw_series(
+                dots.into_iter()
+                    .map(|p| Circle::new(p, 1, c.mix(0.7).filled())),
+            )
+            .map_err(fail("seabed under a path"))?;
+    }
+    Ok(())
+}
+
 /// Contour interval for an elevation span: 1 m, or the smallest 1-2-5 step that keeps about a
 /// dozen contours (a 55 m hill at 1 m would hatch the whole map).
 pub fn contour_step(span: f64) -> f64 {
@@ -155,5 +217,28 @@ mod tests {
         assert_eq!(shade(1.0), RGBColor(110, 80, 50));
         assert_eq!(shade(2.0), shade(1.0));
         assert_eq!(shade(0.5), RGBColor(178, 159, 135));
+    }
+
+    /// The side view draws the seabed under AUVs of a scenario with both (seabed-fleet), not
+    /// under a lone crawler (ipso-dsmv) nor without a seabed (amp-pso-1); the picture of a
+    /// seabed-fleet plan says so.
+    #[test]
+    fn the_seabed_is_drawn_under_auvs_only() -> anyhow::Result<()> {
+        let load = |name: &str| {
+            Scenario::load(std::path::Path::new(&format!(
+                "{}/../scenarios/{name}.toml",
+                env!("CARGO_MANIFEST_DIR")
+            )))
+        };
+        let fleet = load("seabed-fleet")?;
+        assert!(has_swimmer_over_seabed(&fleet));
+        assert!(!has_swimmer_over_seabed(&load("ipso-dsmv")?));
+        assert!(!has_swimmer_over_seabed(&load("amp-pso-1")?));
+        let mut fleet_small = fleet.clone();
+        fleet_small.optimizer.iterations = 2;
+        let plan = crate::planner::plan_in_process(&fleet_small, None, &mut |_| {});
+        let svg = crate::svg::render_plan(&fleet_small, &plan)?;
+        assert!(svg.contains("dots: seabed"));
+        Ok(())
     }
 }
