@@ -63,15 +63,13 @@ pub(super) fn obstacle_clearance(track: &Trajectory, obstacles: &[Obstacle]) -> 
 /// [`SEABED_STEP_M`] along each segment; `None` without fixes. An AUV's simulator does not
 /// stop at the seabed, so this is how a run learns that a vehicle would have hit it.
 pub(super) fn seabed_clearance(track: &Trajectory, seabed: &Terrain) -> Option<f64> {
-    let height = |p: &Vec3| p.z - seabed.elevation(p.x, p.y);
-    let mut best = height(track.points.first()?);
-    for w in track.points.windows(2) {
-        let n = ((w[1] - w[0]).norm() / SEABED_STEP_M).ceil().max(1.0) as usize;
-        for k in 1..=n {
-            best = best.min(height(&(w[0] + (w[1] - w[0]) * (k as f64 / n as f64))));
-        }
-    }
-    Some(best)
+    let first = track.points.first()?;
+    let legs = track.points.windows(2);
+    Some(
+        legs.fold(first.z - seabed.elevation(first.x, first.y), |best, w| {
+            best.min(seabed.lowest_height_along(&w[0], &w[1], SEABED_STEP_M).0)
+        }),
+    )
 }
 
 /// Closest `track` came to any of `hazards` horizontally, metres (negative: inside one); `None`
