@@ -107,12 +107,12 @@ pub fn command(args: &BenchTelemetryArgs, stop: &AtomicBool) -> anyhow::Result<i
     let f = &report.figures;
     let expected = (n as f64 * args.hz * (arrival / time_scale)).round();
     crate::say(&format!(
-        "{n} vehicles, {} Hz, {wall:.1} s wall: {} reports ({expected:.0} expected over the mission), coordinator CPU {} , latency median {:.2} ms, p99 {:.2} ms; min separation {}; {}\n",
+        "{n} vehicles, {} Hz, {wall:.1} s wall: {} reports ({expected:.0} expected over the mission), coordinator CPU {} , latency median {} ms, p99 {} ms; min separation {}; {}\n",
         args.hz,
         f.reports,
         cpu.map_or("unknown (no /proc/self/stat)".to_string(), |c| format!("{c:.2} s = {:.1} % of one core", 100.0 * c / wall)),
-        f.latency_median_ms,
-        f.latency_p99_ms,
+        crate::summary::opt(f.latency_median_ms, 2),
+        crate::summary::opt(f.latency_p99_ms, 2),
         f.min_separation_m.map_or("–".into(), |d| format!("{d:.1} m")),
         report.ended
     ));

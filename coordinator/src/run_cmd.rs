@@ -297,8 +297,10 @@ pub fn execution_summary(r: &ExecutionReport) -> String {
         r.holds
     ));
     s.push_str(&format!(
-        "  telemetry: {} reports, latency median {:.2} ms, p99 {:.2} ms\n",
-        f.reports, f.latency_median_ms, f.latency_p99_ms
+        "  telemetry: {} reports, latency median {} ms, p99 {} ms\n",
+        f.reports,
+        crate::summary::opt(f.latency_median_ms, 2),
+        crate::summary::opt(f.latency_p99_ms, 2)
     ));
     if !r.obstacle_decision_ms.is_empty() || !r.update_delivery_ms.is_empty() {
         s.push_str(&format!(

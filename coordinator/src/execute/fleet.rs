@@ -326,8 +326,8 @@ impl Fleet {
                 min_obstacle_clearance_m: obstacle_clearance(&v.track, obstacles),
                 min_seabed_clearance_m: None,
                 min_hazard_clearance_m: None,
-                median_cross_track_m: quantile(&v.cross_track, 0.5),
-                p95_cross_track_m: quantile(&v.cross_track, 0.95),
+                median_cross_track_m: quantile_of(&v.cross_track, 0.5),
+                p95_cross_track_m: quantile_of(&v.cross_track, 0.95),
                 revision: v.revision,
                 lost: v.lost,
             })
@@ -342,10 +342,16 @@ impl Fleet {
             all_arrived_in_window: vehicles.iter().all(|v| v.in_window),
             vehicles,
             reports: self.reports,
-            latency_median_ms: quantile(&self.latencies_ms, 0.5),
-            latency_p99_ms: quantile(&self.latencies_ms, 0.99),
+            latency_median_ms: quantile_of(&self.latencies_ms, 0.5),
+            latency_p99_ms: quantile_of(&self.latencies_ms, 0.99),
         }
     }
+}
+
+/// The `q` quantile of `x`, or `None` for no values: a vehicle that never reported has no
+/// median (a NaN would be written to the log as `null` and not read back).
+fn quantile_of(x: &[f64], q: f64) -> Option<f64> {
+    (!x.is_empty()).then(|| quantile(x, q))
 }
 
 /// One vehicle's execution figures.
@@ -373,10 +379,10 @@ pub struct VehicleFigures {
     /// horizontally, metres (negative: inside it); absent for an AUV, or without hazards.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub min_hazard_clearance_m: Option<f64>,
-    /// Median cross-track error, metres.
-    pub median_cross_track_m: f64,
-    /// 95th percentile, metres.
-    pub p95_cross_track_m: f64,
+    /// Median cross-track error, metres; `None` without a report on a plan.
+    pub median_cross_track_m: Option<f64>,
+    /// 95th percentile, metres; `None` likewise.
+    pub p95_cross_track_m: Option<f64>,
     /// Plan revision it ended on.
     pub revision: u32,
     /// Lost at the end.
@@ -404,10 +410,10 @@ pub struct ExecutionFigures {
     pub vehicles: Vec<VehicleFigures>,
     /// Reports received.
     pub reports: u64,
-    /// Telemetry latency, median, milliseconds.
-    pub latency_median_ms: f64,
-    /// Telemetry latency, 99th percentile, milliseconds.
-    pub latency_p99_ms: f64,
+    /// Telemetry latency, median, milliseconds; `None` without reports.
+    pub latency_median_ms: Option<f64>,
+    /// Telemetry latency, 99th percentile, milliseconds; `None` without reports.
+    pub latency_p99_ms: Option<f64>,
 }
 
 #[cfg(test)]

@@ -99,28 +99,46 @@ impl LogWriter {
     }
 }
 
-/// Reads a whole log; a bad line is an error naming the file, the line and what is wrong.
-pub fn read(path: &Path) -> anyhow::Result<Vec<Record>> {
+/// A log read back.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Log {
+    /// Its records, in order.
+    pub records: Vec<Record>,
+    /// The number of a last line cut short (no newline, not a whole record), left out: the
+    /// run was stopped while writing it.
+    pub cut_short: Option<usize>,
+}
+
+/// Reads a whole log; a bad line is an error naming the file, the line and what is wrong. Only
+/// a last line without its newline that is not a whole record is left out instead (and named
+/// in [`Log::cut_short`]): that is what a run killed mid-write leaves, and the records before
+/// it still tell the mission.
+pub fn read(path: &Path) -> anyhow::Result<Log> {
     let file = File::open(path)
         .with_context(|| format!("cannot open the mission log {}", path.display()))?;
+    let mut reader = BufReader::new(file);
     let mut records = Vec::new();
-    for (n, line) in BufReader::new(file).lines().enumerate() {
-        let line =
-            line.with_context(|| format!("{}: cannot read line {}", path.display(), n + 1))?;
+    let mut cut_short = None;
+    let mut line = String::new();
+    for n in 1.. {
+        line.clear();
+        let read = reader
+            .read_line(&mut line)
+            .with_context(|| format!("{}: cannot read line {n}", path.display()))?;
+        if read == 0 {
+            break;
+        }
         if line.trim().is_empty() {
             continue;
         }
-        let r: Record = serde_json::from_str(&line).map_err(|e| {
-            anyhow::anyhow!(
-                "{} line {}: not a mission-log record: {e}",
-                path.display(),
-                n + 1
-            )
-        })?;
-        records.push(r);
+        match serde_json::from_str::<Record>(&line) {
+            Ok(r) => records.push(r),
+            Err(_) if !line.ends_with('\n') => cut_short = Some(n),
+            Err(e) => anyhow::bail!("{} line {n}: not a mission-log record: {e}", path.display()),
+        }
     }
     match records.first() {
-        Some(Record::Start(_)) => Ok(records),
+        Some(Record::Start(_)) => Ok(Log { records, cut_short }),
         _ => anyhow::bail!(
             "{}: a mission log starts with a \"start\" record; this one does not",
             path.display()
@@ -158,13 +176,25 @@ mod tests {
         w.write(&start);
         w.write(&event);
         w.flush();
-        assert_eq!(read(&path)?, vec![start, event]);
+        assert_eq!(read(&path)?.records, vec![start.clone(), event.clone()]);
         let text = std::fs::read_to_string(&path)?;
         assert!(text
             .lines()
             .next()
             .unwrap_or("")
             .contains("\"record\":\"start\""));
+        // Killed mid-write: the last line has no newline and is half a record.
+        let cut = text.len() - 20;
+        std::fs::write(&path, &text[..cut])?;
+        let log = read(&path)?;
+        assert_eq!((log.records, log.cut_short), (vec![start.clone()], Some(2)));
+        // A whole last record without its newline is read.
+        std::fs::write(&path, text.trim_end())?;
+        assert_eq!(read(&path)?.records, vec![start, event]);
+        // The same half record with a newline after it is no cut: an error naming the line.
+        std::fs::write(&path, format!("{}\n{}", &text[..cut], text))?;
+        let e = read(&path).err().map(|e| e.to_string()).unwrap_or_default();
+        assert!(e.contains("line 2") && e.contains("m.ndjson"), "{e}");
         std::fs::write(&path, format!("{text}{{\"record\": \"nonsense\"}}\n"))?;
         let e = read(&path).err().map(|e| e.to_string()).unwrap_or_default();
         assert!(e.contains("line 3") && e.contains("m.ndjson"), "{e}");

@@ -2,6 +2,7 @@
 //! (`run`) and for `replay`, so the two say the same of the same figures.
 
 use super::fleet::{ExecutionFigures, VehicleFigures};
+use crate::summary::opt;
 
 /// Why the execution falls short: d_min broken, an executed track inside a hard obstacle (its
 /// physical sphere: the inflation is the planner's margin), an AUV's through the seabed or a
@@ -59,12 +60,12 @@ pub fn verdict_line(f: &ExecutionFigures) -> String {
 /// One vehicle's line of a summary: arrival, tracking error, clearances, reports.
 pub fn vehicle_line(v: &VehicleFigures) -> String {
     format!(
-        "  {:<8} arrived {:>8} {} | cross-track median {:.2} m, p95 {:.2} m, max {:.2} m | obstacle clearance {}{}{} | {} reports, revision {}{}\n",
+        "  {:<8} arrived {:>8} {} | cross-track median {} m, p95 {} m, max {:.2} m | obstacle clearance {}{}{} | {} reports, revision {}{}\n",
         v.vehicle,
         v.arrived_s.map_or("never".to_string(), |t| format!("{t:.0} s")),
         if v.in_window { "(in window)" } else { "(OUT of window)" },
-        v.median_cross_track_m,
-        v.p95_cross_track_m,
+        opt(v.median_cross_track_m, 2),
+        opt(v.p95_cross_track_m, 2),
         v.max_cross_track_m,
         v.min_obstacle_clearance_m
             .map_or("–".to_string(), |c| format!("{c:.1} m")),
@@ -89,11 +90,11 @@ mod tests {
             arrived_s: Some(420.0),
             in_window: true,
             max_cross_track_m: 2.0,
-            p95_cross_track_m: 1.5,
+            p95_cross_track_m: Some(1.5),
             min_obstacle_clearance_m: None,
             min_seabed_clearance_m: None,
             min_hazard_clearance_m: None,
-            median_cross_track_m: 1.0,
+            median_cross_track_m: Some(1.0),
             revision: 0,
             lost: false,
         }
@@ -110,8 +111,8 @@ mod tests {
             all_arrived_in_window: true,
             vehicles,
             reports: 20,
-            latency_median_ms: 0.2,
-            latency_p99_ms: 0.4,
+            latency_median_ms: Some(0.2),
+            latency_p99_ms: Some(0.4),
         }
     }
 
@@ -161,5 +162,10 @@ mod tests {
         let line = vehicle_line(&a);
         assert!(line.contains("above the seabed 37.5 m"), "{line}");
         assert!(line.ends_with(", LOST\n"), "{line}");
+        // No report: no median, no percentile.
+        a.median_cross_track_m = None;
+        a.p95_cross_track_m = None;
+        let line = vehicle_line(&a);
+        assert!(line.contains("cross-track median – m, p95 – m"), "{line}");
     }
 }
