@@ -169,6 +169,21 @@ pub fn run_command(args: &RunArgs, shutdown: Arc<AtomicBool>) -> anyhow::Result<
     let buffer = separation_buffer(args.separation_buffer, d_min)?;
     std::fs::create_dir_all(&p.out)
         .with_context(|| format!("cannot create output directory {}", p.out.display()))?;
+    // The log's directory too, as for --out, and before planning: a bad --log is told at once,
+    // not after the plan.
+    let log = args
+        .log
+        .clone()
+        .unwrap_or_else(|| p.out.join("mission.ndjson"));
+    if let Some(dir) = log.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).with_context(|| {
+            format!(
+                "--log (SHOAL_LOG) {}: cannot create its directory {}",
+                log.display(),
+                dir.display()
+            )
+        })?;
+    }
     let mut options = crate::distributed_options(p, &scenario)?;
     // The execution is the mission (its keys are shoal/<mission>/…); planning is its own.
     let mission = options.mission.clone();
@@ -200,10 +215,6 @@ pub fn run_command(args: &RunArgs, shutdown: Arc<AtomicBool>) -> anyhow::Result<
     options.mission = mission;
     options.agent_args = vec!["--position-noise".into(), args.position_noise.to_string()];
     options.log_dir = p.out.join("logs-exec");
-    let log = args
-        .log
-        .clone()
-        .unwrap_or_else(|| p.out.join("mission.ndjson"));
     let exec = ExecOptions {
         time_scale: args.time_scale,
         telemetry_hz: args.telemetry_hz,
@@ -365,6 +376,45 @@ mod tests {
                 "{bad}: {e:?}"
             );
         }
+    }
+
+    /// A --log whose directory cannot be made (a file stands there) is an error naming the
+    /// flag, told before any planning (it used to come after the plan, from the execution).
+    #[test]
+    fn a_bad_log_path_is_told_before_planning() -> anyhow::Result<()> {
+        use clap::Parser;
+        let dir = std::env::temp_dir().join(format!("shoal-run-log-{}", std::process::id()));
+        std::fs::create_dir_all(&dir)?;
+        let file = dir.join("a-file");
+        std::fs::write(&file, "")?;
+        let scenario = concat!(env!("CARGO_MANIFEST_DIR"), "/../scenarios/amp-pso-1.toml");
+        let log = file.join("m.ndjson");
+        let out = dir.join("out");
+        let cli = crate::cli::Cli::try_parse_from([
+            "shoal-coordinator".as_ref(),
+            "run".as_ref(),
+            scenario.as_ref(),
+            "--in-process".as_ref(),
+            "--iterations".as_ref(),
+            "3".as_ref(),
+            "--log".as_ref(),
+            log.as_os_str(),
+            "--out".as_ref(),
+            out.as_os_str(),
+        ] as [&std::ffi::OsStr; 10])?;
+        let crate::cli::Command::Run(args) = cli.command else {
+            anyhow::bail!("not a run command");
+        };
+        let e = run_command(&args, Arc::new(AtomicBool::new(false)))
+            .err()
+            .map(|e| format!("{e:#}"))
+            .unwrap_or_default();
+        std::fs::remove_dir_all(&dir)?;
+        assert!(
+            e.contains("--log (SHOAL_LOG)") && e.contains("a-file"),
+            "{e}"
+        );
+        Ok(())
     }
 
     #[test]
