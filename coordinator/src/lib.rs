@@ -171,27 +171,42 @@ fn compare_command(args: &compare::CompareArgs, stop: &Arc<AtomicBool>) -> anyho
 pub fn load_scenario(args: &PlanArgs) -> anyhow::Result<Scenario> {
     let mut s = Scenario::load(&args.scenario)?;
     let o = &mut s.optimizer;
+    // The flags given, as typed, for an error that would otherwise blame the file.
+    let mut given = Vec::new();
     if let Some(v) = args.seed {
         o.seed = v;
+        given.push(format!("--seed {v}"));
     }
     if let Some(v) = args.algorithm {
         o.algorithm = v;
+        given.push(format!("--algorithm {}", v.as_str()));
     }
     if let Some(v) = args.iterations {
         o.iterations = v;
+        given.push(format!("--iterations {v}"));
     }
     if let Some(v) = args.populations {
         o.populations = v;
+        given.push(format!("--populations {v}"));
     }
     if let Some(v) = args.particles {
         o.particles = v;
+        given.push(format!("--particles {v}"));
     }
     if let Some(v) = args.threads {
         o.threads = v;
+        given.push(format!("--threads {v}"));
     }
-    // Overrides are user input too: check them with the same rules, naming the flag's field.
-    s.validate(&args.scenario)?;
-    Ok(s)
+    // Overrides are user input too: check them with the same rules, naming the field, and
+    // saying that the command line set it.
+    match s.validate(&args.scenario) {
+        Ok(()) => Ok(s),
+        Err(e) if given.is_empty() => Err(e.into()),
+        Err(e) => Err(anyhow::Error::new(e).context(format!(
+            "with the command line's {} over the scenario file",
+            given.join(" ")
+        ))),
+    }
 }
 
 /// A duration from a number of seconds given by the user, or an error naming the flag.
@@ -414,5 +429,40 @@ impl Progress {
         if let Some(b) = &self.bar {
             b.finish_and_clear();
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::Parser;
+
+    fn plan_args(extra: &[&str]) -> anyhow::Result<PlanArgs> {
+        let scenario = concat!(env!("CARGO_MANIFEST_DIR"), "/../scenarios/amp-pso-1.toml");
+        let mut line = vec!["shoal-coordinator", "plan", scenario, "--in-process"];
+        line.extend_from_slice(extra);
+        match cli::Cli::try_parse_from(line)?.command {
+            cli::Command::Plan(a) => Ok(a),
+            _ => anyhow::bail!("not a plan command"),
+        }
+    }
+
+    /// A flag that breaks a rule is named as the command line's, not blamed on the file; the
+    /// file's own fields are checked as before.
+    #[test]
+    fn an_override_that_breaks_a_rule_is_told_as_the_command_lines() -> anyhow::Result<()> {
+        let e = load_scenario(&plan_args(&["--iterations", "0", "--seed", "4"])?)
+            .err()
+            .map(|e| format!("{e:#}"))
+            .unwrap_or_default();
+        assert!(
+            e.starts_with(
+                "with the command line's --seed 4 --iterations 0 over the scenario file: "
+            ) && e.contains("`optimizer.iterations` = 0"),
+            "{e}"
+        );
+        let s = load_scenario(&plan_args(&["--iterations", "7"])?)?;
+        assert_eq!(s.optimizer.iterations, 7);
+        Ok(())
     }
 }
