@@ -41,12 +41,12 @@ pub struct VehiclePlan {
     pub hard_collisions: usize,
     /// Metres of path inside inflated soft obstacles.
     pub soft_exposure_m: f64,
-    /// Crawlers only: the seed 000 figures of the path on the seabed.
     /// An AUV over a seabed: the lowest height of its path above the seabed, metres (sampled
     /// every [`crate::cost::SEABED_STEP_M`]; under the scenario's clearance is a violation).
     /// Absent for a crawler or without a seabed.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub min_seabed_clearance_m: Option<f64>,
+    /// Crawlers only: the seed 000 figures of the path on the seabed.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub crawler: Option<crate::crawler::CrawlerFigures>,
     /// Energy-planned AUVs only: seed 001's figures (q_path, q_e, q_r, q_a, f_f, …).
