@@ -13,7 +13,8 @@
 //! | F_i(S) | eq. (11) integrated over time: seconds closer than d_min to any other vehicle | s | 1 s ("one point per second") |
 //!
 //! The penalty `P` (weight `W = optimizer.penalty_weight`) counts what makes a plan infeasible:
-//! hard-obstacle intrusions, turns beyond the limit, pitch beyond the limit and separation breaches,
+//! hard-obstacle intrusions, an AUV's legs closer to the seabed than its clearance
+//! ([`seabed_penalty`]), turns beyond the limit, pitch beyond the limit and separation breaches,
 //! each as `count + depth of the breach relative to its limit`, so the swarm feels both how many
 //! and how bad.
 
