@@ -142,7 +142,7 @@ pub struct OptimizerSettings {
     /// λ1..λ5 of eq. (12): length, depth, soft threat, time, space (§4.1.4).
     pub weights: [f64; 5],
     /// Weight of the constraint penalties (hard obstacles, turn, pitch, separation) that turn the
-    /// constrained problem into an unconstrained one (§3.3.1, ref. [30]).
+    /// constrained problem into an unconstrained one (§3.3.1, ref. \[30\]).
     pub penalty_weight: f64,
     /// Velocity limit per dimension as a fraction of that dimension's range, for whichever
     /// algorithm plans. Unset, each algorithm keeps its own ([`OptimizerSettings::velocity_cap`]):

@@ -1,4 +1,4 @@
-//! NSPSO, seed 000's non-dominated sorting PSO baseline (ref. [46], Li 2003) with the settings of
+//! NSPSO, seed 000's non-dominated sorting PSO baseline (ref. \[46\], Li 2003) with the settings of
 //! Table 4 (functions: M = 30, t_max = 300) and Table 8 (crawler path: M = 50, t_max = 100):
 //! c1 = c2 = 2 and an inertia weight falling linearly from ω_max = 0.9 to ω_min = 0.4. The seed
 //! gives nothing more, so Shoal reads Li's algorithm as follows.
