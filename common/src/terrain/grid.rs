@@ -84,6 +84,9 @@ pub struct HeightGrid {
     pub rows: usize,
     /// Heights row-major, south row first; private so its length always matches `cols × rows`.
     heights: Vec<f64>,
+    /// The highest of `heights`, kept from construction: the seabed's ceiling is asked for
+    /// on every fitness evaluation of an AUV over the grid.
+    max_height: f64,
 }
 
 /// The "not a number" error for `text` at `file:line` (an empty field is shown as `(empty)`).
@@ -117,6 +120,11 @@ fn locate(coord: f64, origin: f64, cell: f64, nodes: usize) -> (usize, f64, bool
     (i, fc - i as f64, (0.0..=max).contains(&f))
 }
 
+/// The highest of `heights` (−∞ for none).
+fn highest(heights: &[f64]) -> f64 {
+    heights.iter().copied().fold(f64::NEG_INFINITY, f64::max)
+}
+
 impl HeightGrid {
     /// Builds a grid from heights given row-major, south row first.
     pub fn new(
@@ -139,12 +147,14 @@ impl HeightGrid {
         if !origin.iter().chain(&heights).all(|v| v.is_finite()) {
             return fail("origin and heights must be finite".to_string());
         }
+        let max_height = highest(&heights);
         Ok(Self {
             origin,
             cell_m,
             cols,
             rows,
             heights,
+            max_height,
         })
     }
 
@@ -171,10 +181,7 @@ impl HeightGrid {
     /// The highest node: no bilinear patch, and no clamped position outside the grid, is
     /// higher.
     pub fn max_height(&self) -> f64 {
-        self.heights
-            .iter()
-            .copied()
-            .fold(f64::NEG_INFINITY, f64::max)
+        self.max_height
     }
 
     /// Bilinear height at `(x, y)`, clamped to the edge outside the grid.
@@ -196,13 +203,15 @@ impl HeightGrid {
     /// Assembles rows read north first (like an image) into a south-first grid.
     fn from_north_rows(origin: [f64; 2], cell_m: f64, cols: usize, rows: Vec<Vec<f64>>) -> Self {
         let n = rows.len();
-        let heights = rows.into_iter().rev().flatten().collect();
+        let heights: Vec<f64> = rows.into_iter().rev().flatten().collect();
+        let max_height = highest(&heights);
         Self {
             origin,
             cell_m,
             cols,
             rows: n,
             heights,
+            max_height,
         }
     }
 
