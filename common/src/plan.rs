@@ -175,7 +175,8 @@ pub fn assess(scenario: &Scenario, trajectories: &[Trajectory]) -> Assessment {
         }
         let seabed = match (&crawler, scenario.swimmer_seabed()) {
             (None, Some((terrain, keep))) => {
-                let lowest = lowest_over_seabed(pts, terrain);
+                // The planner's cost samples the same points.
+                let lowest = terrain.lowest_height_on_path(pts, crate::cost::SEABED_STEP_M);
                 if let Some((h, p)) = lowest.filter(|(h, _)| *h < keep - TOL) {
                     let how = if h < 0.0 {
                         format!("goes {:.1} m into", -h)
@@ -286,21 +287,6 @@ pub fn assess(scenario: &Scenario, trajectories: &[Trajectory]) -> Assessment {
         fleet,
         violations,
     }
-}
-
-/// Lowest height of the polyline `points` above `terrain` and where, every
-/// [`crate::cost::SEABED_STEP_M`] along each leg (the planner's cost samples the same points);
-/// `None` without points.
-fn lowest_over_seabed(
-    points: &[crate::geometry::Vec3],
-    terrain: &crate::terrain::Terrain,
-) -> Option<(f64, crate::geometry::Vec3)> {
-    let first = points.first()?;
-    let legs = points
-        .windows(2)
-        .map(|w| terrain.lowest_height_along(&w[0], &w[1], crate::cost::SEABED_STEP_M));
-    let one = terrain.lowest_height_along(first, first, 1.0);
-    Some(legs.fold(one, |a, b| if b.0 < a.0 { b } else { a }))
 }
 
 /// Plain-words notes that are not violations: why the common arrival differs from the mission

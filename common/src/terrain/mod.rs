@@ -244,6 +244,20 @@ impl Terrain {
                 |best, h| if h.0 < best.0 { h } else { best },
             )
     }
+
+    /// Lowest height above the seabed of the polyline `points` and where
+    /// ([`Terrain::lowest_height_along`] on each leg; a lone point is its own height); `None`
+    /// without points. What a plan's AUV path and an executed track are both measured with.
+    pub fn lowest_height_on_path(&self, points: &[Vec3], step: f64) -> Option<(f64, Vec3)> {
+        let first = points.first()?;
+        let start = (first.z - self.elevation(first.x, first.y), *first);
+        Some(
+            points
+                .windows(2)
+                .map(|w| self.lowest_height_along(&w[0], &w[1], step))
+                .fold(start, |best, h| if h.0 < best.0 { h } else { best }),
+        )
+    }
 }
 
 /// Horizontal clearance of segment `a→b` from hazard `h` (seed 000 eq. (4)): distance from the

@@ -63,13 +63,9 @@ pub(super) fn obstacle_clearance(track: &Trajectory, obstacles: &[Obstacle]) -> 
 /// [`SEABED_STEP_M`] along each segment; `None` without fixes. An AUV's simulator does not
 /// stop at the seabed, so this is how a run learns that a vehicle would have hit it.
 pub(super) fn seabed_clearance(track: &Trajectory, seabed: &Terrain) -> Option<f64> {
-    let first = track.points.first()?;
-    let legs = track.points.windows(2);
-    Some(
-        legs.fold(first.z - seabed.elevation(first.x, first.y), |best, w| {
-            best.min(seabed.lowest_height_along(&w[0], &w[1], SEABED_STEP_M).0)
-        }),
-    )
+    seabed
+        .lowest_height_on_path(&track.points, SEABED_STEP_M)
+        .map(|(h, _)| h)
 }
 
 /// Closest `track` came to any of `hazards` horizontally, metres (negative: inside one); `None`
