@@ -189,11 +189,7 @@ pub fn assess(scenario: &Scenario, trajectories: &[Trajectory]) -> Assessment {
                         p.x,
                         p.y,
                         keep,
-                        if scenario.optimizer.algorithm.is_energy_planner() {
-                            "energy.terrain_clearance_m"
-                        } else {
-                            "seabed.auv_clearance_m"
-                        }
+                        scenario.swimmer_clearance().map_or("", |(_, setting)| setting)
                     ));
                 }
                 lowest.map(|(h, _)| h)

@@ -547,13 +547,22 @@ impl Scenario {
     /// energy mission's `energy.terrain_clearance_m` (seed 001), else `seabed.auv_clearance_m`;
     /// `None` without a seabed.
     pub fn swimmer_seabed(&self) -> Option<(&crate::terrain::Terrain, f64)> {
+        let terrain = self.seabed.as_ref()?.terrain.as_ref()?;
+        Some((terrain, self.swimmer_clearance()?.0))
+    }
+
+    /// A swimmer's seabed clearance, metres, and the setting that gives it (for messages);
+    /// `None` without a seabed.
+    pub fn swimmer_clearance(&self) -> Option<(f64, &'static str)> {
         let seabed = self.seabed.as_ref()?;
-        let clearance = if self.optimizer.algorithm.is_energy_planner() {
-            self.energy.terrain_clearance_m
+        Some(if self.optimizer.algorithm.is_energy_planner() {
+            (
+                self.energy.terrain_clearance_m,
+                "energy.terrain_clearance_m",
+            )
         } else {
-            seabed.auv_clearance_m
-        };
-        Some((seabed.terrain.as_ref()?, clearance))
+            (seabed.auv_clearance_m, "seabed.auv_clearance_m")
+        })
     }
 
     /// Hard obstacles only.
