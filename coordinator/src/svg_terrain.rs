@@ -155,11 +155,8 @@ pub fn draw_seabed_under_paths(
         return Ok(());
     };
     for (i, v) in plan.vehicles.iter().enumerate() {
-        let swimmer = scenario
-            .vehicles
-            .iter()
-            .any(|s| s.id == v.id && s.kind != VehicleKind::Crawler);
-        if !swimmer {
+        // The plan gives exactly the AUVs over the seabed a height above it.
+        if v.min_seabed_clearance_m.is_none() {
             continue;
         }
         let mut dots = Vec::new();
