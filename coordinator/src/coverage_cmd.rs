@@ -12,10 +12,25 @@ use shoal_common::coverage::boxes::Rect;
 use shoal_common::coverage::metrics::Distribution;
 use shoal_common::coverage::mission::{build_map, run_coverage, CoverageReport};
 use shoal_common::coverage::params::DetourMethod;
+use shoal_common::coverage::path::CoveragePath;
+use shoal_common::coverage::TerrainMap25;
 use shoal_common::scenario::{CoverageSettings, Scenario};
 
 use crate::summary::opt;
 use crate::svg_coverage::render_coverage;
+
+/// What a planned coverage mission leaves for `run`: whether it passes, and each crawler's
+/// exact path and start delay (scenario order) on the map they were planned on.
+pub struct PlannedCoverage {
+    /// The plan passes ([`passes`]; a fleet's also keeps d_min).
+    pub feasible: bool,
+    /// Each crawler's path, scenario order.
+    pub paths: Vec<CoveragePath>,
+    /// Each crawler's start delay, seconds (a fleet's separation timing; 0 alone).
+    pub start_delays_s: Vec<f64>,
+    /// The seabed map.
+    pub map: TerrainMap25,
+}
 
 /// `plan.json` of a coverage mission.
 #[derive(Debug, Serialize)]
@@ -72,9 +87,9 @@ pub fn scenario_area(scenario: &Scenario) -> Rect {
     Rect::new(b.min[0], b.min[1], b.max[0], b.max[1])
 }
 
-/// Runs the mission of `scenario` (which has a `[coverage]` table) into `out`; returns whether
-/// the plan is feasible. A raised `stop` (Ctrl-C) cuts the tracking simulation short; the plan
-/// is still written, marked `Interrupted`.
+/// Runs the mission of `scenario` (which has a `[coverage]` table) into `out`; returns the plan.
+/// A raised `stop` (Ctrl-C) cuts the tracking simulation short; the plan is still written,
+/// marked `Interrupted`.
 pub fn plan_coverage_command(
     scenario_file: &Path,
     scenario: &Scenario,
@@ -82,7 +97,7 @@ pub fn plan_coverage_command(
     out: &Path,
     quiet: bool,
     stop: &AtomicBool,
-) -> anyhow::Result<bool> {
+) -> anyhow::Result<PlannedCoverage> {
     let seed = settings.terrain_seed.unwrap_or(scenario.optimizer.seed);
     let dir = scenario_file.parent().unwrap_or(Path::new("."));
     let map = build_map(settings, seed, dir)
@@ -95,7 +110,7 @@ pub fn plan_coverage_command(
         }
     };
     let terrain_seed = settings.heightmap.is_none().then_some(seed);
-    let (report, _) = run_coverage(
+    let (report, plan) = run_coverage(
         settings,
         &map,
         scenario_area(scenario),
@@ -117,7 +132,12 @@ pub fn plan_coverage_command(
     };
     let svg = render_coverage(&report, &map)?;
     write_outputs(out, &file, &svg, summary(&scenario.name, &report), &notices)?;
-    Ok(feasible)
+    Ok(PlannedCoverage {
+        feasible,
+        paths: vec![plan.path],
+        start_delays_s: vec![0.0],
+        map,
+    })
 }
 
 /// Writes `plan.json` (from `file`) and `plan.svg` into `out`, then prints `summary`, the

@@ -15,7 +15,9 @@ use shoal_common::coverage::TerrainMap25;
 use shoal_common::plan::DistributedFigures;
 use shoal_common::scenario::Scenario;
 
-use crate::coverage_cmd::{clearance_words, notices, passes, write_outputs, CoverageTermination};
+use crate::coverage_cmd::{
+    clearance_words, notices, passes, write_outputs, CoverageTermination, PlannedCoverage,
+};
 use crate::distributed::{plan_strips_distributed, DistributedOptions};
 use crate::svg_coverage::render_fleet_coverage;
 
@@ -40,7 +42,7 @@ pub struct FleetCoveragePlanFile<'a> {
 }
 
 /// Plans `scenario`'s fleet coverage into `out`; `distributed` runs it over agents. Returns
-/// whether the plan is feasible. A raised `stop` (Ctrl-C) cuts the crawlers' tracking
+/// the plan. A raised `stop` (Ctrl-C) cuts the crawlers' tracking
 /// simulations short, the agents' too; every strip is still planned whole.
 pub fn plan_fleet_coverage(
     scenario_file: &Path,
@@ -49,7 +51,7 @@ pub fn plan_fleet_coverage(
     quiet: bool,
     distributed: Option<&DistributedOptions>,
     stop: &Arc<AtomicBool>,
-) -> anyhow::Result<bool> {
+) -> anyhow::Result<PlannedCoverage> {
     let job = FleetCoverage::new(scenario)
         .map_err(|e| anyhow::anyhow!("{}: {e}", scenario_file.display()))?;
     let dir = scenario_file.parent().unwrap_or(Path::new("."));
@@ -91,6 +93,7 @@ pub fn plan_fleet_coverage(
         }
     };
     say("coverage fleet: timing the crawlers apart".into());
+    let paths = plans.iter().map(|p| p.path.clone()).collect();
     let report = assemble(&job, &map, plans);
     let notices = fleet_notices(&report, scenario, figures.as_ref());
     let sep = &report.separation;
@@ -114,7 +117,12 @@ pub fn plan_fleet_coverage(
         fleet_summary(&scenario.name, &report),
         &notices,
     )?;
-    Ok(feasible)
+    Ok(PlannedCoverage {
+        feasible,
+        paths,
+        start_delays_s: report.separation.start_delays_s.clone(),
+        map,
+    })
 }
 
 /// Every strip on its own thread (the machine's cores share them).

@@ -10,6 +10,7 @@ pub mod cli;
 pub mod compare;
 pub mod coverage_cmd;
 pub mod coverage_fleet;
+pub mod coverage_run;
 pub mod crawler_table;
 pub mod distributed;
 pub mod energy_planner;
@@ -247,49 +248,66 @@ pub fn distributed_options(
     })
 }
 
+/// Plans a `[coverage]` mission as `plan` does (`run` too): one crawler in this process, a
+/// fleet over its agents (with the options `distributed` gives) unless `--in-process`; writes
+/// `plan.json` and `plan.svg` into `--out`.
+pub fn plan_coverage_mission(
+    args: &PlanArgs,
+    scenario: &Scenario,
+    shutdown: &Arc<AtomicBool>,
+    distributed: impl FnOnce() -> anyhow::Result<distributed::DistributedOptions>,
+) -> anyhow::Result<coverage_cmd::PlannedCoverage> {
+    let Some(settings) = &scenario.coverage else {
+        bail!("{}: no [coverage] table", args.scenario.display());
+    };
+    let fleet = scenario.vehicles.len() > 1;
+    if !fleet && !args.in_process {
+        bail!(
+            "{}: a [coverage] mission with one crawler plans inside this process: add --in-process (several crawlers split the area among their agents)",
+            args.scenario.display()
+        );
+    }
+    if let Some(a) = args.algorithm {
+        eprintln!(
+            "note: --algorithm {} is not used: a [coverage] mission plans with seed 002's Boustrophedon",
+            a.as_str()
+        );
+    }
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("cannot create output directory {}", args.out.display()))?;
+    if fleet {
+        let options = if args.in_process {
+            None
+        } else {
+            Some(distributed()?)
+        };
+        coverage_fleet::plan_fleet_coverage(
+            &args.scenario,
+            scenario,
+            &args.out,
+            args.quiet,
+            options.as_ref(),
+            shutdown,
+        )
+    } else {
+        coverage_cmd::plan_coverage_command(
+            &args.scenario,
+            scenario,
+            settings,
+            &args.out,
+            args.quiet,
+            shutdown,
+        )
+    }
+}
+
 fn plan_command(args: &PlanArgs, shutdown: Arc<AtomicBool>) -> anyhow::Result<i32> {
     let scenario = load_scenario(args)?;
-    if let Some(settings) = &scenario.coverage {
-        let fleet = scenario.vehicles.len() > 1;
-        if !fleet && !args.in_process {
-            bail!(
-                "{}: a [coverage] mission with one crawler plans inside this process: add --in-process (several crawlers split the area among their agents)",
-                args.scenario.display()
-            );
-        }
-        if let Some(a) = args.algorithm {
-            eprintln!(
-                "note: --algorithm {} is not used: a [coverage] mission plans with seed 002's Boustrophedon",
-                a.as_str()
-            );
-        }
-        std::fs::create_dir_all(&args.out)
-            .with_context(|| format!("cannot create output directory {}", args.out.display()))?;
-        let feasible = if fleet {
-            let options = if args.in_process {
-                None
-            } else {
-                Some(distributed_options(args, &scenario)?)
-            };
-            coverage_fleet::plan_fleet_coverage(
-                &args.scenario,
-                &scenario,
-                &args.out,
-                args.quiet,
-                options.as_ref(),
-                &shutdown,
-            )?
-        } else {
-            coverage_cmd::plan_coverage_command(
-                &args.scenario,
-                &scenario,
-                settings,
-                &args.out,
-                args.quiet,
-                &shutdown,
-            )?
-        };
-        return Ok(if feasible {
+    if scenario.coverage.is_some() {
+        let planned = plan_coverage_mission(args, &scenario, &shutdown, || {
+            distributed_options(args, &scenario)
+        })?;
+        return Ok(if planned.feasible {
             EXIT_FEASIBLE
         } else {
             EXIT_VIOLATIONS

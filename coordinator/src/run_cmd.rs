@@ -8,9 +8,11 @@ use std::sync::Arc;
 use std::time::Duration;
 
 use anyhow::{bail, Context as _};
-use shoal_common::scenario::{Obstacle, ObstacleKind};
+use shoal_common::scenario::{Obstacle, ObstacleKind, Scenario};
+use shoal_common::trajectory::Trajectory;
 
 use crate::cli::PlanArgs;
+use crate::coverage_run;
 use crate::execute::{self, verdict, ExecOptions, ExecutionReport};
 use crate::{distributed, planner, say, summary, write_outputs, write_svg, Progress};
 use crate::{EXIT_FEASIBLE, EXIT_VIOLATIONS};
@@ -136,17 +138,96 @@ fn separation_buffer(flag: Option<f64>, d_min: f64) -> anyhow::Result<f64> {
     Ok(buffer)
 }
 
+/// What `run` executes: the scenario the agents get (a coverage mission's starts moved to its
+/// paths), every vehicle's timed trajectory (scenario order) and the time they are timed to end.
+pub struct Executable {
+    /// The scenario sent to the agents.
+    pub scenario: Scenario,
+    /// Per vehicle, mission-timed.
+    pub trajectories: Vec<Trajectory>,
+    /// The common arrival (a coverage fleet: the last crawler's finish).
+    pub common_arrival_s: f64,
+}
+
+/// Plans a fleet, energy or tour mission as `plan` does and writes its outputs; `None` (after
+/// saying why) when the plan is not to be executed: infeasible, or Ctrl-C while planning.
+fn plan_trajectories(
+    p: &PlanArgs,
+    scenario: &Scenario,
+    options: &distributed::DistributedOptions,
+    shutdown: &Arc<AtomicBool>,
+) -> anyhow::Result<Option<Executable>> {
+    let mut progress = Progress::new(scenario.optimizer.iterations, p.quiet);
+    let plan = if p.in_process {
+        planner::plan_in_process(scenario, Some(Arc::clone(shutdown)), &mut |r| {
+            progress.update(r)
+        })
+    } else {
+        distributed::plan_distributed(scenario, options, shutdown, &mut |s| {
+            progress.update_distributed(s)
+        })?
+    };
+    progress.finish();
+    write_outputs(&p.out, &plan)?;
+    write_svg(&p.out, scenario, &plan)?;
+    say(&summary::summary(&plan));
+    if !executable(&plan_state(&plan, shutdown)) {
+        return Ok(None);
+    }
+    Ok(Some(Executable {
+        scenario: scenario.clone(),
+        trajectories: plan
+            .vehicles
+            .iter()
+            .map(|v| Trajectory::from_samples(&v.trajectory))
+            .collect(),
+        common_arrival_s: plan.common_arrival_s,
+    }))
+}
+
+/// How planning ended, as far as executing it goes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum PlanState {
+    /// Feasible and whole.
+    Ready,
+    /// Ctrl-C while planning.
+    Interrupted,
+    /// With violations.
+    Infeasible,
+}
+
+fn plan_state(plan: &shoal_common::plan::Plan, shutdown: &AtomicBool) -> PlanState {
+    if shutdown.load(Ordering::Relaxed) {
+        PlanState::Interrupted
+    } else if !plan.feasible {
+        PlanState::Infeasible
+    } else {
+        PlanState::Ready
+    }
+}
+
+/// Whether a plan in `state` is executed; says why not on stderr.
+pub(crate) fn executable(state: &PlanState) -> bool {
+    match state {
+        PlanState::Ready => true,
+        // Ctrl-C while planning asks for the plan so far, not for a mission started and
+        // stopped at once.
+        PlanState::Interrupted => {
+            eprintln!("interrupted while planning: the plan so far is written, it is not executed");
+            false
+        }
+        PlanState::Infeasible => {
+            eprintln!("the plan is not feasible: it is not executed (see plan.json)");
+            false
+        }
+    }
+}
+
 /// Plans, then executes; exit 0 when the execution kept d_min, stayed out of every hard
 /// obstacle and every vehicle arrived in the window, 3 otherwise.
 pub fn run_command(args: &RunArgs, shutdown: Arc<AtomicBool>) -> anyhow::Result<i32> {
     let p = &args.plan;
     let scenario = crate::load_scenario(p)?;
-    if scenario.coverage.is_some() {
-        bail!(
-            "{}: `run` executes timed trajectories (fleet plans, energy plans, inspection tours); a [coverage] mission's plan cannot be executed yet",
-            p.scenario.display()
-        );
-    }
     positive("--time-scale (SHOAL_TIME_SCALE)", args.time_scale)?;
     positive("--telemetry-hz (SHOAL_TELEMETRY_HZ)", args.telemetry_hz)?;
     positive("--horizon (SHOAL_HORIZON)", args.horizon)?;
@@ -188,30 +269,19 @@ pub fn run_command(args: &RunArgs, shutdown: Arc<AtomicBool>) -> anyhow::Result<
     // The execution is the mission (its keys are shoal/<mission>/…); planning is its own.
     let mission = options.mission.clone();
     options.mission = format!("{mission}-plan");
-    let mut progress = Progress::new(scenario.optimizer.iterations, p.quiet);
-    let plan = if p.in_process {
-        planner::plan_in_process(&scenario, Some(Arc::clone(&shutdown)), &mut |r| {
-            progress.update(r)
-        })
+    let executable = if scenario.coverage.is_some() {
+        coverage_run::plan(p, &scenario, &options, buffer, &shutdown)?
     } else {
-        distributed::plan_distributed(&scenario, &options, &shutdown, &mut |s| {
-            progress.update_distributed(s)
-        })?
+        plan_trajectories(p, &scenario, &options, &shutdown)?
     };
-    progress.finish();
-    write_outputs(&p.out, &plan)?;
-    write_svg(&p.out, &scenario, &plan)?;
-    say(&summary::summary(&plan));
-    if shutdown.load(Ordering::Relaxed) {
-        // Ctrl-C while planning asks for the plan so far, not for a mission started and
-        // stopped at once.
-        eprintln!("interrupted while planning: the plan so far is written, it is not executed");
+    let Some(Executable {
+        scenario,
+        trajectories,
+        common_arrival_s,
+    }) = executable
+    else {
         return Ok(EXIT_VIOLATIONS);
-    }
-    if !plan.feasible {
-        eprintln!("the plan is not feasible: it is not executed (see plan.json)");
-        return Ok(EXIT_VIOLATIONS);
-    }
+    };
     options.mission = mission;
     options.agent_args = vec!["--position-noise".into(), args.position_noise.to_string()];
     options.log_dir = p.out.join("logs-exec");
@@ -242,9 +312,7 @@ pub fn run_command(args: &RunArgs, shutdown: Arc<AtomicBool>) -> anyhow::Result<
                                     "--inject-obstacle: the scenario has no vehicle {v:?}"
                                 )
                             })?;
-                        let tr = &plan.vehicles[i].trajectory;
-                        let traj = shoal_common::trajectory::Trajectory::from_samples(tr);
-                        let c = traj.position_at(t + AHEAD_S);
+                        let c = trajectories[i].position_at(t + AHEAD_S);
                         [c.x, c.y, c.z]
                     }
                 };
@@ -270,7 +338,14 @@ pub fn run_command(args: &RunArgs, shutdown: Arc<AtomicBool>) -> anyhow::Result<
         scenario.vehicles.len(),
         args.telemetry_hz
     );
-    let report = execute::execute(&scenario, &plan, &options, &exec, &shutdown)?;
+    let report = execute::execute_trajectories(
+        &scenario,
+        &trajectories,
+        common_arrival_s,
+        &options,
+        &exec,
+        &shutdown,
+    )?;
     let path = p.out.join("execution.json");
     let json = serde_json::to_string_pretty(&report).context("cannot serialise the execution")?;
     std::fs::write(&path, json).with_context(|| format!("cannot write {}", path.display()))?;

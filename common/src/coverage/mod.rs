@@ -19,6 +19,7 @@
 pub mod arcs;
 pub mod boustrophedon;
 pub mod boxes;
+pub mod drive;
 pub mod dubins;
 pub mod edt;
 pub mod fleet;

@@ -532,15 +532,18 @@ impl Scenario {
     /// The turning radius vehicle `i` executes with, metres: its own `turn_radius_m`, else for
     /// a seed 001 energy mission the R_AUV its plan was made for (`energy.min_turn_radius_m`:
     /// the plan's climbing turns are that tight, and a wider-turning vehicle cannot fly them),
-    /// else `None` (the simulator's default).
+    /// for a seed 002 coverage crawler the R_min its U-turns and detour arcs were planned with
+    /// (`coverage.planner.min_turn_radius_m`), else `None` (the simulator's default).
     pub fn execution_turn_radius_m(&self, i: usize) -> Option<f64> {
         let v = self.vehicles.get(i)?;
-        v.turn_radius_m.or_else(|| {
-            self.optimizer
-                .algorithm
-                .is_energy_planner()
-                .then_some(self.energy.min_turn_radius_m)
-        })
+        v.turn_radius_m
+            .or_else(|| self.coverage.as_ref().map(|c| c.planner.min_turn_radius_m))
+            .or_else(|| {
+                self.optimizer
+                    .algorithm
+                    .is_energy_planner()
+                    .then_some(self.energy.min_turn_radius_m)
+            })
     }
 
     /// The seabed a swimming vehicle must keep off, with the height it keeps above it: an

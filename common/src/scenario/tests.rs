@@ -177,7 +177,7 @@ fn the_velocity_cap_is_the_algorithms_own_unless_the_file_sets_one() -> Result<(
 }
 
 #[test]
-fn a_vehicle_executes_with_its_own_turn_radius_else_the_energy_plans_r_auv(
+fn a_vehicle_executes_with_its_own_turn_radius_else_the_radius_its_plan_was_made_for(
 ) -> Result<(), ScenarioError> {
     // A fleet scenario with no turn radius leaves the simulator's default.
     let fleet = parse(GOOD)?;
@@ -194,5 +194,11 @@ fn a_vehicle_executes_with_its_own_turn_radius_else_the_energy_plans_r_auv(
         Path::new("scenarios/epa-pso.toml"),
     )?;
     assert_eq!(epa.execution_turn_radius_m(0), Some(8.0));
+    // The shipped seed 002 mission: its U-turns are semicircles of R_min = 5 m.
+    let cpp = Scenario::parse(
+        include_str!("../../../scenarios/cpp-seabed.toml"),
+        Path::new("scenarios/cpp-seabed.toml"),
+    )?;
+    assert_eq!(cpp.execution_turn_radius_m(0), Some(5.0));
     Ok(())
 }

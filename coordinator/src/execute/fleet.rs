@@ -51,13 +51,26 @@ pub struct Tracked {
     pub cross_track: Vec<f64>,
     /// Mission time of its first `arrived` report.
     pub arrived_s: Option<f64>,
+    /// When its first plan has it arrive, mission seconds: its arrival window is around this
+    /// (the common arrival of a synchronised fleet; a coverage crawler's own finish).
+    pub planned_arrival_s: f64,
     /// Declared lost (silent too long).
     pub lost: bool,
     /// Commanded to hold.
     pub holding: bool,
+    /// When the hold was commanded, mission seconds (`None` unless holding).
+    pub held_since_s: Option<f64>,
 }
 
 impl Tracked {
+    /// Where on its plan a holding vehicle stopped, as a plan time: the nearest point of the
+    /// plan to where it is, searched around the time it was told to hold (its plan went on
+    /// without it). `None` when it is not holding.
+    pub fn resume_s(&self) -> Option<f64> {
+        let since = self.held_since_s.filter(|_| self.holding)?;
+        Some(picture::progress(&self.plan, self.position(), since, PROGRESS_WINDOW_S).plan_time_s)
+    }
+
     /// Latest position fix, or the plan's start before any.
     pub fn position(&self) -> Vec3 {
         match &self.last {
@@ -112,8 +125,10 @@ impl Fleet {
                     anchor: None,
                     cross_track: Vec::new(),
                     arrived_s: None,
+                    planned_arrival_s: plan.arrival(),
                     lost: false,
                     holding: false,
+                    held_since_s: None,
                 })
                 .collect(),
             d_min,
@@ -319,9 +334,10 @@ impl Fleet {
                 vehicle: v.id.clone(),
                 reports: v.fixes,
                 arrived_s: v.arrived_s,
+                planned_arrival_s: Some(v.planned_arrival_s),
                 in_window: v
                     .arrived_s
-                    .is_some_and(|t| (t - common_arrival_s).abs() <= window_s),
+                    .is_some_and(|t| (t - v.planned_arrival_s).abs() <= window_s),
                 max_cross_track_m: v.cross_track.iter().copied().fold(0.0, f64::max),
                 min_obstacle_clearance_m: obstacle_clearance(&v.track, obstacles),
                 min_seabed_clearance_m: None,
@@ -363,7 +379,11 @@ pub struct VehicleFigures {
     pub reports: usize,
     /// Mission time of its first `arrived` report (resolution: the report interval).
     pub arrived_s: Option<f64>,
-    /// Arrived within the window around the common arrival.
+    /// When its plan had it arrive, mission seconds (absent in logs written before it was
+    /// kept: their vehicles were all timed for the common arrival).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub planned_arrival_s: Option<f64>,
+    /// Arrived within the window around its planned arrival.
     pub in_window: bool,
     /// Largest cross-track error reported, metres.
     pub max_cross_track_m: f64,
@@ -400,7 +420,8 @@ pub struct ExecutionFigures {
     pub min_separation_at_s: Option<f64>,
     /// Which pair.
     pub min_separation_pair: Option<[String; 2]>,
-    /// The arrival every vehicle was timed for, mission seconds.
+    /// The arrival every vehicle was timed for, mission seconds (a coverage fleet's crawlers
+    /// each have their own, [`VehicleFigures::planned_arrival_s`]: this is the last of them).
     pub common_arrival_s: f64,
     /// Half-width of the arrival window, mission seconds.
     pub arrival_window_s: f64,

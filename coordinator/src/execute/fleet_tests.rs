@@ -200,3 +200,31 @@ fn a_prediction_starts_from_the_fix_carried_forward_to_now() {
         "{p:?}"
     );
 }
+
+/// A vehicle that stopped at x = 30 m (plan time 30 s) is found there on its plan long after
+/// its plan went on: the plan time of where it stopped, not of now. Under way, there is none.
+#[test]
+fn a_holding_vehicle_resumes_from_where_it_stopped_on_its_plan() {
+    // A sample every 100 m: searched around now (t = 900 s), the nearest would be x = 600 m.
+    let plan = Trajectory {
+        times: (0..=10).map(|k| 100.0 * k as f64).collect(),
+        points: (0..=10)
+            .map(|k| Vec3::new(100.0 * k as f64, 0.0, 0.0))
+            .collect(),
+    };
+    let ids = vec!["a".to_string()];
+    let mut f = Fleet::new(&ids, std::slice::from_ref(&plan), 50.0, 60.0);
+    f.report(
+        report("a", 0, 30.0, [30.0, 1.0, 0.0], VehicleStatus::Underway),
+        1,
+    );
+    assert_eq!(f.vehicles[0].resume_s(), None);
+    f.vehicles[0].holding = true;
+    f.vehicles[0].held_since_s = Some(32.0);
+    f.report(
+        report("a", 1, 900.0, [30.5, 1.0, 0.0], VehicleStatus::Holding),
+        2,
+    );
+    let resume = f.vehicles[0].resume_s().unwrap_or(f64::NAN);
+    assert!((resume - 30.5).abs() < 1e-9, "{resume}");
+}

@@ -315,17 +315,22 @@ pub(super) fn replan_vehicle(x: &mut Exec, i: usize, why: &str) -> bool {
         p0,
         heading,
         current: &x.fleet.vehicles[i].plan,
+        resume_s: x.fleet.vehicles[i].resume_s(),
         others: &predictions,
-        arrival_s: x.common_arrival_s,
+        arrival_s: x.fleet.vehicles[i].planned_arrival_s,
         budget,
         separation_buffer_m: o.separation_buffer_m,
         seed,
     };
-    // A tour must still pass its remaining inspection points, and an energy plan (seed 001)
-    // keeps the path its cost chose over the seabed, its turning radius and the current, none
-    // of which seed 004's replan models: both are repaired, not replanned.
+    // A tour must still pass its remaining inspection points, an energy plan (seed 001)
+    // keeps the path its cost chose over the seabed, its turning radius and the current, and
+    // a coverage crawler (seed 002) must still drive its remaining rows, none of which seed
+    // 004's replan models: all three are repaired, not replanned.
     let algorithm = x.scenario.optimizer.algorithm;
-    let result = if algorithm.is_tour_planner() || algorithm.is_energy_planner() {
+    let result = if algorithm.is_tour_planner()
+        || algorithm.is_energy_planner()
+        || x.scenario.coverage.is_some()
+    {
         repair::repair(&request)
     } else {
         replan::replan(&request)
@@ -348,6 +353,7 @@ pub(super) fn replan_vehicle(x: &mut Exec, i: usize, why: &str) -> bool {
         v.plan = plan.clone();
         v.revision = x.revision;
         v.holding = false;
+        v.held_since_s = None;
         x.send(
             &id,
             CoordinatorToAgent::Update {
@@ -396,6 +402,7 @@ pub(super) fn replan_vehicle(x: &mut Exec, i: usize, why: &str) -> bool {
                 },
             );
             x.fleet.vehicles[i].holding = true;
+            x.fleet.vehicles[i].held_since_s = Some(now);
             x.holds += 1;
             x.event(
                 EVENT_HOLD,

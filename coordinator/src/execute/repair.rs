@@ -5,8 +5,9 @@
 //! radius and the current, none of which the replan models. A repair keeps the
 //! rest of the tour and changes only what must change:
 //!
-//! - the vehicle goes from where it will be back onto its tour (directly: after a deviation or a
-//!   hold, it rejoins at the next point of the plan);
+//! - the vehicle goes from where it will be back onto its tour (directly: after a deviation it
+//!   rejoins at the next point of the plan; after a hold, at the next point after where it
+//!   stopped, so the points its plan passed while it waited are still visited);
 //! - every run of legs that a hard obstacle now blocks is replaced by a way round it
 //!   ([`super::detour`]) from the last point before the run to the first point after it;
 //! - the result is re-timed to arrive when the plan did, each leg's speed scaled alike and kept
@@ -17,6 +18,10 @@
 //! approach are flown a little slower or faster ([`RETIMINGS`]), the later ones making up the
 //! difference, and the first timing that keeps the buffer is taken, else the first that keeps
 //! d_min (as [`super::replan`] prefers the buffer but never holds for it alone).
+//! A coverage crawler (seed 002) is repaired the same way, but gets no way round a blocked
+//! run: it must stay on passable seabed, which the detour's 3-D grid does not know, so it
+//! holds until the obstacle is gone.
+//!
 //! A repair that still meets a hard obstacle, or comes within d_min of another vehicle's
 //! predicted track at every timing, is not safe: the coordinator then holds the vehicle and
 //! retries, so a tour vehicle gives way by waiting, and carries on when the way is clear.
@@ -41,7 +46,7 @@ fn blocked(scenario: &Scenario, a: &Vec3, b: &Vec3) -> bool {
 /// a way round a blocked run that the grid cannot find.
 fn repaired_path(r: &Request) -> Option<(Vec<Vec3>, Vec<f64>)> {
     let scenario = r.scenario;
-    let rest = rebase(r.current, r.t0);
+    let rest = rebase(r.current, r.resume_s.unwrap_or(r.t0));
     let mut pts = rest.points.clone();
     pts[0] = r.p0;
     let speeds: Vec<f64> = pts
@@ -58,6 +63,12 @@ fn repaired_path(r: &Request) -> Option<(Vec<Vec3>, Vec<f64>)> {
             out_speeds.push(speeds[k]);
             k += 1;
             continue;
+        }
+        // A coverage crawler's way round would have to stay on passable seabed, which the 3-D
+        // grid of the detour does not know: none is made, and the crawler holds until the
+        // way is clear (a detour on the seabed map is not built).
+        if scenario.coverage.is_some() {
+            return None;
         }
         // The run of blocked legs k..=j, rejoined at its end point.
         let mut j = k;
@@ -271,6 +282,7 @@ mod tests {
             p0: Vec3::new(700.0, 200.0, 200.0),
             heading: Some(Vec3::new(1.0, 0.0, 0.0)),
             current,
+            resume_s: None,
             others,
             arrival_s: 4000.0,
             budget: Duration::from_millis(100),
@@ -295,6 +307,34 @@ mod tests {
         {
             assert!((a - b).abs() < 1e-9, "{:?}", r.trajectory.times);
         }
+        Ok(())
+    }
+
+    /// A vehicle that held at (400, 200) from t = 200 s and resumes at t = 2500 s goes on
+    /// from where it stopped: every corner its plan passed meanwhile is still visited. Taken
+    /// from t0 instead, the rest would begin past (1200, 200) and (1200, 1200).
+    #[test]
+    fn a_held_vehicle_resumes_where_it_stopped() -> Result<(), Box<dyn std::error::Error>> {
+        let s = scenario()?;
+        let plan = tour();
+        let mut q = request(&s, &plan, &[]);
+        q.t0 = 2500.0;
+        q.p0 = Vec3::new(400.0, 200.0, 200.0);
+        q.heading = None;
+        q.resume_s = Some(200.0);
+        let r = repair(&q);
+        assert!(r.safe, "{r:?}");
+        assert_eq!(r.trajectory.points[0], q.p0);
+        assert_eq!(r.trajectory.points[1..], plan.points[1..]);
+        assert!((r.trajectory.times[0] - 2500.0).abs() < 1e-9);
+        // 3800 m left at the plan's 1 m/s: late, past the plan's 4000 s.
+        assert!(r.trajectory.arrival() > 4000.0, "{:?}", r.trajectory.times);
+        q.resume_s = None;
+        let skipped = repair(&q);
+        assert!(!skipped
+            .trajectory
+            .points
+            .contains(&Vec3::new(1200.0, 200.0, 200.0)));
         Ok(())
     }
 

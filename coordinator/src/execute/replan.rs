@@ -53,6 +53,9 @@ pub struct Request<'a> {
     pub heading: Option<Vec3>,
     /// The trajectory it follows now (mission-timed).
     pub current: &'a Trajectory,
+    /// The time on `current` from which its rest is still to be driven: where a holding
+    /// vehicle stopped (its plan went on without it); `None`: `t0`.
+    pub resume_s: Option<f64>,
     /// Every vehicle's predicted trajectory, mission-timed (this vehicle's is ignored).
     pub others: &'a [Trajectory],
     /// The fleet's arrival time, mission seconds.

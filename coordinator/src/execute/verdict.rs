@@ -37,8 +37,14 @@ pub fn failures(f: &ExecutionFigures) -> Vec<String> {
             ));
         }
         if !v.in_window {
+            let planned = v
+                .planned_arrival_s
+                .map_or(String::new(), |p| format!(" (due at {p:.0} s)"));
             out.push(match v.arrived_s {
-                Some(t) => format!("{} arrived at {t:.0} s, outside the window", v.vehicle),
+                Some(t) => format!(
+                    "{} arrived at {t:.0} s, outside the window{planned}",
+                    v.vehicle
+                ),
                 None => format!("{} never arrived", v.vehicle),
             });
         }
@@ -88,6 +94,7 @@ mod tests {
             vehicle: id.to_string(),
             reports: 10,
             arrived_s: Some(420.0),
+            planned_arrival_s: Some(420.0),
             in_window: true,
             max_cross_track_m: 2.0,
             p95_cross_track_m: Some(1.5),
@@ -132,7 +139,11 @@ mod tests {
         c.min_hazard_clearance_m = Some(-6.0);
         c.in_window = false;
         c.arrived_s = None;
-        let mut f = figures(vec![a, c]);
+        let mut late = vehicle("crawler2");
+        late.in_window = false;
+        late.arrived_s = Some(1312.4);
+        late.planned_arrival_s = Some(1250.0);
+        let mut f = figures(vec![a, c, late]);
         f.min_separation_m = Some(8.25);
         let got = failures(&f);
         assert_eq!(
@@ -143,6 +154,7 @@ mod tests {
                 "auv1's track went 2.0 m into the seabed",
                 "crawler1's track entered a soft-substrate hazard (6.0 m inside it)",
                 "crawler1 never arrived",
+                "crawler2 arrived at 1312 s, outside the window (due at 1250 s)",
             ]
         );
         assert!(verdict_line(&f).starts_with("  NOT MET: separation fell"));

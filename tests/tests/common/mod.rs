@@ -11,6 +11,7 @@
 //! Every test file compiles its own copy of this module and uses only part of it.
 #![allow(dead_code)]
 
+pub mod coverage;
 pub mod fleet;
 pub mod process;
 

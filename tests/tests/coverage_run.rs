@@ -1,0 +1,134 @@
+//! Executing a coverage plan end to end (seed 002 under `run`): two crawlers plan their strips
+//! of a shrunken `cpp-fleet`, their agents drive simulated crawlers along the paths on the
+//! seabed map at 500× real time, each crawler ends at its own finish, the pair keeps d_min,
+//! and `replay` agrees. An obstacle dropped on a crawler's path makes it hold (no way round
+//! on the seabed map is built), and the run says so instead of driving through it.
+
+mod common;
+
+use std::path::Path;
+use std::process::Command;
+use std::time::{Duration, Instant};
+
+use common::coverage::small_fleet;
+use common::fleet::Fleet;
+use common::process::{coordinator, root};
+use common::{without_shoal_env, TestResult};
+use serde_json::Value;
+
+const LIMIT: Duration = Duration::from_secs(240);
+
+fn num(v: &Value, field: &str) -> f64 {
+    match v[field].as_f64() {
+        Some(x) => x,
+        None => panic!("{field} is not a number in {v}"),
+    }
+}
+
+fn json(path: &Path) -> Result<Value, Box<dyn std::error::Error>> {
+    Ok(serde_json::from_str(&std::fs::read_to_string(path)?)?)
+}
+
+/// `run FILE --in-process -q --time-scale 500 --out OUT EXTRA…`.
+fn run(file: &Path, out: &Path, extra: &[&str]) -> Command {
+    let mut cmd = Command::new(coordinator());
+    without_shoal_env(&mut cmd);
+    cmd.current_dir(root())
+        .arg("run")
+        .arg(file)
+        .args(["--in-process", "-q", "--time-scale", "500"])
+        .args(extra)
+        .arg("--out")
+        .arg(out);
+    cmd
+}
+
+#[test]
+fn crawlers_drive_their_coverage_paths_and_each_ends_at_its_own_finish() -> TestResult {
+    let mut fleet = Fleet::new();
+    let file = small_fleet(fleet.dir(), &|t| t)?;
+    let out = fleet.dir().join("out");
+    let c = fleet.spawn("coordinator", run(&file, &out, &[]));
+    let r = fleet.wait(c, Instant::now() + LIMIT);
+    assert_eq!(r.code(), Some(0), "{}\n{}", r.stdout, r.stderr);
+    assert!(r.stdout.contains("  MET: "), "{}", r.stdout);
+    // The plan is the coverage plan, timed 10 m over d_min for the tracking error.
+    let plan = json(&out.join("plan.json"))?;
+    assert_eq!(plan["kind"], "coverage-fleet");
+    assert_eq!(num(&plan["fleet"]["separation"], "d_min_m"), 60.0);
+    let report = json(&out.join("execution.json"))?;
+    let f = &report["figures"];
+    assert!(num(f, "min_separation_m") >= 50.0, "{f}");
+    assert_eq!(f["all_arrived_in_window"], Value::Bool(true), "{f}");
+    let vehicles = f["vehicles"].as_array().cloned().unwrap_or_default();
+    assert_eq!(vehicles.len(), 2);
+    let mut due = Vec::new();
+    for v in &vehicles {
+        // Each crawler is due when its own path ends, and arrived then.
+        let planned = num(v, "planned_arrival_s");
+        assert!((num(v, "arrived_s") - planned).abs() <= 30.0, "{v}");
+        // 15 rows of 300 m at 0.5 m/s take over 2.5 h.
+        assert!(planned > 9000.0, "{v}");
+        assert!(num(v, "p95_cross_track_m") < 5.0, "{v}");
+        assert!(num(v, "reports") > 20.0, "{v}");
+        assert_eq!(num(v, "revision"), 0.0, "{v}");
+        due.push(planned);
+    }
+    assert!(
+        (due[0] - due[1]).abs() > 1.0,
+        "both crawlers due at the same time: {due:?}"
+    );
+    assert!((num(f, "common_arrival_s") - due[0].max(due[1])).abs() < 1e-6);
+    // Replay: the same figures from the records alone.
+    let mut replay = Command::new(coordinator());
+    without_shoal_env(&mut replay);
+    replay
+        .current_dir(root())
+        .arg("replay")
+        .arg(out.join("mission.ndjson"));
+    let rp = fleet.spawn("replay", replay);
+    let rp = fleet.wait(rp, Instant::now() + Duration::from_secs(60));
+    assert_eq!(rp.code(), Some(0), "{}\n{}", rp.stdout, rp.stderr);
+    assert!(
+        rp.stdout.contains("the figures match the log's end record"),
+        "{}",
+        rp.stdout
+    );
+    fleet.passed();
+    Ok(())
+}
+
+#[test]
+fn a_crawler_holds_before_an_obstacle_on_its_coverage_path() -> TestResult {
+    let mut fleet = Fleet::new();
+    let file = small_fleet(fleet.dir(), &|t| t)?;
+    let out = fleet.dir().join("out");
+    // By t = 1500 s crawler2 has driven its rows up to y ≈ 205 m (10 m apart, 10 min each,
+    // round the seamount at (150, 150)); a 5 m obstacle (55 m inflated by d_min) at (150, 270)
+    // blocks its rows from y = 215 m on and keeps clear of those it drove.
+    let c = fleet.spawn(
+        "coordinator",
+        run(&file, &out, &["--inject-obstacle", "1500:150,270,0,5"]),
+    );
+    let r = fleet.wait(c, Instant::now() + LIMIT);
+    assert_eq!(r.code(), Some(3), "{}\n{}", r.stdout, r.stderr);
+    assert!(r.stdout.contains("crawler2 never arrived"), "{}", r.stdout);
+    let report = json(&out.join("execution.json"))?;
+    let f = &report["figures"];
+    assert!(num(&report, "holds") >= 1.0, "{report}");
+    let c2 = &f["vehicles"][1];
+    assert_eq!(c2["vehicle"], "crawler2");
+    // It stopped before the obstacle's keep-out sphere and stayed held (it did not skip the
+    // rows its plan passed while it waited), and the pair kept d_min.
+    assert!(num(c2, "min_obstacle_clearance_m") > 50.0, "{c2}");
+    assert_eq!(num(c2, "revision"), 0.0, "{c2}");
+    assert!(num(f, "min_separation_m") >= 50.0, "{f}");
+    let log = std::fs::read_to_string(out.join("mission.ndjson"))?;
+    assert!(
+        log.lines()
+            .any(|l| l.contains("\"kind\":\"hold\"") && l.contains("crawler2")),
+        "no hold event for crawler2"
+    );
+    fleet.passed();
+    Ok(())
+}
