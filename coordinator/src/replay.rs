@@ -153,6 +153,7 @@ pub fn command(args: &ReplayArgs) -> anyhow::Result<i32> {
     for v in &f.vehicles {
         out.push_str(&verdict::vehicle_line(v));
     }
+    out.push_str(&verdict::coverage_line(f));
     out.push_str(&verdict::verdict_line(f));
     match &r.logged {
         Some(l) if same_figures(l, f) => out.push_str("the figures match the log's end record\n"),
@@ -270,13 +271,17 @@ pub fn render(r: &Replayed) -> anyhow::Result<String> {
 }
 
 /// Whether the replayed figures are the logged ones. A log written before the planned arrival
-/// was kept has none in its end record: the replay's own counts as matching it.
+/// and a coverage mission's ground figures were kept has none in its end record: the replay's
+/// own count as matching them.
 fn same_figures(logged: &ExecutionFigures, replayed: &ExecutionFigures) -> bool {
     let mut logged = logged.clone();
     for (l, r) in logged.vehicles.iter_mut().zip(&replayed.vehicles) {
-        if l.planned_arrival_s.is_none() {
-            l.planned_arrival_s = r.planned_arrival_s;
-        }
+        l.planned_arrival_s = l.planned_arrival_s.or(r.planned_arrival_s);
+        l.min_ground_clearance_m = l.min_ground_clearance_m.or(r.min_ground_clearance_m);
+        l.impassable_m = l.impassable_m.or(r.impassable_m);
+    }
+    if logged.coverage.is_none() {
+        logged.coverage = replayed.coverage.clone();
     }
     logged == *replayed
 }
@@ -396,6 +401,16 @@ mod tests {
         assert!((v.max_cross_track_m - 3.0).abs() < 1e-6, "{v:?}");
         let median = v.median_cross_track_m.unwrap_or(f64::NAN);
         assert!((median - 2.0).abs() < 1e-6, "{v:?}");
+        // An end record written before the planned arrivals were kept still matches; a figure
+        // that differs does not.
+        assert_eq!(v.planned_arrival_s, Some(1000.0));
+        let mut old = r.figures.clone();
+        for v in &mut old.vehicles {
+            v.planned_arrival_s = None;
+        }
+        assert!(same_figures(&old, &r.figures));
+        old.vehicles[0].max_cross_track_m += 1.0;
+        assert!(!same_figures(&old, &r.figures));
         Ok(())
     }
 

@@ -382,6 +382,7 @@ pub fn execution_summary(r: &ExecutionReport) -> String {
         r.replans,
         r.holds
     ));
+    s.push_str(&verdict::coverage_line(f));
     s.push_str(&format!(
         "  telemetry: {} reports, latency median {} ms, p99 {} ms\n",
         f.reports,

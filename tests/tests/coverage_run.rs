@@ -72,6 +72,10 @@ fn crawlers_drive_their_coverage_paths_and_each_ends_at_its_own_finish() -> Test
         assert!(num(v, "p95_cross_track_m") < 5.0, "{v}");
         assert!(num(v, "reports") > 20.0, "{v}");
         assert_eq!(num(v, "revision"), 0.0, "{v}");
+        // On the seabed map: never on impassable ground, a few metres inside the planner's
+        // 8 m safety clearance at most.
+        assert_eq!(num(v, "impassable_m"), 0.0, "{v}");
+        assert!(num(v, "min_ground_clearance_m") > 3.0, "{v}");
         due.push(planned);
     }
     assert!(
@@ -79,6 +83,13 @@ fn crawlers_drive_their_coverage_paths_and_each_ends_at_its_own_finish() -> Test
         "both crawlers due at the same time: {due:?}"
     );
     assert!((num(f, "common_arrival_s") - due[0].max(due[1])).abs() < 1e-6);
+    // The executed swaths cover about what the planned ones do (88 %), less the tracking error.
+    let executed = num(&f["coverage"], "ratio");
+    let planned = num(&plan["fleet"]["coverage"], "ratio");
+    assert!(
+        executed > planned - 0.06 && executed <= planned + 0.01,
+        "{executed} vs {planned}"
+    );
     // Replay: the same figures from the records alone.
     let mut replay = Command::new(coordinator());
     without_shoal_env(&mut replay);

@@ -302,6 +302,17 @@ impl Fleet {
                 }
             }
         }
+        // A coverage crawler must keep off the ground its map calls impassable.
+        if scenario.coverage.is_some() {
+            let tracks: Vec<Trajectory> = self.vehicles.iter().map(|v| v.track.clone()).collect();
+            if let Some(g) = super::ground::ground(scenario, &tracks) {
+                for (fig, t) in f.vehicles.iter_mut().zip(g.tracks) {
+                    fig.min_ground_clearance_m = t.map(|t| t.min_clearance_m);
+                    fig.impassable_m = t.map(|t| t.impassable_m);
+                }
+                f.coverage = Some(g.coverage);
+            }
+        }
         f
     }
 
@@ -342,6 +353,8 @@ impl Fleet {
                 min_obstacle_clearance_m: obstacle_clearance(&v.track, obstacles),
                 min_seabed_clearance_m: None,
                 min_hazard_clearance_m: None,
+                min_ground_clearance_m: None,
+                impassable_m: None,
                 median_cross_track_m: quantile_of(&v.cross_track, 0.5),
                 p95_cross_track_m: quantile_of(&v.cross_track, 0.95),
                 revision: v.revision,
@@ -360,6 +373,7 @@ impl Fleet {
             reports: self.reports,
             latency_median_ms: quantile_of(&self.latencies_ms, 0.5),
             latency_p99_ms: quantile_of(&self.latencies_ms, 0.99),
+            coverage: None,
         }
     }
 }
@@ -399,6 +413,13 @@ pub struct VehicleFigures {
     /// horizontally, metres (negative: inside it); absent for an AUV, or without hazards.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub min_hazard_clearance_m: Option<f64>,
+    /// A coverage crawler (seed 002): the closest its executed track came to impassable ground
+    /// of its seabed map (a cell centre), metres; absent otherwise.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub min_ground_clearance_m: Option<f64>,
+    /// A coverage crawler: metres of its executed track on impassable ground; absent otherwise.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub impassable_m: Option<f64>,
     /// Median cross-track error, metres; `None` without a report on a plan.
     pub median_cross_track_m: Option<f64>,
     /// 95th percentile, metres; `None` likewise.
@@ -435,6 +456,10 @@ pub struct ExecutionFigures {
     pub latency_median_ms: Option<f64>,
     /// Telemetry latency, 99th percentile, milliseconds; `None` without reports.
     pub latency_p99_ms: Option<f64>,
+    /// A coverage mission: the area the executed tracks' swaths covered (the plan's swath
+    /// width); absent otherwise.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub coverage: Option<shoal_common::coverage::metrics::CoverageCount>,
 }
 
 #[cfg(test)]

@@ -8,6 +8,7 @@
 
 mod detour;
 pub mod fleet;
+mod ground;
 pub mod log;
 mod react;
 mod repair;

@@ -5,9 +5,9 @@ use super::fleet::{ExecutionFigures, VehicleFigures};
 use crate::summary::opt;
 
 /// Why the execution falls short: d_min broken, an executed track inside a hard obstacle (its
-/// physical sphere: the inflation is the planner's margin), an AUV's through the seabed or a
-/// crawler's into a soft-substrate hazard, a vehicle that did not arrive in the window. Empty
-/// when it met all of them.
+/// physical sphere: the inflation is the planner's margin), an AUV's through the seabed, a
+/// crawler's into a soft-substrate hazard or (coverage) onto impassable ground, a vehicle that
+/// did not arrive in the window. Empty when it met all of them.
 pub fn failures(f: &ExecutionFigures) -> Vec<String> {
     let mut out = Vec::new();
     if let Some(d) = f.min_separation_m.filter(|d| *d < f.d_min_m) {
@@ -28,6 +28,12 @@ pub fn failures(f: &ExecutionFigures) -> Vec<String> {
             out.push(format!(
                 "{}'s track entered a soft-substrate hazard ({:.1} m inside it)",
                 v.vehicle, -c
+            ));
+        }
+        if let Some(m) = v.impassable_m.filter(|m| *m > 0.0) {
+            out.push(format!(
+                "{}'s track crossed {m:.0} m of impassable ground",
+                v.vehicle
             ));
         }
         if let Some(c) = v.min_seabed_clearance_m.filter(|c| *c < 0.0) {
@@ -56,17 +62,28 @@ pub fn failures(f: &ExecutionFigures) -> Vec<String> {
 pub fn verdict_line(f: &ExecutionFigures) -> String {
     let failures = failures(f);
     if failures.is_empty() {
-        "  MET: d_min kept, no hard obstacle, seabed or hazard entered, every vehicle in the window\n"
+        "  MET: d_min kept, no hard obstacle, seabed, hazard or impassable ground entered, every vehicle in the window\n"
             .to_string()
     } else {
         format!("  NOT MET: {}\n", failures.join("; "))
     }
 }
 
+/// A coverage mission's line: the area the executed swaths covered; empty for other missions.
+pub fn coverage_line(f: &ExecutionFigures) -> String {
+    f.coverage.as_ref().map_or(String::new(), |c| {
+        format!(
+            "  coverage: the executed tracks' swaths cover {:.2} % of the area ({:.2} % of the passable area)\n",
+            100.0 * c.ratio,
+            100.0 * c.ratio_of_passable
+        )
+    })
+}
+
 /// One vehicle's line of a summary: arrival, tracking error, clearances, reports.
 pub fn vehicle_line(v: &VehicleFigures) -> String {
     format!(
-        "  {:<8} arrived {:>8} {} | cross-track median {} m, p95 {} m, max {:.2} m | obstacle clearance {}{}{} | {} reports, revision {}{}\n",
+        "  {:<8} arrived {:>8} {} | cross-track median {} m, p95 {} m, max {:.2} m | obstacle clearance {}{}{}{} | {} reports, revision {}{}\n",
         v.vehicle,
         v.arrived_s.map_or("never".to_string(), |t| format!("{t:.0} s")),
         if v.in_window { "(in window)" } else { "(OUT of window)" },
@@ -79,6 +96,12 @@ pub fn vehicle_line(v: &VehicleFigures) -> String {
             .map_or(String::new(), |c| format!(", above the seabed {c:.1} m")),
         v.min_hazard_clearance_m
             .map_or(String::new(), |c| format!(", hazard clearance {c:.1} m")),
+        v.min_ground_clearance_m.map_or(String::new(), |c| format!(
+            ", from impassable ground {c:.1} m{}",
+            v.impassable_m
+                .filter(|m| *m > 0.0)
+                .map_or(String::new(), |m| format!(" ({m:.0} m on it)"))
+        )),
         v.reports,
         v.revision,
         if v.lost { ", LOST" } else { "" }
@@ -101,6 +124,8 @@ mod tests {
             min_obstacle_clearance_m: None,
             min_seabed_clearance_m: None,
             min_hazard_clearance_m: None,
+            min_ground_clearance_m: None,
+            impassable_m: None,
             median_cross_track_m: Some(1.0),
             revision: 0,
             lost: false,
@@ -120,7 +145,24 @@ mod tests {
             reports: 20,
             latency_median_ms: Some(0.2),
             latency_p99_ms: Some(0.4),
+            coverage: None,
         }
+    }
+
+    #[test]
+    fn the_coverage_line_is_there_only_for_a_coverage_mission() {
+        let mut f = figures(vec![vehicle("crawler1")]);
+        assert_eq!(coverage_line(&f), "");
+        f.coverage = Some(shoal_common::coverage::metrics::CoverageCount {
+            ratio: 0.8614,
+            ratio_of_passable: 0.95312,
+            covered_m2: 861_400.0,
+            area_m2: 1_000_000.0,
+        });
+        assert_eq!(
+            coverage_line(&f),
+            "  coverage: the executed tracks' swaths cover 86.14 % of the area (95.31 % of the passable area)\n"
+        );
     }
 
     #[test]
@@ -137,6 +179,7 @@ mod tests {
         a.min_obstacle_clearance_m = Some(0.0);
         let mut c = vehicle("crawler1");
         c.min_hazard_clearance_m = Some(-6.0);
+        c.impassable_m = Some(12.4);
         c.in_window = false;
         c.arrived_s = None;
         let mut late = vehicle("crawler2");
@@ -153,6 +196,7 @@ mod tests {
                 "auv1's track entered a hard obstacle (0.0 m inside its surface)",
                 "auv1's track went 2.0 m into the seabed",
                 "crawler1's track entered a soft-substrate hazard (6.0 m inside it)",
+                "crawler1's track crossed 12 m of impassable ground",
                 "crawler1 never arrived",
                 "crawler2 arrived at 1312 s, outside the window (due at 1250 s)",
             ]
@@ -168,6 +212,19 @@ mod tests {
         assert!(line.contains("hazard clearance 10.1 m"), "{line}");
         assert!(line.contains("obstacle clearance –"), "{line}");
         assert!(!line.contains("seabed"), "{line}");
+        assert!(!line.contains("impassable"), "{line}");
+        let mut g = vehicle("crawler2");
+        g.min_ground_clearance_m = Some(7.96);
+        g.impassable_m = Some(0.0);
+        let line = vehicle_line(&g);
+        assert!(line.contains("from impassable ground 8.0 m |"), "{line}");
+        g.min_ground_clearance_m = Some(0.0);
+        g.impassable_m = Some(3.2);
+        let line = vehicle_line(&g);
+        assert!(
+            line.contains("from impassable ground 0.0 m (3 m on it)"),
+            "{line}"
+        );
         let mut a = vehicle("auv1");
         a.min_seabed_clearance_m = Some(37.46);
         a.lost = true;
