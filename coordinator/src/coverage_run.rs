@@ -19,7 +19,7 @@
 //!   finish, not a common one (a crawler does not wait for the others).
 
 use std::path::Path;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
 
 use anyhow::bail;
@@ -29,7 +29,7 @@ use shoal_common::trajectory::Trajectory;
 
 use crate::cli::PlanArgs;
 use crate::distributed::DistributedOptions;
-use crate::run_cmd::{executable, Executable, PlanState};
+use crate::run_cmd::{executable, plan_state, Executable};
 
 /// Plans `scenario`'s coverage into `--out` and returns what the agents execute; `None` (after
 /// saying why) when the plan is not to be executed.
@@ -55,14 +55,7 @@ pub fn plan(
         );
     }
     let planned = crate::plan_coverage_mission(p, &planning, shutdown, || Ok(options.clone()))?;
-    let state = if shutdown.load(Ordering::Relaxed) {
-        PlanState::Interrupted
-    } else if !planned.feasible {
-        PlanState::Infeasible
-    } else {
-        PlanState::Ready
-    };
-    if !executable(&state) {
+    if !executable(&plan_state(planned.feasible, shutdown)) {
         return Ok(None);
     }
     let trajectories: Vec<Trajectory> = planned

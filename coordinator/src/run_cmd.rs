@@ -171,7 +171,7 @@ fn plan_trajectories(
     write_outputs(&p.out, &plan)?;
     write_svg(&p.out, scenario, &plan)?;
     say(&summary::summary(&plan));
-    if !executable(&plan_state(&plan, shutdown)) {
+    if !executable(&plan_state(plan.feasible, shutdown)) {
         return Ok(None);
     }
     Ok(Some(Executable {
@@ -196,10 +196,11 @@ pub(crate) enum PlanState {
     Infeasible,
 }
 
-fn plan_state(plan: &shoal_common::plan::Plan, shutdown: &AtomicBool) -> PlanState {
+/// The state of a plan that is `feasible` or not, Ctrl-C (`shutdown`) counting first.
+pub(crate) fn plan_state(feasible: bool, shutdown: &AtomicBool) -> PlanState {
     if shutdown.load(Ordering::Relaxed) {
         PlanState::Interrupted
-    } else if !plan.feasible {
+    } else if !feasible {
         PlanState::Infeasible
     } else {
         PlanState::Ready

@@ -22,7 +22,6 @@ use std::sync::mpsc::{self, Receiver, RecvTimeoutError};
 use std::time::{Duration, Instant};
 
 use shoal_common::execution::{unix_us, MissionClock};
-use shoal_common::plan::Plan;
 use shoal_common::scenario::{Obstacle, Scenario};
 use shoal_common::trajectory::Trajectory;
 use shoal_common::wire::codec;
@@ -72,14 +71,6 @@ pub struct ExecOptions {
 enum Open {
     Telemetry(Vec<u8>, u64),
     Obstacle(Vec<u8>),
-}
-
-/// The plan's trajectories, scenario order.
-fn plan_trajectories(plan: &Plan) -> Vec<Trajectory> {
-    plan.vehicles
-        .iter()
-        .map(|v| Trajectory::from_samples(&v.trajectory))
-        .collect()
 }
 
 /// Everything the execution loop shares.
@@ -191,26 +182,9 @@ impl Exec<'_> {
     }
 }
 
-/// Executes `plan` of `scenario`: opens a router (and the agents `distributed` asks for), has
+/// Executes the given trajectories of `scenario` (scenario order, mission-timed; their common
+/// arrival `common_arrival_s`): opens a router (and the agents `distributed` asks for), has
 /// every agent drive its vehicle, and watches until every vehicle has arrived or is lost.
-pub fn execute(
-    scenario: &Scenario,
-    plan: &Plan,
-    distributed: &DistributedOptions,
-    options: &ExecOptions,
-    stop: &AtomicBool,
-) -> anyhow::Result<ExecutionReport> {
-    execute_trajectories(
-        scenario,
-        &plan_trajectories(plan),
-        plan.common_arrival_s,
-        distributed,
-        options,
-        stop,
-    )
-}
-
-/// [`execute`] on given trajectories (scenario order, mission-timed) and their common arrival.
 pub fn execute_trajectories(
     scenario: &Scenario,
     plans: &[Trajectory],
