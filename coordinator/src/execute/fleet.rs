@@ -60,6 +60,9 @@ pub struct Tracked {
     pub holding: bool,
     /// When the hold was commanded, mission seconds (`None` unless holding).
     pub held_since_s: Option<f64>,
+    /// Since when its link reports a fault (its latest report does), mission seconds: it is
+    /// not driven any more, so it is neither re-planned nor waited for.
+    pub fault_s: Option<f64>,
 }
 
 impl Tracked {
@@ -129,6 +132,7 @@ impl Fleet {
                     lost: false,
                     holding: false,
                     held_since_s: None,
+                    fault_s: None,
                 })
                 .collect(),
             d_min,
@@ -183,6 +187,10 @@ impl Fleet {
             v.fixes += 1;
             v.anchor = Some((tau, offset, v.revision));
         }
+        v.fault_s = match t.state.status {
+            VehicleStatus::Fault => v.fault_s.or(Some(now)),
+            _ => None,
+        };
         if t.state.status == VehicleStatus::Arrived && v.arrived_s.is_none() {
             v.arrived_s = Some(t.state.arrived_s.unwrap_or(now));
         }
@@ -208,12 +216,12 @@ impl Fleet {
 
     /// Each vehicle's predicted trajectory from `now` over `horizon_s`: along its plan from its
     /// latest fix, from the fix's time (from where its plan has it, before its first report); a
-    /// lost or holding vehicle stays where it was last seen.
+    /// lost, holding or faulted vehicle stays where it was last seen.
     pub fn predictions_over(&self, now: f64, horizon_s: f64) -> Vec<Trajectory> {
         self.vehicles
             .iter()
             .map(|v| {
-                if v.lost || v.holding {
+                if v.lost || v.holding || v.fault_s.is_some() {
                     let p = v.position();
                     return Trajectory {
                         times: vec![now, now + horizon_s],
@@ -359,6 +367,7 @@ impl Fleet {
                 p95_cross_track_m: quantile_of(&v.cross_track, 0.95),
                 revision: v.revision,
                 lost: v.lost,
+                fault_s: v.fault_s,
             })
             .collect();
         ExecutionFigures {
@@ -428,6 +437,9 @@ pub struct VehicleFigures {
     pub revision: u32,
     /// Lost at the end.
     pub lost: bool,
+    /// Its link reported a fault from this mission time to the end; absent otherwise.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fault_s: Option<f64>,
 }
 
 /// The figures of an execution (also what `replay` reports).

@@ -228,3 +228,37 @@ fn a_holding_vehicle_resumes_from_where_it_stopped_on_its_plan() {
     let resume = f.vehicles[0].resume_s().unwrap_or(f64::NAN);
     assert!((resume - 30.5).abs() < 1e-9, "{resume}");
 }
+
+/// A vehicle whose link reports a fault is predicted to stay where it is, keeps the time its
+/// fault began over later fault reports, and is clear of it once a report says otherwise.
+#[test]
+fn a_faulted_vehicle_stays_put_in_the_picture_until_its_link_recovers() {
+    let ids = vec!["a".to_string()];
+    let mut f = Fleet::new(&ids, &[straight(0.0)], 50.0, 60.0);
+    f.report(
+        report("a", 0, 10.0, [10.0, 0.0, 0.0], VehicleStatus::Underway),
+        1,
+    );
+    assert_eq!(f.vehicles[0].fault_s, None);
+    f.report(
+        report("a", 1, 20.0, [20.0, 0.0, 0.0], VehicleStatus::Fault),
+        2,
+    );
+    f.report(
+        report("a", 2, 30.0, [20.0, 0.0, 0.0], VehicleStatus::Fault),
+        3,
+    );
+    assert_eq!(f.vehicles[0].fault_s, Some(20.0));
+    let p = &f.predictions(30.0)[0];
+    assert!(
+        (p.position_at(80.0) - Vec3::new(20.0, 0.0, 0.0)).norm() < 1e-9,
+        "{p:?}"
+    );
+    let figures = f.figures(100.0, 30.0, &[]);
+    assert_eq!(figures.vehicles[0].fault_s, Some(20.0));
+    f.report(
+        report("a", 3, 40.0, [21.0, 0.0, 0.0], VehicleStatus::Underway),
+        4,
+    );
+    assert_eq!(f.vehicles[0].fault_s, None);
+}

@@ -20,6 +20,8 @@ use super::fleet::ExecutionFigures;
 pub const EVENT_LOST: &str = "vehicle_lost";
 /// The event kind of a vehicle told to hold (its `vehicles` names it).
 pub const EVENT_HOLD: &str = "hold";
+/// The event kind of a vehicle whose link reports a fault (its `vehicles` names it).
+pub const EVENT_FAULT: &str = "fault";
 
 /// What starts a log.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

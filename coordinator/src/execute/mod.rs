@@ -386,9 +386,9 @@ fn run_loop(
             .fleet
             .vehicles
             .iter()
-            .all(|v| v.lost || v.arrived_s.is_some());
+            .all(|v| v.lost || v.arrived_s.is_some() || v.fault_s.is_some());
         if done {
-            return "every vehicle arrived or is lost".into();
+            return "every vehicle arrived, is lost or reports a fault".into();
         }
         if now > give_up_s {
             return format!("mission time {now:.0} s is past the arrival window: given up");

@@ -17,7 +17,7 @@ use shoal_common::wire::coordinator_to_agent::CoordinatorToAgent;
 use shoal_common::wire::open::{FleetStatus, Telemetry, OPEN_VERSION};
 use shoal_common::wire::WireTrajectory;
 
-use super::log::{Record, EVENT_HOLD, EVENT_LOST};
+use super::log::{Record, EVENT_FAULT, EVENT_HOLD, EVENT_LOST};
 use super::repair;
 use super::replan::{self, Request};
 use super::Exec;
@@ -58,6 +58,7 @@ pub(super) fn telemetry(x: &mut Exec, bytes: &[u8], received_us: u64) {
     }
     let was_arrived = x.fleet.vehicles[i].arrived_s.is_some();
     let was_lost = x.fleet.vehicles[i].lost;
+    let was_faulted = x.fleet.vehicles[i].fault_s.is_some();
     let revision = t.revision;
     x.log.write(&Record::Telemetry {
         received_unix_us: received_us,
@@ -79,6 +80,21 @@ pub(super) fn telemetry(x: &mut Exec, bytes: &[u8], received_us: u64) {
             vec![id.clone()],
             format!("{id} reports again"),
         );
+    }
+    match (was_faulted, x.fleet.vehicles[i].fault_s) {
+        (false, Some(t)) => x.event(
+            EVENT_FAULT,
+            vec![id.clone()],
+            format!(
+                "{id}'s link reports a fault at t = {t:.1} s: it is no longer re-planned or waited for, and the others keep clear of where it is"
+            ),
+        ),
+        (true, None) => x.event(
+            "fault_cleared",
+            vec![id.clone()],
+            format!("{id}'s link reports no fault any more"),
+        ),
+        _ => {}
     }
     if !was_arrived {
         if let Some(t) = x.fleet.vehicles[i].arrived_s {
@@ -231,7 +247,7 @@ pub(super) fn check(x: &mut Exec, now: f64) {
     }
     for i in 0..x.fleet.vehicles.len() {
         let v = &x.fleet.vehicles[i];
-        let active = !v.lost && v.arrived_s.is_none();
+        let active = !v.lost && v.arrived_s.is_none() && v.fault_s.is_none();
         let cooled = x.last_reaction[i].is_none_or(|t| t.elapsed() >= COOL_DOWN);
         if !(active && cooled) {
             continue;
@@ -253,7 +269,7 @@ pub(super) fn check(x: &mut Exec, now: f64) {
     for c in x.fleet.conflicts(now) {
         let can = |i: usize| {
             let v = &x.fleet.vehicles[i];
-            !v.lost && !v.holding && v.arrived_s.is_none()
+            !v.lost && !v.holding && v.arrived_s.is_none() && v.fault_s.is_none()
         };
         let who = if can(c.b) {
             c.b

@@ -51,7 +51,13 @@ pub fn failures(f: &ExecutionFigures) -> Vec<String> {
                     "{} arrived at {t:.0} s, outside the window{planned}",
                     v.vehicle
                 ),
-                None => format!("{} never arrived", v.vehicle),
+                None => match v.fault_s {
+                    Some(t) => format!(
+                        "{} never arrived: its link reported a fault at {t:.0} s",
+                        v.vehicle
+                    ),
+                    None => format!("{} never arrived", v.vehicle),
+                },
             });
         }
     }
@@ -83,7 +89,7 @@ pub fn coverage_line(f: &ExecutionFigures) -> String {
 /// One vehicle's line of a summary: arrival, tracking error, clearances, reports.
 pub fn vehicle_line(v: &VehicleFigures) -> String {
     format!(
-        "  {:<8} arrived {:>8} {} | cross-track median {} m, p95 {} m, max {:.2} m | obstacle clearance {}{}{}{} | {} reports, revision {}{}\n",
+        "  {:<8} arrived {:>8} {} | cross-track median {} m, p95 {} m, max {:.2} m | obstacle clearance {}{}{}{} | {} reports, revision {}{}{}\n",
         v.vehicle,
         v.arrived_s.map_or("never".to_string(), |t| format!("{t:.0} s")),
         if v.in_window { "(in window)" } else { "(OUT of window)" },
@@ -104,7 +110,9 @@ pub fn vehicle_line(v: &VehicleFigures) -> String {
         )),
         v.reports,
         v.revision,
-        if v.lost { ", LOST" } else { "" }
+        if v.lost { ", LOST" } else { "" },
+        v.fault_s
+            .map_or(String::new(), |t| format!(", FAULT since {t:.0} s"))
     )
 }
 
@@ -129,6 +137,7 @@ mod tests {
             median_cross_track_m: Some(1.0),
             revision: 0,
             lost: false,
+            fault_s: None,
         }
     }
 
@@ -182,11 +191,15 @@ mod tests {
         c.impassable_m = Some(12.4);
         c.in_window = false;
         c.arrived_s = None;
+        let mut broken = vehicle("auv2");
+        broken.in_window = false;
+        broken.arrived_s = None;
+        broken.fault_s = Some(36_012.4);
         let mut late = vehicle("crawler2");
         late.in_window = false;
         late.arrived_s = Some(1312.4);
         late.planned_arrival_s = Some(1250.0);
-        let mut f = figures(vec![a, c, late]);
+        let mut f = figures(vec![a, c, late, broken]);
         f.min_separation_m = Some(8.25);
         let got = failures(&f);
         assert_eq!(
@@ -199,6 +212,7 @@ mod tests {
                 "crawler1's track crossed 12 m of impassable ground",
                 "crawler1 never arrived",
                 "crawler2 arrived at 1312 s, outside the window (due at 1250 s)",
+                "auv2 never arrived: its link reported a fault at 36012 s",
             ]
         );
         assert!(verdict_line(&f).starts_with("  NOT MET: separation fell"));
@@ -231,6 +245,9 @@ mod tests {
         let line = vehicle_line(&a);
         assert!(line.contains("above the seabed 37.5 m"), "{line}");
         assert!(line.ends_with(", LOST\n"), "{line}");
+        a.fault_s = Some(600.2);
+        assert!(vehicle_line(&a).ends_with(", LOST, FAULT since 600 s\n"));
+        a.fault_s = None;
         // No report: no median, no percentile.
         a.median_cross_track_m = None;
         a.p95_cross_track_m = None;
