@@ -152,20 +152,7 @@ fn a_fleet_executes_its_plan_replans_around_a_new_obstacle_and_replays() -> Test
     assert!(has("obstacle", "auv2"), "no obstacle event blocking auv2");
     assert!(has("replanned", "auv2"), "auv2 was not replanned");
     // Replay: the same figures from the records alone.
-    let mut replay = Command::new(coordinator());
-    without_shoal_env(&mut replay);
-    replay
-        .current_dir(root())
-        .arg("replay")
-        .arg(out.join("mission.ndjson"));
-    let rp = fleet.spawn("replay", replay);
-    let rp = fleet.wait(rp, Instant::now() + Duration::from_secs(60));
-    assert_eq!(rp.code(), Some(0), "{}\n{}", rp.stdout, rp.stderr);
-    assert!(
-        rp.stdout.contains("the figures match the log's end record"),
-        "{}",
-        rp.stdout
-    );
+    let rp = fleet.replay(&out.join("mission.ndjson"));
     assert!(rp.stdout.contains("  MET: "), "{}", rp.stdout);
     let svg = std::fs::read_to_string(out.join("mission.svg"))?;
     assert!(

@@ -227,6 +227,23 @@ impl Fleet {
         }
     }
 
+    /// `shoal-coordinator replay LOG`, run to its end (60 s at most); asserts it exits 0 and
+    /// finds the figures of the log's end record again.
+    pub fn replay(&mut self, log: &Path) -> Run {
+        let mut cmd = Command::new(coordinator());
+        without_shoal_env(&mut cmd);
+        cmd.current_dir(root()).arg("replay").arg(log);
+        let h = self.spawn("replay", cmd);
+        let r = self.wait(h, Instant::now() + Duration::from_secs(60));
+        assert_eq!(r.code(), Some(0), "{}\n{}", r.stdout, r.stderr);
+        assert!(
+            r.stdout.contains("the figures match the log's end record"),
+            "{}",
+            r.stdout
+        );
+        r
+    }
+
     /// Kills `h` at once (SIGKILL on Unix: no goodbye to the network) and reaps it.
     pub fn kill(&mut self, h: Handle) {
         let p = &mut self.procs[h.0];
