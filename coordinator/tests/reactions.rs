@@ -57,10 +57,29 @@ fn execute(
     let endpoint = free_endpoint()?;
     let agents: Vec<_> = s.vehicles.iter().map(|v| agent(&v.id, &endpoint)).collect();
     let arrival = plans.iter().map(Trajectory::arrival).fold(0.0, f64::max);
+    let (distributed, options) = settings(s, &endpoint, deviation_m, dir);
+    let stop = AtomicBool::new(false);
+    let report = execute_trajectories(s, plans, arrival, &distributed, &options, &stop)?;
+    finish(agents)?;
+    let events = std::fs::read_to_string(dir.join("mission.ndjson"))?
+        .lines()
+        .filter_map(|l| serde_json::from_str::<Value>(l).ok())
+        .filter(|r| r["record"] == "event")
+        .collect();
+    Ok((report, events))
+}
+
+/// The settings of [`execute`]: external agents on `endpoint`, 40× real time.
+fn settings(
+    s: &Scenario,
+    endpoint: &str,
+    deviation_m: f64,
+    dir: &Path,
+) -> (DistributedOptions, ExecOptions) {
     let distributed = DistributedOptions {
         mission: format!("reactions-{}", s.vehicles.len()),
         agents: AgentsMode::External,
-        listen: vec![endpoint.clone()],
+        listen: vec![endpoint.to_string()],
         routers: Vec::new(),
         join_timeout: Duration::from_secs(30),
         round_timeout: Duration::from_secs(10),
@@ -85,15 +104,37 @@ fn execute(
         quiet: true,
         seed: 1,
     };
-    let stop = AtomicBool::new(false);
-    let report = execute_trajectories(s, plans, arrival, &distributed, &options, &stop)?;
-    finish(agents)?;
-    let events = std::fs::read_to_string(dir.join("mission.ndjson"))?
-        .lines()
-        .filter_map(|l| serde_json::from_str::<Value>(l).ok())
-        .filter(|r| r["record"] == "event")
-        .collect();
-    Ok((report, events))
+    (distributed, options)
+}
+
+/// A scenario the agents could not read (here a start outside the box, as a coverage
+/// crawler's on a seabed above the box's nominal top was once) is refused before any router
+/// or agent starts, naming the field: every agent would have dropped the order, and the
+/// coordinator seen its vehicles only go silent.
+#[test]
+fn a_scenario_the_agents_cannot_read_is_refused_at_once() -> TestResult {
+    let mut s = scenario(&[("auv1", [100.0, 100.0, 200.0], [1900.0, 100.0, 200.0])])?;
+    s.vehicles[0].start[2] = 450.0;
+    let plans = vec![steady(&[s.vehicles[0].start, s.vehicles[0].goal], 1.5)];
+    let dir = tempfile::tempdir()?;
+    let (distributed, options) = settings(&s, "tcp/127.0.0.1:1", 10.0, dir.path());
+    let e = execute_trajectories(
+        &s,
+        &plans,
+        1200.0,
+        &distributed,
+        &options,
+        &AtomicBool::new(false),
+    )
+    .err()
+    .map(|e| format!("{e:#}"))
+    .unwrap_or_default();
+    assert!(
+        e.contains("does not read back") && e.contains("vehicles[0].start") && e.contains("450"),
+        "{e}"
+    );
+    assert!(!dir.path().join("mission.ndjson").exists());
+    Ok(())
 }
 
 /// The events of `kind` naming `vehicle`.

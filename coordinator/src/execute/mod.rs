@@ -198,6 +198,13 @@ pub fn execute_trajectories(
     if plans.len() != ids.len() {
         anyhow::bail!("{} trajectories for {} vehicles", plans.len(), ids.len());
     }
+    // Every agent reads the scenario back with the same parser and drops an order it cannot
+    // read (the coordinator would only see its vehicle go silent and be lost): checked here,
+    // before anything starts, with the name the agents give it.
+    let scenario_toml = toml::to_string(scenario)?;
+    let origin = format!("<scenario of mission {}>", distributed.mission);
+    Scenario::parse(&scenario_toml, std::path::Path::new(&origin))
+        .map_err(|e| anyhow::anyhow!("the scenario sent to the agents does not read back: {e}"))?;
     let session = Session::open(scenario, distributed)?;
     let (tx, rx) = mpsc::channel::<Open>();
     let net_session = session.net.session().clone();
@@ -260,7 +267,6 @@ pub fn execute_trajectories(
         decisions_ms: Vec::new(),
         dropped: 0,
     };
-    let scenario_toml = toml::to_string(scenario)?;
     x.log.write(&Record::Start(Start {
         mission: x.mission.clone(),
         scenario_toml: scenario_toml.clone(),
