@@ -29,7 +29,7 @@ use shoal_common::trajectory::Trajectory;
 
 use crate::cli::PlanArgs;
 use crate::distributed::DistributedOptions;
-use crate::run_cmd::{executable, plan_state, Executable};
+use crate::run_cmd::{executable, Executable};
 
 /// Plans `scenario`'s coverage into `--out` and returns what the agents execute; `None` (after
 /// saying why) when the plan is not to be executed.
@@ -55,7 +55,7 @@ pub fn plan(
         );
     }
     let planned = crate::plan_coverage_mission(p, &planning, shutdown, || Ok(options.clone()))?;
-    if !executable(&plan_state(planned.feasible, shutdown)) {
+    if !executable(planned.feasible, shutdown) {
         return Ok(None);
     }
     let trajectories: Vec<Trajectory> = planned

@@ -171,7 +171,7 @@ fn plan_trajectories(
     write_outputs(&p.out, &plan)?;
     write_svg(&p.out, scenario, &plan)?;
     say(&summary::summary(&plan));
-    if !executable(&plan_state(plan.feasible, shutdown)) {
+    if !executable(plan.feasible, shutdown) {
         return Ok(None);
     }
     Ok(Some(Executable {
@@ -185,42 +185,18 @@ fn plan_trajectories(
     }))
 }
 
-/// How planning ended, as far as executing it goes.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) enum PlanState {
-    /// Feasible and whole.
-    Ready,
-    /// Ctrl-C while planning.
-    Interrupted,
-    /// With violations.
-    Infeasible,
-}
-
-/// The state of a plan that is `feasible` or not, Ctrl-C (`shutdown`) counting first.
-pub(crate) fn plan_state(feasible: bool, shutdown: &AtomicBool) -> PlanState {
+/// Whether a plan that is `feasible` or not is executed; says why not on stderr. Ctrl-C while
+/// planning (`shutdown`) asks for the plan so far, not for a mission started and stopped at
+/// once.
+pub(crate) fn executable(feasible: bool, shutdown: &AtomicBool) -> bool {
     if shutdown.load(Ordering::Relaxed) {
-        PlanState::Interrupted
+        eprintln!("interrupted while planning: the plan so far is written, it is not executed");
+        false
     } else if !feasible {
-        PlanState::Infeasible
+        eprintln!("the plan is not feasible: it is not executed (see plan.json)");
+        false
     } else {
-        PlanState::Ready
-    }
-}
-
-/// Whether a plan in `state` is executed; says why not on stderr.
-pub(crate) fn executable(state: &PlanState) -> bool {
-    match state {
-        PlanState::Ready => true,
-        // Ctrl-C while planning asks for the plan so far, not for a mission started and
-        // stopped at once.
-        PlanState::Interrupted => {
-            eprintln!("interrupted while planning: the plan so far is written, it is not executed");
-            false
-        }
-        PlanState::Infeasible => {
-            eprintln!("the plan is not feasible: it is not executed (see plan.json)");
-            false
-        }
+        true
     }
 }
 

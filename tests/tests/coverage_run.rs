@@ -13,17 +13,10 @@ use std::time::{Duration, Instant};
 use common::coverage::small_fleet;
 use common::fleet::Fleet;
 use common::process::{coordinator, root};
-use common::{without_shoal_env, TestResult};
+use common::{number, without_shoal_env, TestResult};
 use serde_json::Value;
 
 const LIMIT: Duration = Duration::from_secs(240);
-
-fn num(v: &Value, field: &str) -> f64 {
-    match v[field].as_f64() {
-        Some(x) => x,
-        None => panic!("{field} is not a number in {v}"),
-    }
-}
 
 fn json(path: &Path) -> Result<Value, Box<dyn std::error::Error>> {
     Ok(serde_json::from_str(&std::fs::read_to_string(path)?)?)
@@ -55,37 +48,37 @@ fn crawlers_drive_their_coverage_paths_and_each_ends_at_its_own_finish() -> Test
     // The plan is the coverage plan, timed 10 m over d_min for the tracking error.
     let plan = json(&out.join("plan.json"))?;
     assert_eq!(plan["kind"], "coverage-fleet");
-    assert_eq!(num(&plan["fleet"]["separation"], "d_min_m"), 60.0);
+    assert_eq!(number(&plan["fleet"]["separation"], "d_min_m"), 60.0);
     let report = json(&out.join("execution.json"))?;
     let f = &report["figures"];
-    assert!(num(f, "min_separation_m") >= 50.0, "{f}");
+    assert!(number(f, "min_separation_m") >= 50.0, "{f}");
     assert_eq!(f["all_arrived_in_window"], Value::Bool(true), "{f}");
     let vehicles = f["vehicles"].as_array().cloned().unwrap_or_default();
     assert_eq!(vehicles.len(), 2);
     let mut due = Vec::new();
     for v in &vehicles {
         // Each crawler is due when its own path ends, and arrived then.
-        let planned = num(v, "planned_arrival_s");
-        assert!((num(v, "arrived_s") - planned).abs() <= 30.0, "{v}");
+        let planned = number(v, "planned_arrival_s");
+        assert!((number(v, "arrived_s") - planned).abs() <= 30.0, "{v}");
         // 15 rows of 300 m at 0.5 m/s take over 2.5 h.
         assert!(planned > 9000.0, "{v}");
-        assert!(num(v, "p95_cross_track_m") < 5.0, "{v}");
-        assert!(num(v, "reports") > 20.0, "{v}");
-        assert_eq!(num(v, "revision"), 0.0, "{v}");
+        assert!(number(v, "p95_cross_track_m") < 5.0, "{v}");
+        assert!(number(v, "reports") > 20.0, "{v}");
+        assert_eq!(number(v, "revision"), 0.0, "{v}");
         // On the seabed map: never on impassable ground, a few metres inside the planner's
         // 8 m safety clearance at most.
-        assert_eq!(num(v, "impassable_m"), 0.0, "{v}");
-        assert!(num(v, "min_ground_clearance_m") > 3.0, "{v}");
+        assert_eq!(number(v, "impassable_m"), 0.0, "{v}");
+        assert!(number(v, "min_ground_clearance_m") > 3.0, "{v}");
         due.push(planned);
     }
     assert!(
         (due[0] - due[1]).abs() > 1.0,
         "both crawlers due at the same time: {due:?}"
     );
-    assert!((num(f, "common_arrival_s") - due[0].max(due[1])).abs() < 1e-6);
+    assert!((number(f, "common_arrival_s") - due[0].max(due[1])).abs() < 1e-6);
     // The executed swaths cover about what the planned ones do (88 %), less the tracking error.
-    let executed = num(&f["coverage"], "ratio");
-    let planned = num(&plan["fleet"]["coverage"], "ratio");
+    let executed = number(&f["coverage"], "ratio");
+    let planned = number(&plan["fleet"]["coverage"], "ratio");
     assert!(
         executed > planned - 0.06 && executed <= planned + 0.01,
         "{executed} vs {planned}"
@@ -114,14 +107,14 @@ fn a_crawler_holds_before_an_obstacle_on_its_coverage_path() -> TestResult {
     assert!(r.stdout.contains("crawler2 never arrived"), "{}", r.stdout);
     let report = json(&out.join("execution.json"))?;
     let f = &report["figures"];
-    assert!(num(&report, "holds") >= 1.0, "{report}");
+    assert!(number(&report, "holds") >= 1.0, "{report}");
     let c2 = &f["vehicles"][1];
     assert_eq!(c2["vehicle"], "crawler2");
     // It stopped before the obstacle's keep-out sphere and stayed held (it did not skip the
     // rows its plan passed while it waited), and the pair kept d_min.
-    assert!(num(c2, "min_obstacle_clearance_m") > 50.0, "{c2}");
-    assert_eq!(num(c2, "revision"), 0.0, "{c2}");
-    assert!(num(f, "min_separation_m") >= 50.0, "{f}");
+    assert!(number(c2, "min_obstacle_clearance_m") > 50.0, "{c2}");
+    assert_eq!(number(c2, "revision"), 0.0, "{c2}");
+    assert!(number(f, "min_separation_m") >= 50.0, "{f}");
     let log = std::fs::read_to_string(out.join("mission.ndjson"))?;
     assert!(
         log.lines()
