@@ -184,7 +184,7 @@ fn a_predicted_conflict_replans_the_later_vehicle_and_separation_holds() -> Test
     assert!(f.vehicles[1].revision >= 1);
     let d = f.min_separation_m.ok_or("no separation figure")?;
     assert!(d >= 50.0, "executed separation {d} m: {f:?}");
-    assert!(f.all_arrived_in_window, "{f:?}");
+    assert!(f.all_arrived_in_window, "{f:?}\n{log:#?}");
     assert_eq!(report.holds, 0);
     Ok(())
 }
