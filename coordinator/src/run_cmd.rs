@@ -57,7 +57,7 @@ pub struct RunArgs {
     /// 150 s of mission time after T. Repeatable.
     #[arg(long = "inject-obstacle", value_parser = parse_injection)]
     pub inject: Vec<(f64, Place, f64)>,
-    /// The mission log (default: <out>/mission.ndjson).
+    /// The mission log (default: `<out>/mission.ndjson`).
     #[arg(long, env = "SHOAL_LOG")]
     pub log: Option<PathBuf>,
 }

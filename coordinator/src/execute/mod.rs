@@ -1,9 +1,9 @@
 //! Executing a plan (`shoal-coordinator run`, issue 8): every agent drives its vehicle along its
 //! trajectory through its vehicle link and reports telemetry; the coordinator keeps the live
 //! fleet picture ([`fleet`]), publishes it on the open JSON keys, logs everything ([`log`]) and
-//! reacts ([`react`]): a predicted loss of separation, a deviation beyond the tolerance, a
+//! reacts (`react`): a predicted loss of separation, a deviation beyond the tolerance, a
 //! vehicle that stops reporting or a new obstacle makes it replan the affected vehicles
-//! ([`replan`]; an inspection tour or an energy plan is repaired instead, [`repair`]) or, when
+//! ([`replan`]; an inspection tour or an energy plan is repaired instead, `repair`) or, when
 //! no safe replan comes in time, command a hold.
 
 mod detour;

@@ -7,7 +7,7 @@
 //! restricted to one vehicle) solved by A-PSO (seed 004 eq. (7) parameters) under a wall-time
 //! budget, warm-started: the first particle is the current plan's remainder resampled onto the
 //! M waypoints (pushed out of new obstacles), the second a coarse way round the hard obstacles
-//! ([`super::detour`]) when there is one, a few more are jittered copies of these, the rest are
+//! (`detour`) when there is one, a few more are jittered copies of these, the rest are
 //! sampled as usual. The first particle alone is already the answer when the change does not
 //! touch the vehicle's path.
 //!
@@ -153,7 +153,7 @@ fn at_even_speed(points: &[Vec3], t0: f64, duration: f64) -> Trajectory {
 }
 
 /// Moves every waypoint of `genes` (M waypoints, coordinates first) closer than
-/// [`PUSH_OUT`] × a hard obstacle's inflated radius to its centre sideways — perpendicular to
+/// `PUSH_OUT` × a hard obstacle's inflated radius to its centre sideways — perpendicular to
 /// the path there, horizontally when the path runs through the centre — to that distance: the
 /// warm start then already goes round a new obstacle, and the swarm only has to smooth it. At
 /// 1.4 r, the chord between two pushed neighbours up to 88° apart round the centre stays

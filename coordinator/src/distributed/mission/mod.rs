@@ -250,7 +250,7 @@ pub fn run(
 }
 
 /// Runs a one-shot mission (tours of seed 003, coverage strips of seed 002): every agent plans
-/// its own share; see [`shares`]. Returns every vehicle's share and the figures.
+/// its own share; see `shares`. Returns every vehicle's share and the figures.
 #[allow(clippy::too_many_arguments)] // `run`'s inputs plus the job
 pub fn run_share_mission(
     scenario: &Scenario,
