@@ -7,7 +7,7 @@ mod common;
 
 use std::path::Path;
 
-use common::{key, plan, scenario, TestResult};
+use common::{key, plan, read_json, scenario, TestResult};
 use serde_json::Value;
 
 fn num(v: &Value, field: &str) -> f64 {
@@ -45,7 +45,7 @@ fn a_crawler_covers_a_small_seabed_safely_and_tracks_its_path() -> TestResult {
     let out = dir.path().join("out");
     let r = plan(&file, &out, &[]);
     assert_eq!(r.code(), Some(0), "{}\n{}", r.stdout, r.stderr);
-    let json: Value = serde_json::from_str(&std::fs::read_to_string(out.join("plan.json"))?)?;
+    let json = read_json(&out.join("plan.json"))?;
     assert_eq!(key(&json, "kind").as_str(), Some("coverage"));
     assert_eq!(key(&json, "feasible").as_bool(), Some(true));
     let c = key(&json, "coverage");
@@ -102,7 +102,7 @@ fn the_hybrid_a_star_baseline_runs_under_the_same_macro_routing() -> TestResult 
         "{}",
         r.stderr
     );
-    let json: Value = serde_json::from_str(&std::fs::read_to_string(out.join("plan.json"))?)?;
+    let json = read_json(&out.join("plan.json"))?;
     let c = key(&json, "coverage");
     assert_eq!(c["method"].as_str(), Some("hybrid-a-star"));
     assert!(c["tracking"].is_null());

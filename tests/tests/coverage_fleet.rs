@@ -5,12 +5,11 @@
 
 mod common;
 
-use std::path::Path;
 use std::time::{Duration, Instant};
 
 use common::coverage::small_fleet;
 use common::fleet::Fleet;
-use common::{key, plan, TestResult};
+use common::{key, plan, read_json, TestResult};
 use serde_json::Value;
 
 const LIMIT: Duration = Duration::from_secs(240);
@@ -22,12 +21,6 @@ fn num(v: &Value, field: &str) -> f64 {
     }
 }
 
-fn read_plan(out: &Path) -> Result<Value, Box<dyn std::error::Error>> {
-    Ok(serde_json::from_str(&std::fs::read_to_string(
-        out.join("plan.json"),
-    )?)?)
-}
-
 #[test]
 fn agents_plan_their_strips_and_the_fleet_keeps_its_separation() -> TestResult {
     let mut fleet = Fleet::new();
@@ -36,7 +29,7 @@ fn agents_plan_their_strips_and_the_fleet_keeps_its_separation() -> TestResult {
     let c = fleet.coordinator_on("coordinator", &file, &out, &[]);
     let r = fleet.wait(c, Instant::now() + LIMIT);
     assert_eq!(r.code(), Some(0), "{}\n{}", r.stdout, r.stderr);
-    let json = read_plan(&out)?;
+    let json = read_json(&out.join("plan.json"))?;
     assert_eq!(key(&json, "kind").as_str(), Some("coverage-fleet"));
     assert_eq!(key(&json, "feasible").as_bool(), Some(true));
     assert_eq!(key(&json, "distributed.messages_dropped").as_u64(), Some(0));
@@ -82,7 +75,7 @@ fn agents_plan_their_strips_and_the_fleet_keeps_its_separation() -> TestResult {
     let local_out = fleet.dir().join("local");
     let local = plan(&file, &local_out, &[]);
     assert_eq!(local.code(), Some(0), "{}\n{}", local.stdout, local.stderr);
-    let local = read_plan(&local_out)?;
+    let local = read_json(&local_out.join("plan.json"))?;
     let lf = key(&local, "fleet");
     assert_eq!(lf["coverage"], f["coverage"]);
     assert_eq!(lf["separation"], f["separation"]);
@@ -132,7 +125,7 @@ fn a_strip_its_agent_cannot_plan_is_planned_by_the_coordinator() -> TestResult {
     let c = fleet.coordinator_on("coordinator", &file, &out, &[]);
     let r = fleet.wait(c, Instant::now() + LIMIT);
     assert_eq!(r.code(), Some(0), "{}\n{}", r.stdout, r.stderr);
-    let json = read_plan(&out)?;
+    let json = read_json(&out.join("plan.json"))?;
     assert_eq!(key(&json, "feasible").as_bool(), Some(true));
     let degraded: Vec<&str> = key(&json, "distributed.degraded")
         .as_array()

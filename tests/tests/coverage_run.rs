@@ -13,14 +13,10 @@ use std::time::{Duration, Instant};
 use common::coverage::small_fleet;
 use common::fleet::Fleet;
 use common::process::{coordinator, root};
-use common::{number, without_shoal_env, TestResult};
+use common::{number, read_json, without_shoal_env, TestResult};
 use serde_json::Value;
 
 const LIMIT: Duration = Duration::from_secs(240);
-
-fn json(path: &Path) -> Result<Value, Box<dyn std::error::Error>> {
-    Ok(serde_json::from_str(&std::fs::read_to_string(path)?)?)
-}
 
 /// `run FILE --in-process -q --time-scale 500 --out OUT EXTRA…`.
 fn run(file: &Path, out: &Path, extra: &[&str]) -> Command {
@@ -46,10 +42,10 @@ fn crawlers_drive_their_coverage_paths_and_each_ends_at_its_own_finish() -> Test
     assert_eq!(r.code(), Some(0), "{}\n{}", r.stdout, r.stderr);
     assert!(r.stdout.contains("  MET: "), "{}", r.stdout);
     // The plan is the coverage plan, timed 10 m over d_min for the tracking error.
-    let plan = json(&out.join("plan.json"))?;
+    let plan = read_json(&out.join("plan.json"))?;
     assert_eq!(plan["kind"], "coverage-fleet");
     assert_eq!(number(&plan["fleet"]["separation"], "d_min_m"), 60.0);
-    let report = json(&out.join("execution.json"))?;
+    let report = read_json(&out.join("execution.json"))?;
     let f = &report["figures"];
     assert!(number(f, "min_separation_m") >= 50.0, "{f}");
     assert_eq!(f["all_arrived_in_window"], Value::Bool(true), "{f}");
@@ -105,7 +101,7 @@ fn a_crawler_holds_before_an_obstacle_on_its_coverage_path() -> TestResult {
     let r = fleet.wait(c, Instant::now() + LIMIT);
     assert_eq!(r.code(), Some(3), "{}\n{}", r.stdout, r.stderr);
     assert!(r.stdout.contains("crawler2 never arrived"), "{}", r.stdout);
-    let report = json(&out.join("execution.json"))?;
+    let report = read_json(&out.join("execution.json"))?;
     let f = &report["figures"];
     assert!(number(&report, "holds") >= 1.0, "{report}");
     let c2 = &f["vehicles"][1];

@@ -11,7 +11,7 @@ use std::time::{Duration, Instant};
 
 use common::fleet::{endpoint, free_port, Fleet};
 use common::process::{coordinator, root};
-use common::{scenario, without_shoal_env, TestResult};
+use common::{read_json, scenario, without_shoal_env, TestResult};
 use serde_json::Value;
 
 const LIMIT: Duration = Duration::from_secs(240);
@@ -73,13 +73,6 @@ fn segment_distance(a: [f64; 3], b: [f64; 3], p: [f64; 3]) -> f64 {
         .sqrt()
 }
 
-/// `<out>/execution.json`.
-fn execution_report(out: &Path) -> Result<Value, Box<dyn std::error::Error>> {
-    Ok(serde_json::from_str(&std::fs::read_to_string(
-        out.join("execution.json"),
-    )?)?)
-}
-
 #[test]
 fn a_fleet_executes_its_plan_replans_around_a_new_obstacle_and_replays() -> TestResult {
     let mut fleet = Fleet::new();
@@ -120,7 +113,7 @@ fn a_fleet_executes_its_plan_replans_around_a_new_obstacle_and_replays() -> Test
     let r = fleet.wait(c, Instant::now() + LIMIT);
     assert_eq!(r.code(), Some(0), "{}\n{}", r.stdout, r.stderr);
     assert!(r.stdout.contains("  MET: "), "{}", r.stdout);
-    let report = execution_report(&out)?;
+    let report = read_json(&out.join("execution.json"))?;
     let f = &report["figures"];
     assert!(num(f, "min_separation_m") >= 50.0, "{f}");
     assert_eq!(f["all_arrived_in_window"], Value::Bool(true), "{f}");
@@ -197,7 +190,7 @@ fn a_vehicle_that_stops_reporting_is_declared_lost_and_the_rest_arrive() -> Test
         "{}",
         r.stdout
     );
-    let report = execution_report(&out)?;
+    let report = read_json(&out.join("execution.json"))?;
     let f = &report["figures"];
     assert_eq!(f["vehicles"][2]["lost"], Value::Bool(true), "{f}");
     assert_eq!(f["vehicles"][2]["arrived_s"], Value::Null, "{f}");
@@ -235,7 +228,7 @@ fn a_lone_auv_flies_its_energy_plan_in_the_current() -> TestResult {
     let c = fleet.spawn("coordinator", cmd);
     let r = fleet.wait(c, Instant::now() + LIMIT);
     assert_eq!(r.code(), Some(0), "{}\n{}", r.stdout, r.stderr);
-    let report = execution_report(&out)?;
+    let report = read_json(&out.join("execution.json"))?;
     let v = &report["figures"]["vehicles"][0];
     assert_eq!(v["in_window"].as_bool(), Some(true), "{v}");
     // Measured: p95 4.4 m, max 16.3 m (one replan where the surface current sweeps the AUV
@@ -292,7 +285,7 @@ fn a_lone_auv_flies_its_energy_plan_in_the_current() -> TestResult {
         "{kept} of {} repaired points are the plan's",
         repaired.len()
     );
-    let v = &execution_report(&out)?["figures"]["vehicles"][0];
+    let v = &read_json(&out.join("execution.json"))?["figures"]["vehicles"][0];
     assert!(num(v, "min_obstacle_clearance_m") > 0.0, "{v}");
     fleet.passed();
     Ok(())
@@ -307,7 +300,7 @@ fn crawlers_report_hazard_clearance_and_the_auv_its_height_above_the_seabed() ->
     let c = fleet.spawn("coordinator", cmd);
     let r = fleet.wait(c, Instant::now() + LIMIT);
     assert_eq!(r.code(), Some(0), "{}\n{}", r.stdout, r.stderr);
-    let report = execution_report(&out)?;
+    let report = read_json(&out.join("execution.json"))?;
     let vehicles = &report["figures"]["vehicles"];
     for k in 0..2 {
         let v = &vehicles[k];
@@ -331,7 +324,7 @@ fn a_vehicle_with_no_safe_replan_is_told_to_hold() -> TestResult {
     let c = fleet.spawn("coordinator", cmd);
     let r = fleet.wait(c, Instant::now() + LIMIT);
     assert_eq!(r.code(), Some(3), "{}\n{}", r.stdout, r.stderr);
-    let report = execution_report(&out)?;
+    let report = read_json(&out.join("execution.json"))?;
     assert!(num(&report, "holds") >= 1.0, "{report}");
     let f = &report["figures"];
     assert_eq!(f["vehicles"][1]["arrived_s"], Value::Null, "{f}");
@@ -373,8 +366,8 @@ fn an_inspection_tour_is_run_and_repaired_round_a_new_obstacle_keeping_its_point
     if r.code() == Some(3) {
         assert!(r.stdout.contains("NOT MET: "), "{}", r.stdout);
     }
-    let plan: Value = serde_json::from_str(&std::fs::read_to_string(out.join("plan.json"))?)?;
-    let report = execution_report(&out)?;
+    let plan = read_json(&out.join("plan.json"))?;
+    let report = read_json(&out.join("execution.json"))?;
     let f = &report["figures"];
     assert!(num(f, "min_separation_m") >= 20.0, "{f}");
     // The cages' 3 m planning margin covers the simulated tracking error at the 95th

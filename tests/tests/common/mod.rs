@@ -37,6 +37,12 @@ pub const CAGES_FLEET_QUICK: [&str; 6] = [
     "ldiw-pso",
 ];
 
+/// The JSON file at `path` (a `plan.json`, `execution.json`, …); an error names the file.
+pub fn read_json(path: &Path) -> Result<Value, Box<dyn Error>> {
+    let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    Ok(serde_json::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))?)
+}
+
 /// `scenarios/<name>.toml`.
 pub fn scenario(name: &str) -> PathBuf {
     let p = root().join("scenarios").join(format!("{name}.toml"));
