@@ -281,9 +281,9 @@ impl Simulator {
             self.status = VehicleStatus::Fault;
             self.velocity = Vec3::zeros();
         } else if let Some(plan) = &self.plan {
-            let to_end = plan.points[plan.points.len() - 1] - self.p;
+            let end = plan.points[plan.points.len() - 1];
+            let to_end = end - self.p;
             let passing = to_end.norm() <= CAPTURE_RADIUS_M && to_end.dot(&self.velocity) <= 0.0;
-            let end = self.p + to_end;
             if self.t >= plan.arrival() && (to_end.norm() <= ARRIVAL_RADIUS_M || passing) {
                 self.status = VehicleStatus::Arrived;
                 self.hold_at = end;
