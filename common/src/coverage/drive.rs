@@ -70,7 +70,7 @@ pub fn drive_trajectory(
 
 /// Indices of `points` to keep: the first, the last, and greedily the farthest point each leg
 /// can reach while every skipped point stays within `tol` of it (at most [`MAX_RUN`] apart).
-fn thin(points: &[Vec3], tol: f64) -> Vec<usize> {
+pub(crate) fn thin(points: &[Vec3], tol: f64) -> Vec<usize> {
     if points.len() <= 2 {
         return (0..points.len()).collect();
     }

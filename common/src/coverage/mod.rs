@@ -31,6 +31,7 @@ pub mod params;
 pub mod path;
 pub mod perlin;
 pub mod reach;
+pub mod reroute;
 pub mod rows;
 pub mod spec;
 pub mod sweeps;

@@ -12,6 +12,18 @@ use std::collections::BinaryHeap;
 use crate::queue::Cheapest;
 
 use super::boxes::Rect;
+use super::hybrid_astar::{self, HybridAStarError, HybridAStarParams, HybridAStarResult};
+use super::path::Pose2;
+
+/// Weight on the grid-distance guide of a guided search (weighted A*: the path found is at most
+/// this factor longer than the shortest, and found with far fewer expansions).
+const GUIDE_WEIGHT: f64 = 1.5;
+
+/// How far the grid guide of a search is expanded: this many times the chord plus a margin (a
+/// way round an obstacle rarely exceeds twice the straight line; beyond it the guide reads flat
+/// and the search is only slower, never wrong).
+const GUIDE_REACH: f64 = 3.0;
+const GUIDE_MARGIN_M: f64 = 200.0;
 
 /// The safety predicate on a raster of square cells.
 #[derive(Debug, Clone)]
@@ -107,6 +119,29 @@ impl ReachGrid {
     /// Whether two points lie in the same free region.
     pub fn connected(&self, a: [f64; 2], b: [f64; 2]) -> bool {
         matches!((self.region(a[0], a[1]), self.region(b[0], b[1])), (Some(p), Some(q)) if p == q)
+    }
+
+    /// A forward-only path from `from` to `goal` on `free` within `bounds` (see
+    /// [`hybrid_astar::plan`]), searched only when the two lie in the same free region of this
+    /// grid and guided by the grid distance to the goal, weighted by [`GUIDE_WEIGHT`]: a
+    /// transit or a way round needs to be found fast, not to be shortest. `Ok(None)` when the
+    /// two are not connected or the search finds nothing within `params.max_expansions`.
+    pub fn guided_search(
+        &self,
+        from: Pose2,
+        goal: Pose2,
+        free: &dyn Fn(f64, f64) -> bool,
+        bounds: [f64; 4],
+        params: &HybridAStarParams,
+    ) -> Result<Option<HybridAStarResult>, HybridAStarError> {
+        if !self.connected(from.xy(), goal.xy()) {
+            return Ok(None);
+        }
+        let chord = (goal.x - from.x).hypot(goal.y - from.y);
+        let guide =
+            self.distance_between(goal.xy(), from.xy(), GUIDE_REACH * chord + GUIDE_MARGIN_M);
+        let guide = |x: f64, y: f64| GUIDE_WEIGHT * guide.at(x, y);
+        hybrid_astar::plan_guided(from, goal, free, bounds, params, &guide)
     }
 
     /// Grid distances (metres) from `goal` over free cells, expanded until `limit` metres;

@@ -19,23 +19,13 @@ use serde::{Deserialize, Serialize};
 
 use super::boustrophedon::{ArcDetour, DetourPlanner, Field, Machine, PlannerEvent, RowState};
 use super::boxes::{band_boxes, no_go_boxes, Rect};
-use super::hybrid_astar::{self, HybridAStarParams};
+use super::hybrid_astar::HybridAStarParams;
 use super::hybrid_detour::HybridDetour;
 use super::params::{CoverageParams, DetourMethod};
 use super::path::{CoveragePath, PieceKind, Pose2};
 use super::reach::ReachGrid;
 use super::rows::RowBook;
 use super::{Terrain25Error, TerrainMap25};
-
-/// Weight on the grid-distance guide of a transit search (weighted A*: the path found is at most
-/// this factor longer than the shortest, and found with far fewer expansions).
-const TRANSIT_GUIDE_WEIGHT: f64 = 1.5;
-
-/// How far the grid guide of a transit is expanded: this many times the transit's chord plus a
-/// margin (a detour around an obstacle rarely exceeds twice the straight line; beyond it the
-/// guide reads flat and the search is only slower, never wrong).
-const GUIDE_REACH: f64 = 3.0;
-const GUIDE_MARGIN_M: f64 = 200.0;
 
 /// A coverage plan for one area.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -222,17 +212,9 @@ impl Sweeping {
             };
             if let Some(from) = here {
                 let goal = entry.pose();
-                let chord = (goal.x - from.x).hypot(goal.y - from.y);
                 let affordable = params.transit_expansions > 0 && self.budget > 0;
-                let transit = if affordable && reach.connected(from.xy(), goal.xy()) {
-                    let guide = reach.distance_between(
-                        goal.xy(),
-                        from.xy(),
-                        GUIDE_REACH * chord + GUIDE_MARGIN_M,
-                    );
-                    // Weighted A* (ε = 1.5): a transit needs to be found, not to be shortest.
-                    let guide = |x: f64, y: f64| TRANSIT_GUIDE_WEIGHT * guide.at(x, y);
-                    hybrid_astar::plan_guided(from, goal, &free, bounds, &transit_params, &guide)
+                let transit = if affordable {
+                    reach.guided_search(from, goal, &free, bounds, &transit_params)
                 } else {
                     Ok(None)
                 };
