@@ -112,7 +112,10 @@ pub fn replay(path: &Path) -> anyhow::Result<Replayed> {
                 }
                 events.push(e.clone());
             }
-            Record::Obstacle(o) => scenario.obstacles.push(o.clone()),
+            Record::Obstacle(o) => {
+                scenario.obstacles.push(o.clone());
+                fleet.obstacle_published();
+            }
             Record::End(f) => logged = Some(f.clone()),
             Record::Start(_) | Record::Plan(_) => {}
         }

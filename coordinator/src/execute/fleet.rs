@@ -104,6 +104,9 @@ pub struct Fleet {
     /// Closest pair over the executed tracks so far is computed at the end; this is the
     /// smallest pairwise distance between simultaneous latest fixes seen live, metres.
     pub live_min_separation: f64,
+    /// Per obstacle published during the run, in order: each vehicle's number of track points
+    /// when it came (see [`Fleet::obstacle_published`]).
+    pub published: Vec<Vec<usize>>,
 }
 
 impl Fleet {
@@ -140,7 +143,17 @@ impl Fleet {
             latencies_ms: Vec::new(),
             reports: 0,
             live_min_separation: f64::INFINITY,
+            published: Vec::new(),
         }
+    }
+
+    /// Notes that an obstacle was published now: a vehicle's clearance from it is measured on
+    /// its track from its last fix before (the leg it was on then) onwards, not on the track it
+    /// drove before the obstacle existed. The live run and `replay` call it at the same point
+    /// of the record stream, so both measure the same.
+    pub fn obstacle_published(&mut self) {
+        let marks = self.vehicles.iter().map(|v| v.track.points.len()).collect();
+        self.published.push(marks);
     }
 
     /// Index of vehicle `id`.
@@ -173,8 +186,12 @@ impl Fleet {
         if v.track.times.last().is_none_or(|&last| now >= last) {
             let tau = progress.plan_time_s;
             let offset = p - v.plan.position_at(tau);
+            // A vehicle told to hold stays where it is: its fixes are joined directly, not
+            // along the plan it has left (which would draw it driving on, past whatever it
+            // was holding for).
+            let held = v.holding || t.state.status == VehicleStatus::Holding;
             if let (Some((tau0, offset0, revision)), Some(&t0)) = (v.anchor, v.track.times.last()) {
-                if revision == v.revision {
+                if revision == v.revision && !held {
                     let corners = along_plan(&v.plan, (t0, tau0, offset0), (now, tau, offset));
                     for (t, q) in corners {
                         v.track.times.push(t);
@@ -325,7 +342,8 @@ impl Fleet {
     }
 
     /// The figures of the execution so far.
-    /// `obstacles`: every obstacle known at the end (the scenario's and the published ones).
+    /// `obstacles`: every obstacle known at the end (the scenario's, then the published ones
+    /// in the order [`Fleet::obstacle_published`] noted them).
     pub fn figures(
         &self,
         common_arrival_s: f64,
@@ -346,10 +364,24 @@ impl Fleet {
                 ));
             }
         }
+        // Per vehicle, the first track point that counts for each obstacle: 0 for the
+        // scenario's own, the last fix before publication for a published one.
+        let own = obstacles.len().saturating_sub(self.published.len());
+        let since = |i: usize| -> Vec<usize> {
+            (0..obstacles.len())
+                .map(|o| {
+                    o.checked_sub(own)
+                        .and_then(|p| self.published.get(p))
+                        .and_then(|marks| marks.get(i))
+                        .map_or(0, |n| n.saturating_sub(1))
+                })
+                .collect()
+        };
         let vehicles: Vec<VehicleFigures> = self
             .vehicles
             .iter()
-            .map(|v| VehicleFigures {
+            .enumerate()
+            .map(|(i, v)| VehicleFigures {
                 vehicle: v.id.clone(),
                 reports: v.fixes,
                 arrived_s: v.arrived_s,
@@ -358,7 +390,7 @@ impl Fleet {
                     .arrived_s
                     .is_some_and(|t| (t - v.planned_arrival_s).abs() <= window_s),
                 max_cross_track_m: v.cross_track.iter().copied().fold(0.0, f64::max),
-                min_obstacle_clearance_m: obstacle_clearance(&v.track, obstacles),
+                min_obstacle_clearance_m: obstacle_clearance(&v.track, obstacles, &since(i)),
                 min_seabed_clearance_m: None,
                 min_hazard_clearance_m: None,
                 min_ground_clearance_m: None,

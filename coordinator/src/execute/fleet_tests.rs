@@ -262,3 +262,83 @@ fn a_faulted_vehicle_stays_put_in_the_picture_until_its_link_recovers() {
     );
     assert_eq!(f.vehicles[0].fault_s, None);
 }
+
+#[test]
+fn an_obstacle_published_mid_run_is_measured_on_the_track_from_then_on() {
+    let ids = vec!["a".to_string()];
+    let mut f = Fleet::new(&ids, &[straight(0.0)], 50.0, 60.0);
+    // a drives along y = 0 and reports at x = 20, 50 and 90; the obstacle (radius 5, centre
+    // (30, 0)) is published after the fix at x = 50, when a is already past it.
+    f.report(
+        report("a", 0, 20.0, [20.0, 0.0, 0.0], VehicleStatus::Underway),
+        1_001_000,
+    );
+    f.report(
+        report("a", 1, 50.0, [50.0, 0.0, 0.0], VehicleStatus::Underway),
+        1_002_000,
+    );
+    f.obstacle_published();
+    f.report(
+        report("a", 2, 90.0, [90.0, 0.0, 0.0], VehicleStatus::Underway),
+        1_003_000,
+    );
+    let rock = Obstacle {
+        id: "rock".into(),
+        kind: ObstacleKind::Hard,
+        centre: [30.0, 0.0, 0.0],
+        radius_m: 5.0,
+        inflation_m: 0.0,
+    };
+    let fig = f.figures(100.0, 10.0, std::slice::from_ref(&rock));
+    // Measured from the fix at x = 50 (the leg it was on when the rock came): 20 m from the
+    // centre, 15 m from the surface. The track before went through it (clearance −5).
+    let c = fig.vehicles[0].min_obstacle_clearance_m.unwrap_or(f64::NAN);
+    assert!((c - 15.0).abs() < 1e-9, "{c}");
+    // The same rock as one of the scenario's own (no publication noted) counts all the way.
+    let mut g = f.clone();
+    g.published.clear();
+    let fig = g.figures(100.0, 10.0, std::slice::from_ref(&rock));
+    let c = fig.vehicles[0].min_obstacle_clearance_m.unwrap_or(f64::NAN);
+    assert!((c + 5.0).abs() < 1e-9, "{c}");
+}
+
+#[test]
+fn a_holding_vehicles_fixes_are_joined_directly_not_along_its_plan() {
+    // Out along y = 0 to (100, 0), up to (100, 20), back to (0, 20) and down to (0, 2).
+    let p = |x: f64, y: f64| Vec3::new(x, y, 0.0);
+    let plan = Trajectory {
+        times: vec![0.0, 100.0, 120.0, 220.0, 238.0],
+        points: vec![
+            p(0.0, 0.0),
+            p(100.0, 0.0),
+            p(100.0, 20.0),
+            p(0.0, 20.0),
+            p(0.0, 2.0),
+        ],
+    };
+    let ids = vec!["a".to_string()];
+    let track_of = |holding: bool| {
+        let mut f = Fleet::new(&ids, std::slice::from_ref(&plan), 50.0, 60.0);
+        f.report(
+            report("a", 0, 2.0, [2.0, 0.0, 0.0], VehicleStatus::Underway),
+            1_001_000,
+        );
+        let status = if holding {
+            f.vehicles[0].holding = true;
+            VehicleStatus::Holding
+        } else {
+            VehicleStatus::Underway
+        };
+        // At t = 236 s it reports (1, 3): 1 m from the plan's last leg (at plan time 237 s),
+        // 3 m from its first. Under way, it would have driven the loop in between.
+        f.report(report("a", 1, 236.0, [1.0, 3.0, 0.0], status), 1_002_000);
+        f.vehicles[0].track.clone()
+    };
+    let held = track_of(true);
+    assert_eq!(held.points.len(), 2, "{held:?}");
+    assert!((held.points[1] - p(1.0, 3.0)).norm() < 1e-9);
+    // Under way, the same fixes are joined along the plan's corners (the loop's far end).
+    let driven = track_of(false);
+    let far = driven.points.iter().map(|q| q.x).fold(0.0, f64::max);
+    assert!(far > 90.0, "{driven:?}");
+}

@@ -181,6 +181,7 @@ fn obstacle(x: &mut Exec, o: Obstacle, received: Instant) {
     );
     x.log.write(&Record::Obstacle(o.clone()));
     x.scenario.obstacles.push(o.clone());
+    x.fleet.obstacle_published();
     for i in blocked {
         if replan_vehicle(x, i, "a new obstacle blocks its path") {
             x.decisions_ms

@@ -39,16 +39,26 @@ pub(super) fn along_plan(
         .collect()
 }
 
-/// Closest approach of `track` to the surface of any hard obstacle, metres.
-pub(super) fn obstacle_clearance(track: &Trajectory, obstacles: &[Obstacle]) -> Option<f64> {
+/// Closest approach of `track` to the surface of any hard obstacle, metres; obstacle `i` is
+/// measured on the track from point `since[i]` on (0 when `since` is shorter). `None` without
+/// a hard obstacle or fixes to measure.
+pub(super) fn obstacle_clearance(
+    track: &Trajectory,
+    obstacles: &[Obstacle],
+    since: &[usize],
+) -> Option<f64> {
     let mut best: Option<f64> = None;
-    for o in obstacles.iter().filter(|o| o.kind == ObstacleKind::Hard) {
+    for (i, o) in obstacles.iter().enumerate() {
+        if o.kind != ObstacleKind::Hard {
+            continue;
+        }
+        let from = since.get(i).copied().unwrap_or(0);
+        let points = track.points.get(from..).unwrap_or(&[]);
         let c = o.centre();
-        let d = match track.points.len() {
+        let d = match points.len() {
             0 => continue,
-            1 => (track.points[0] - c).norm(),
-            _ => track
-                .points
+            1 => (points[0] - c).norm(),
+            _ => points
                 .windows(2)
                 .map(|w| segment_point_distance(&w[0], &w[1], &c))
                 .fold(f64::INFINITY, f64::min),
