@@ -21,6 +21,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::{self, Receiver, RecvTimeoutError};
 use std::time::{Duration, Instant};
 
+use shoal_common::coverage::reroute::CrawlerGround;
 use shoal_common::execution::{unix_us, MissionClock};
 use shoal_common::scenario::{Obstacle, Scenario};
 use shoal_common::trajectory::Trajectory;
@@ -97,6 +98,9 @@ pub(crate) struct Exec<'a> {
     /// Decision times of obstacle replans (obstacle received → update sent), ms.
     pub(crate) decisions_ms: Vec<f64>,
     dropped: u64,
+    /// A coverage fleet's seabed map, for a crawler's way round a new obstacle; `None` for
+    /// other missions, or when the map cannot be built (a crawler then holds instead).
+    ground: Option<CrawlerGround>,
 }
 
 /// What an execution leaves.
@@ -182,6 +186,19 @@ impl Exec<'_> {
     }
 }
 
+/// The seabed of a coverage fleet, for its crawlers' ways round new obstacles; `None` for
+/// other missions, or (with a warning) when the map cannot be built here.
+fn crawler_ground(scenario: &Scenario) -> Option<CrawlerGround> {
+    scenario.coverage.as_ref()?;
+    match CrawlerGround::of(scenario, std::path::Path::new(".")) {
+        Ok(g) => Some(g),
+        Err(e) => {
+            tracing::warn!("a blocked crawler will hold, with no way round: {e}");
+            None
+        }
+    }
+}
+
 /// Executes the given trajectories of `scenario` (scenario order, mission-timed; their common
 /// arrival `common_arrival_s`): opens a router (and the agents `distributed` asks for), has
 /// every agent drive its vehicle, and watches until every vehicle has arrived or is lost.
@@ -243,6 +260,8 @@ pub fn execute_trajectories(
         })
         .wait()
         .map_err(|e| anyhow::anyhow!("cannot declare the queryable {status_key}: {e}"))?;
+    // Built before the mission clock starts: a large map takes a moment.
+    let ground = crawler_ground(scenario);
     let log = LogWriter::create(&options.log)?;
     let epoch_unix_ms = unix_us() / 1000 + 1500;
     let mut x = Exec {
@@ -266,6 +285,7 @@ pub fn execute_trajectories(
         deliveries_ms: Vec::new(),
         decisions_ms: Vec::new(),
         dropped: 0,
+        ground,
     };
     x.log.write(&Record::Start(Start {
         mission: x.mission.clone(),

@@ -338,6 +338,7 @@ pub(super) fn replan_vehicle(x: &mut Exec, i: usize, why: &str) -> bool {
         budget,
         separation_buffer_m: o.separation_buffer_m,
         seed,
+        ground: x.ground.as_ref(),
     };
     // A tour must still pass its remaining inspection points, an energy plan (seed 001)
     // keeps the path its cost chose over the seabed, its turning radius and the current, and

@@ -18,9 +18,12 @@
 //! approach are flown a little slower or faster ([`RETIMINGS`]), the later ones making up the
 //! difference, and the first timing that keeps the buffer is taken, else the first that keeps
 //! d_min (as [`super::replan`] prefers the buffer but never holds for it alone).
-//! A coverage crawler (seed 002) is repaired the same way, but gets no way round a blocked
-//! run: it must stay on passable seabed, which the detour's 3-D grid does not know, so it
-//! holds until the obstacle is gone.
+//! A coverage crawler (seed 002) is repaired the same way, but its way round a blocked run
+//! must stay on passable seabed, which the detour's 3-D grid does not know: it is searched on
+//! the seabed map instead ([`shoal_common::coverage::reroute`]: the coverage planner's safety
+//! clearance and turning radius, the obstacle's keep-out sphere at the crawler's height). A
+//! crawler with no way round (none within the search budget, or no map) holds until the
+//! obstacle is gone.
 //!
 //! A repair that still meets a hard obstacle, or comes within d_min of another vehicle's
 //! predicted track at every timing, is not safe: the coordinator then holds the vehicle and
@@ -28,6 +31,8 @@
 
 use std::time::Instant;
 
+use shoal_common::coverage::path::Pose2;
+use shoal_common::coverage::reroute::WaysRound;
 use shoal_common::geometry::{segment_hits_sphere, Vec3};
 use shoal_common::scenario::Scenario;
 use shoal_common::separation::{motion_separation, Motion};
@@ -43,45 +48,58 @@ fn blocked(scenario: &Scenario, a: &Vec3, b: &Vec3) -> bool {
 }
 
 /// The rest of the tour from `p0` as points and the plan's own speed on each leg; `None` for
-/// a way round a blocked run that the grid cannot find.
+/// a way round a blocked run that the grid cannot find (or, for a crawler, not within the
+/// request's budget).
 fn repaired_path(r: &Request) -> Option<(Vec<Vec3>, Vec<f64>)> {
+    let started = Instant::now();
     let scenario = r.scenario;
+    let crawler = scenario.coverage.is_some();
+    // A crawler's ways round, rasterised on first use (see `crawler_way_round`).
+    let keep_out = |p: &Vec3| near_obstacle(scenario, p);
+    let mut ways: Option<Option<WaysRound>> = None;
     let rest = rebase(r.current, r.resume_s.unwrap_or(r.t0));
     let mut pts = rest.points.clone();
     pts[0] = r.p0;
-    let speeds: Vec<f64> = pts
+    let mut speeds: Vec<f64> = pts
         .windows(2)
         .zip(rest.times.windows(2))
         .map(|(p, t)| (p[1] - p[0]).norm() / (t[1] - t[0]).max(1e-9))
         .collect();
+    if crawler {
+        (pts, speeds) = split_legs(&pts, &speeds, CRAWLER_LEG_M);
+    }
+    let runs = blocked_runs(r, &pts);
     let mut out = vec![pts[0]];
     let mut out_speeds = Vec::new();
     let mut k = 0;
     while k + 1 < pts.len() {
-        if !blocked(scenario, &pts[k], &pts[k + 1]) {
+        let Some(&(_, j)) = runs.iter().find(|(a, _)| *a == k) else {
             out.push(pts[k + 1]);
             out_speeds.push(speeds[k]);
             k += 1;
             continue;
-        }
-        // A coverage crawler's way round would have to stay on passable seabed, which the 3-D
-        // grid of the detour does not know: none is made, and the crawler holds until the
-        // way is clear (a detour on the seabed map is not built).
-        if scenario.coverage.is_some() {
-            return None;
-        }
-        // The run of blocked legs k..=j, rejoined at its end point.
-        let mut j = k;
-        while j + 2 < pts.len() && blocked(scenario, &pts[j + 1], &pts[j + 2]) {
-            j += 1;
-        }
-        let way = super::detour::detour(
-            scenario,
-            pts[k],
-            pts[j + 1],
-            scenario.vehicles[r.vehicle].max_pitch_deg,
-            super::detour::keep_off(scenario, r.vehicle),
-        )?;
+        };
+        // The run k..=j, rejoined at its end point.
+        let way = if crawler {
+            // A coverage crawler must stay on passable seabed, which the 3-D grid of the
+            // detour does not know: its way round is searched on the seabed map. Without the
+            // map (it could not be built) there is none, and the crawler holds.
+            let ways = ways.get_or_insert_with(|| r.ground.map(|g| g.ways_round(&keep_out)));
+            let way = crawler_way_round(r, ways.as_ref()?, &pts, k, j)?;
+            // Past its budget the repair gives up: the crawler holds, and the retry has longer.
+            if started.elapsed() > r.budget {
+                return None;
+            }
+            way
+        } else {
+            super::detour::detour(
+                scenario,
+                pts[k],
+                pts[j + 1],
+                scenario.vehicles[r.vehicle].max_pitch_deg,
+                super::detour::keep_off(scenario, r.vehicle),
+            )?
+        };
         let run_length: f64 = (k..=j).map(|i| (pts[i + 1] - pts[i]).norm()).sum();
         let run_time: f64 = (k..=j)
             .map(|i| (pts[i + 1] - pts[i]).norm() / speeds[i].max(1e-9))
@@ -94,6 +112,119 @@ fn repaired_path(r: &Request) -> Option<(Vec<Vec3>, Vec<f64>)> {
         k = j + 1;
     }
     Some((out, out_speeds))
+}
+
+/// The legs of `pts` a way round replaces, as runs `(first, last)` of leg indices in order:
+/// each run of consecutive blocked legs; for a crawler, widened on both sides over the legs
+/// that come within two turning radii of the keep-out, so the way round leaves and rejoins
+/// the path where the crawler has room to turn (a rejoin on the edge of the keep-out, on the
+/// path's heading, may not be reachable at all).
+fn blocked_runs(r: &Request, pts: &[Vec3]) -> Vec<(usize, usize)> {
+    let scenario = r.scenario;
+    let hit: Vec<bool> = pts
+        .windows(2)
+        .map(|w| blocked(scenario, &w[0], &w[1]))
+        .collect();
+    let room = match (scenario.coverage.is_some(), r.ground) {
+        (true, Some(g)) => WAY_ROUND_MARGIN_M + 2.0 * g.min_turn_radius_m,
+        _ => 0.0,
+    };
+    let near: Vec<bool> = if room > 0.0 {
+        pts.windows(2)
+            .map(|w| {
+                scenario.hard_obstacles().any(|o| {
+                    segment_hits_sphere(&w[0], &w[1], &o.centre(), o.inflated_radius() + room)
+                })
+            })
+            .collect()
+    } else {
+        hit.clone()
+    };
+    let mut runs: Vec<(usize, usize)> = Vec::new();
+    let mut i = 0;
+    while i < hit.len() {
+        if !hit[i] {
+            i += 1;
+            continue;
+        }
+        let after_last = runs.last().map_or(0, |&(_, j)| j + 1);
+        let mut k = i;
+        while k > after_last && near[k - 1] {
+            k -= 1;
+        }
+        let mut j = i;
+        while j + 1 < hit.len() && (near[j + 1] || hit[j + 1]) {
+            j += 1;
+        }
+        runs.push((k, j));
+        i = j + 1;
+    }
+    runs
+}
+
+/// Legs of a crawler's path are cut to at most this long before its blocked runs are found, so
+/// a way round replaces only the stretch near the obstacle, not a whole row.
+const CRAWLER_LEG_M: f64 = 10.0;
+
+/// `pts` with every leg longer than `max_m` cut into equal pieces at most that long, each
+/// piece keeping its leg's speed (the path and its timing are unchanged).
+fn split_legs(pts: &[Vec3], speeds: &[f64], max_m: f64) -> (Vec<Vec3>, Vec<f64>) {
+    let mut out = vec![pts[0]];
+    let mut out_speeds = Vec::new();
+    for (w, s) in pts.windows(2).zip(speeds) {
+        let n = ((w[1] - w[0]).norm() / max_m).ceil().max(1.0) as usize;
+        for m in 1..=n {
+            out.push(w[0] + (w[1] - w[0]) * (m as f64 / n as f64));
+            out_speeds.push(*s);
+        }
+    }
+    (out, out_speeds)
+}
+
+/// Margin a crawler's way round keeps outside the inflated spheres, metres: its points are
+/// checked every half metre on the map and thinned by 5 cm, and a leg that grazed a sphere would
+/// make the repair unsafe.
+const WAY_ROUND_MARGIN_M: f64 = 1.0;
+
+/// Whether `p` is within [`WAY_ROUND_MARGIN_M`] of a hard obstacle's inflated sphere.
+fn near_obstacle(scenario: &Scenario, p: &Vec3) -> bool {
+    scenario
+        .hard_obstacles()
+        .any(|o| (p - o.centre()).norm() < o.inflated_radius() + WAY_ROUND_MARGIN_M)
+}
+
+/// A crawler's way round the blocked legs `k..=j` of `pts` ([`WaysRound::between`]), from
+/// `pts[k]` on the heading it arrives there with to `pts[j + 1]` on the heading of the last
+/// blocked leg, ending exactly there. `None` without a way.
+fn crawler_way_round(
+    r: &Request,
+    ways: &WaysRound,
+    pts: &[Vec3],
+    k: usize,
+    j: usize,
+) -> Option<Vec<Vec3>> {
+    let heading = |d: Vec3| (d.x.hypot(d.y) > 1e-6).then(|| d.y.atan2(d.x));
+    // Arriving at pts[k]: the leg before it, or (at the vehicle) its course, else the
+    // blocked leg's own direction.
+    let before = if k > 0 {
+        Some(pts[k] - pts[k - 1])
+    } else {
+        r.heading
+    };
+    let start = before
+        .and_then(heading)
+        .or_else(|| heading(pts[k + 1] - pts[k]))?;
+    let end = heading(pts[j + 1] - pts[j])?;
+    let mut way = ways.between(
+        Pose2::new(pts[k].x, pts[k].y, start),
+        Pose2::new(pts[j + 1].x, pts[j + 1].y, end),
+    )?;
+    // The search may end within a metre of the goal: end on the path's own point.
+    if let Some(last) = way.last_mut() {
+        *last = pts[j + 1];
+    }
+    way[0] = pts[k];
+    Some(way)
 }
 
 /// `points` flown at `speeds` scaled alike to take `duration` from `t0`, each leg kept within
@@ -288,6 +419,7 @@ mod tests {
             budget: Duration::from_millis(100),
             separation_buffer_m: 0.0,
             seed: 1,
+            ground: None,
         }
     }
 

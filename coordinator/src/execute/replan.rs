@@ -21,6 +21,7 @@ use std::time::{Duration, Instant};
 use rand::rngs::StdRng;
 use rand::Rng;
 use shoal_common::cost::FleetModel;
+use shoal_common::coverage::reroute::CrawlerGround;
 use shoal_common::geometry::Vec3;
 use shoal_common::scenario::Scenario;
 use shoal_common::swarm::pso::Pso;
@@ -68,6 +69,9 @@ pub struct Request<'a> {
     pub separation_buffer_m: f64,
     /// RNG seed.
     pub seed: u64,
+    /// A coverage crawler's seabed, for its way round a new obstacle (`None`: there is none,
+    /// and a blocked crawler holds).
+    pub ground: Option<&'a CrawlerGround>,
 }
 
 /// A replanned trajectory.
