@@ -11,7 +11,8 @@
 use std::time::{Duration, Instant};
 
 use shoal_common::geometry::{segment_hits_sphere, Vec3};
-use shoal_common::scenario::{Obstacle, ObstacleKind};
+use shoal_common::scenario::{Obstacle, ObstacleKind, Scenario};
+use shoal_common::trajectory::Trajectory;
 use shoal_common::wire::codec;
 use shoal_common::wire::coordinator_to_agent::CoordinatorToAgent;
 use shoal_common::wire::open::{FleetStatus, Telemetry, OPEN_VERSION};
@@ -318,6 +319,21 @@ pub(super) fn replan_vehicle(x: &mut Exec, i: usize, why: &str) -> bool {
     let t0 = now + lead;
     let remaining = (x.common_arrival_s + o.arrival_window_s - now).max(o.horizon_s);
     let predictions = x.fleet.predictions_over(now, remaining);
+    // Until t0 the vehicle drives its predicted course: if that enters a hard obstacle, no
+    // update can take effect in time. A hold is obeyed at once; the retries start from there.
+    if !x.fleet.vehicles[i].holding && course_enters_obstacle(&predictions[i], now, t0, &x.scenario)
+    {
+        x.last_reaction[i] = Some(Instant::now());
+        hold(
+            x,
+            i,
+            why,
+            format!(
+                "its course enters a hard obstacle before an update could take effect at t = {t0:.0} s"
+            ),
+        );
+        return false;
+    }
     let p0 = predictions[i].position_at(t0);
     // The course there: where the prediction was heading over the last few seconds before.
     let heading = Some(p0 - predictions[i].position_at((t0 - 5.0).max(now)))
@@ -411,22 +427,12 @@ pub(super) fn replan_vehicle(x: &mut Exec, i: usize, why: &str) -> bool {
                 ),
             );
         } else {
-            x.send(
-                &id,
-                CoordinatorToAgent::Hold {
-                    mission: x.mission.clone(),
-                    vehicle: id.clone(),
-                    reason: why.to_string(),
-                },
-            );
-            x.fleet.vehicles[i].holding = true;
-            x.fleet.vehicles[i].held_since_s = Some(now);
-            x.holds += 1;
-            x.event(
-                EVENT_HOLD,
-                vec![id.clone()],
+            hold(
+                x,
+                i,
+                why,
                 format!(
-                    "{id} told to hold ({why}): no safe replan in {:.0} ms ({} obstacle intrusions, closest vehicle {:.1} m)",
+                    "no safe replan in {:.0} ms ({} obstacle intrusions, closest vehicle {:.1} m)",
                     result.elapsed.as_secs_f64() * 1000.0,
                     result.hard_hits,
                     result.min_separation_m
@@ -435,6 +441,48 @@ pub(super) fn replan_vehicle(x: &mut Exec, i: usize, why: &str) -> bool {
         }
         false
     }
+}
+
+/// Commands vehicle `i` to hold where it is (obeyed at once) and says why.
+fn hold(x: &mut Exec, i: usize, why: &str, detail: String) {
+    let id = x.fleet.vehicles[i].id.clone();
+    x.send(
+        &id,
+        CoordinatorToAgent::Hold {
+            mission: x.mission.clone(),
+            vehicle: id.clone(),
+            reason: why.to_string(),
+        },
+    );
+    let now = x.clock();
+    x.fleet.vehicles[i].holding = true;
+    x.fleet.vehicles[i].held_since_s = Some(now);
+    x.holds += 1;
+    x.event(
+        EVENT_HOLD,
+        vec![id.clone()],
+        format!("{id} told to hold ({why}): {detail}"),
+    );
+}
+
+/// Whether `course` between mission times `from` and `to` enters a hard obstacle's inflated
+/// sphere.
+fn course_enters_obstacle(course: &Trajectory, from: f64, to: f64, scenario: &Scenario) -> bool {
+    let mut pts = vec![course.position_at(from)];
+    pts.extend(
+        course
+            .times
+            .iter()
+            .zip(&course.points)
+            .filter(|(t, _)| **t > from && **t < to)
+            .map(|(_, q)| *q),
+    );
+    pts.push(course.position_at(to));
+    pts.windows(2).any(|w| {
+        scenario
+            .hard_obstacles()
+            .any(|o| segment_hits_sphere(&w[0], &w[1], &o.centre(), o.inflated_radius()))
+    })
 }
 
 /// The progress line on stderr.
@@ -461,4 +509,37 @@ pub(super) fn progress_line(s: &FleetStatus, reports: u64) -> String {
         fmt(s.predicted.map(|c| c.min_distance_m)),
         vehicles.join(" | ")
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_course_enters_an_obstacle_only_between_the_times_it_passes_it(
+    ) -> Result<(), Box<dyn std::error::Error>> {
+        let file = concat!(env!("CARGO_MANIFEST_DIR"), "/../scenarios/amp-pso-1.toml");
+        let mut s = Scenario::load(std::path::Path::new(file))?;
+        s.obstacles = vec![Obstacle {
+            id: "rock".into(),
+            kind: ObstacleKind::Hard,
+            centre: [50.0, 3.0, 0.0],
+            radius_m: 4.0,
+            inflation_m: 1.0,
+        }];
+        // 1 m/s along the x axis: it passes 3 m from the centre (inside 4 + 1 m) at t = 50 s.
+        let course = Trajectory {
+            times: vec![0.0, 100.0],
+            points: vec![Vec3::new(0.0, 0.0, 0.0), Vec3::new(100.0, 0.0, 0.0)],
+        };
+        // Up to (40, 0): √(10² + 3²) = 10.4 m from the centre; from (60, 0) on, the same.
+        assert!(!course_enters_obstacle(&course, 0.0, 40.0, &s));
+        assert!(!course_enters_obstacle(&course, 60.0, 100.0, &s));
+        assert!(course_enters_obstacle(&course, 0.0, 60.0, &s));
+        assert!(course_enters_obstacle(&course, 48.0, 52.0, &s));
+        // A soft obstacle is not in the way.
+        s.obstacles[0].kind = ObstacleKind::Soft;
+        assert!(!course_enters_obstacle(&course, 0.0, 60.0, &s));
+        Ok(())
+    }
 }
