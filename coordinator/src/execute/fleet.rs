@@ -39,8 +39,10 @@ pub struct Tracked {
     pub heard: Option<Instant>,
     /// Where the latest report puts it on its plan.
     pub progress: Option<Progress>,
-    /// Executed track: every reported fix and, between two fixes on the same plan, that
-    /// plan's corners shifted by the fixes' offsets from it ([`Fleet::report`]).
+    /// Executed track: every reported fix and, between two fixes, the corners of the plan at
+    /// the later one shifted by the fixes' offsets from it (the earlier fix placed on that plan
+    /// when the vehicle was replanned in between; fixes of a holding vehicle are joined
+    /// directly): [`Fleet::report`].
     pub track: Trajectory,
     /// Fixes in `track`.
     pub fixes: usize,
@@ -190,8 +192,20 @@ impl Fleet {
             // along the plan it has left (which would draw it driving on, past whatever it
             // was holding for).
             let held = v.holding || t.state.status == VehicleStatus::Holding;
-            if let (Some((tau0, offset0, revision)), Some(&t0)) = (v.anchor, v.track.times.last()) {
-                if revision == v.revision && !held {
+            if let (Some((tau0, offset0, revision)), Some(&t0), Some(&q0)) =
+                (v.anchor, v.track.times.last(), v.track.points.last())
+            {
+                // Replanned since the last fix: that fix is placed on the new plan (which keeps
+                // the old one up to the replan), so the track between follows the plan the
+                // vehicle was switching to rather than a chord across whatever lies between
+                // (fixes are 250 m apart for a crawler at 1000×).
+                let (tau0, offset0) = if revision == v.revision {
+                    (tau0, offset0)
+                } else {
+                    let tau = picture::progress(&v.plan, q0, t0, PROGRESS_WINDOW_S).plan_time_s;
+                    (tau, q0 - v.plan.position_at(tau))
+                };
+                if !held {
                     let corners = along_plan(&v.plan, (t0, tau0, offset0), (now, tau, offset));
                     for (t, q) in corners {
                         v.track.times.push(t);

@@ -82,7 +82,8 @@ fn between_two_fixes_the_track_follows_the_plan_round_its_corners() {
         2,
     );
     assert_eq!(f.vehicles[0].track.times, vec![50.0, 60.0]);
-    // Nor is one on a new revision of the plan.
+    // One on a new revision of the plan follows the new plan's corners, the earlier fix placed
+    // on it (a replan keeps the plan up to it: here the same plan).
     let mut f = Fleet::new(&ids, std::slice::from_ref(&plan), 50.0, 60.0);
     f.report(
         report("a", 0, 50.0, [50.0, 2.0, 0.0], VehicleStatus::Underway),
@@ -93,7 +94,7 @@ fn between_two_fixes_the_track_follows_the_plan_round_its_corners() {
         report("a", 1, 150.0, [98.0, 50.0, 0.0], VehicleStatus::Underway),
         2,
     );
-    assert_eq!(f.vehicles[0].track.times, vec![50.0, 150.0]);
+    assert_eq!(f.vehicles[0].track.times, vec![50.0, 100.0, 150.0]);
 }
 
 #[test]
