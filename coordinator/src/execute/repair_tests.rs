@@ -1,0 +1,277 @@
+//! Unit tests of `execute::repair`.
+
+use super::*;
+use shoal_common::scenario::{Obstacle, ObstacleKind};
+use std::time::Duration;
+
+fn scenario() -> Result<Scenario, Box<dyn std::error::Error>> {
+    let file = concat!(env!("CARGO_MANIFEST_DIR"), "/../scenarios/amp-pso-1.toml");
+    let mut s = Scenario::load(std::path::Path::new(file))?;
+    s.bounds.min = [0.0, 0.0, 0.0];
+    s.bounds.max = [2000.0, 2000.0, 400.0];
+    s.obstacles.clear();
+    s.vehicles.truncate(2);
+    for v in &mut s.vehicles {
+        v.speed_min_mps = 0.5;
+        v.speed_max_mps = 2.0;
+    }
+    Ok(s)
+}
+
+/// A square tour from (200, 200): east 1000 m, north 1000 m, back west and south, 1 m/s.
+fn tour() -> Trajectory {
+    let p = |x: f64, y: f64| Vec3::new(x, y, 200.0);
+    Trajectory {
+        times: vec![0.0, 1000.0, 2000.0, 3000.0, 4000.0],
+        points: vec![
+            p(200.0, 200.0),
+            p(1200.0, 200.0),
+            p(1200.0, 1200.0),
+            p(200.0, 1200.0),
+            p(200.0, 200.0),
+        ],
+    }
+}
+
+fn request<'a>(s: &'a Scenario, current: &'a Trajectory, others: &'a [Trajectory]) -> Request<'a> {
+    Request {
+        scenario: s,
+        vehicle: 0,
+        t0: 500.0,
+        p0: Vec3::new(700.0, 200.0, 200.0),
+        heading: Some(Vec3::new(1.0, 0.0, 0.0)),
+        current,
+        resume_s: None,
+        others,
+        arrival_s: 4000.0,
+        budget: Duration::from_millis(100),
+        separation_buffer_m: 0.0,
+        seed: 1,
+        ground: None,
+    }
+}
+
+#[test]
+fn an_unblocked_tour_is_kept_as_it_is() -> Result<(), Box<dyn std::error::Error>> {
+    let s = scenario()?;
+    let plan = tour();
+    let r = repair(&request(&s, &plan, &[]));
+    assert!(r.safe && r.hard_hits == 0);
+    // From (700, 200) at t = 500 on: the same corners at the same times.
+    assert_eq!(r.trajectory.points[1..], plan.points[1..]);
+    for (a, b) in r
+        .trajectory
+        .times
+        .iter()
+        .zip([500.0, 1000.0, 2000.0, 3000.0, 4000.0])
+    {
+        assert!((a - b).abs() < 1e-9, "{:?}", r.trajectory.times);
+    }
+    Ok(())
+}
+
+/// A vehicle that held at (400, 200) from t = 200 s and resumes at t = 2500 s goes on
+/// from where it stopped: every corner its plan passed meanwhile is still visited. Taken
+/// from t0 instead, the rest would begin past (1200, 200) and (1200, 1200).
+#[test]
+fn a_held_vehicle_resumes_where_it_stopped() -> Result<(), Box<dyn std::error::Error>> {
+    let s = scenario()?;
+    let plan = tour();
+    let mut q = request(&s, &plan, &[]);
+    q.t0 = 2500.0;
+    q.p0 = Vec3::new(400.0, 200.0, 200.0);
+    q.heading = None;
+    q.resume_s = Some(200.0);
+    let r = repair(&q);
+    assert!(r.safe, "{r:?}");
+    assert_eq!(r.trajectory.points[0], q.p0);
+    assert_eq!(r.trajectory.points[1..], plan.points[1..]);
+    assert!((r.trajectory.times[0] - 2500.0).abs() < 1e-9);
+    // 3800 m left at the plan's 1 m/s: late, past the plan's 4000 s.
+    assert!(r.trajectory.arrival() > 4000.0, "{:?}", r.trajectory.times);
+    q.resume_s = None;
+    let skipped = repair(&q);
+    assert!(!skipped
+        .trajectory
+        .points
+        .contains(&Vec3::new(1200.0, 200.0, 200.0)));
+    Ok(())
+}
+
+#[test]
+fn a_blocked_leg_is_gone_round_and_every_later_corner_kept(
+) -> Result<(), Box<dyn std::error::Error>> {
+    let mut s = scenario()?;
+    // On the north-bound leg, floor to surface: the way round is east or west of it.
+    for z in [100.0, 300.0] {
+        s.obstacles.push(Obstacle {
+            id: format!("new{z}"),
+            kind: ObstacleKind::Hard,
+            centre: [1200.0, 700.0, z],
+            radius_m: 100.0,
+            inflation_m: 50.0,
+        });
+    }
+    let plan = tour();
+    let r = repair(&request(&s, &plan, &[]));
+    assert!(r.safe, "{r:?}");
+    for w in r.trajectory.points.windows(2) {
+        assert!(!blocked(&s, &w[0], &w[1]));
+    }
+    // The inspection corners are all still there, in order, after the detour.
+    let corners = &plan.points[1..];
+    let mut at = 0;
+    for p in &r.trajectory.points {
+        if at < corners.len() && (p - corners[at]).norm() < 1e-9 {
+            at += 1;
+        }
+    }
+    assert_eq!(at, corners.len(), "{:?}", r.trajectory.points);
+    // Longer than the plan's 3500 m from (700, 200), flown faster to keep the arrival.
+    let length: f64 = r
+        .trajectory
+        .points
+        .windows(2)
+        .map(|w| (w[1] - w[0]).norm())
+        .sum();
+    assert!(length > 3500.0 + 10.0, "{length}");
+    assert!((r.trajectory.arrival() - 4000.0).abs() < 1e-6);
+    Ok(())
+}
+
+#[test]
+fn a_repair_that_meets_another_vehicle_is_not_safe() -> Result<(), Box<dyn std::error::Error>> {
+    let s = scenario()?;
+    let plan = tour();
+    // The other vehicle waits at the first corner.
+    let p = Vec3::new(1200.0, 200.0, 200.0);
+    let other = Trajectory {
+        times: vec![0.0, 5000.0],
+        points: vec![p, p],
+    };
+    let others = [plan.clone(), other];
+    let r = repair(&request(&s, &plan, &others));
+    assert!(!r.safe && r.min_separation_m < 1.0, "{r:?}");
+    Ok(())
+}
+
+#[test]
+fn a_repair_that_only_keeps_d_min_is_retimed_to_keep_the_buffer(
+) -> Result<(), Box<dyn std::error::Error>> {
+    let s = scenario()?;
+    let plan = tour();
+    // The other vehicle drives north at 1 m/s along x = 950 and crosses the first leg
+    // (y = 200) 55·√2 s after this vehicle does (t = 750): perpendicular at equal speeds,
+    // they pass 55 m apart. 5 % faster, this vehicle crosses at 737.5 s and they pass
+    // 65.45 m apart; 5 % slower, 45.02 m (both by hand, sampled every 0.01 s).
+    let crossing = 750.0 + 55.0 * 2f64.sqrt();
+    let other = Trajectory {
+        times: vec![0.0, 5000.0],
+        points: vec![
+            Vec3::new(950.0, 200.0 - crossing, 200.0),
+            Vec3::new(950.0, 200.0 + 5000.0 - crossing, 200.0),
+        ],
+    };
+    let others = [plan.clone(), other];
+    // Without a buffer the on-time repair (55 m) is kept.
+    let r = repair(&request(&s, &plan, &others));
+    assert!(r.safe, "{r:?}");
+    assert!((r.min_separation_m - 55.0).abs() < 0.05, "{r:?}");
+    assert!((r.trajectory.arrival() - 4000.0).abs() < 1e-6);
+    // With a 10 m buffer, the first timing that keeps 60 m: the first leg (the closest
+    // approach is on it) in 0.95 × 500 s, not 1.05 × (45 m); the three later legs take
+    // 3025 s in all, so the arrival stays at 4000 s.
+    let mut req = request(&s, &plan, &others);
+    req.separation_buffer_m = 10.0;
+    let r = repair(&req);
+    assert!(r.safe, "{r:?}");
+    assert!((r.min_separation_m - 65.45).abs() < 0.05, "{r:?}");
+    assert!((r.trajectory.times[1] - 975.0).abs() < 1e-6, "{r:?}");
+    assert!((r.trajectory.arrival() - 4000.0).abs() < 1e-6, "{r:?}");
+    for (w, t) in r
+        .trajectory
+        .points
+        .windows(2)
+        .zip(r.trajectory.times.windows(2))
+    {
+        let speed = (w[1] - w[0]).norm() / (t[1] - t[0]);
+        assert!((0.5..=2.0).contains(&speed), "{speed}");
+    }
+    // A buffer no timing keeps falls back to the on-time repair, which keeps d_min.
+    req.separation_buffer_m = 60.0;
+    let r = repair(&req);
+    assert!(r.safe && (r.min_separation_m - 55.0).abs() < 0.05, "{r:?}");
+    Ok(())
+}
+
+#[test]
+fn retiming_keeps_the_arrival_only_where_the_speed_range_allows() {
+    // Two 100 m legs at 1 m/s from t = 0; the range is 0.5–1.0 m/s.
+    let p = |x: f64| Vec3::new(x, 0.0, 0.0);
+    let base = Trajectory {
+        times: vec![0.0, 100.0, 200.0],
+        points: vec![p(0.0), p(100.0), p(200.0)],
+    };
+    // The first leg slower (125 s at 0.8 m/s): the second cannot make up 25 s at 1 m/s,
+    // so the arrival moves to 225 s.
+    let t = retimed(&base, 50.0, 1.25, (0.5, 1.0));
+    assert!((t.times[1] - 125.0).abs() < 1e-9 && (t.times[2] - 225.0).abs() < 1e-9);
+    // The first leg at 0.8 × its time would need 1.25 m/s: it is flown at 1 m/s.
+    let t = retimed(&base, 50.0, 0.8, (0.5, 1.0));
+    assert!((t.times[1] - 100.0).abs() < 1e-9 && (t.times[2] - 200.0).abs() < 1e-9);
+    // With room in the range (up to 2 m/s): 80 s, then 120 s, arriving at 200 s.
+    let t = retimed(&base, 50.0, 0.8, (0.5, 2.0));
+    assert!((t.times[1] - 80.0).abs() < 1e-9 && (t.times[2] - 200.0).abs() < 1e-9);
+    // A closest approach on the second leg slows both legs (the prefix is every leg that
+    // starts before it): nothing is left to make up the time.
+    let t = retimed(&base, 150.0, 1.1, (0.5, 2.0));
+    assert!((t.times[1] - 110.0).abs() < 1e-9 && (t.times[2] - 220.0).abs() < 1e-9);
+}
+
+#[test]
+fn long_legs_are_cut_into_equal_pieces_that_keep_their_speed() {
+    let p = |x: f64| Vec3::new(x, 0.0, 0.0);
+    let (pts, speeds) = split_legs(&[p(0.0), p(25.0), p(28.0)], &[1.0, 2.0], 10.0);
+    // 25 m → three pieces of 8.333 m; 3 m stays one.
+    assert_eq!(pts.len(), 5);
+    assert!((pts[1] - p(25.0 / 3.0)).norm() < 1e-9);
+    assert!((pts[3] - p(25.0)).norm() < 1e-9);
+    assert!((pts[4] - p(28.0)).norm() < 1e-9);
+    assert_eq!(speeds, vec![1.0, 1.0, 1.0, 2.0]);
+}
+
+#[test]
+fn a_crawlers_blocked_run_is_widened_by_two_turning_radii() -> Result<(), Box<dyn std::error::Error>>
+{
+    let mut s = scenario()?;
+    s.obstacles.push(Obstacle {
+        id: "rock".into(),
+        kind: ObstacleKind::Hard,
+        centre: [500.0, 0.0, 0.0],
+        radius_m: 9.5,
+        inflation_m: 0.0,
+    });
+    // Legs of 10 m along the x axis: legs 49 (490–500) and 50 (500–510) enter the 9.5 m sphere.
+    let pts: Vec<Vec3> = (0..=100)
+        .map(|k| Vec3::new(10.0 * k as f64, 0.0, 0.0))
+        .collect();
+    let plan = tour();
+    let mut r = request(&s, &plan, &[]);
+    assert_eq!(blocked_runs(&r, &pts), vec![(49, 50)]);
+    // A crawler turning at 5 m: the run takes every leg within 9.5 + 1 + 2 × 5 = 20.5 m of the
+    // centre, legs 47 (470–480, 20 m) to 52 (520–530); 46 and 53 are 30 m off.
+    let mut crawler = s.clone();
+    crawler.coverage = Some(Default::default());
+    let grid = shoal_common::terrain::HeightGrid::new([0.0, 0.0], 2.0, 10, 10, vec![0.0; 100])?;
+    let ground = shoal_common::coverage::reroute::CrawlerGround {
+        map: shoal_common::coverage::TerrainMap25::from_grid(&grid, &Default::default())?,
+        area: shoal_common::coverage::boxes::Rect::new(0.0, 0.0, 18.0, 18.0),
+        safety_clearance_m: 8.0,
+        min_turn_radius_m: 5.0,
+        sensor_height_m: 0.0,
+    };
+    r.scenario = &crawler;
+    r.ground = Some(&ground);
+    assert_eq!(blocked_runs(&r, &pts), vec![(47, 52)]);
+    Ok(())
+}
