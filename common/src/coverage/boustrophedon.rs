@@ -182,12 +182,7 @@ impl Field<'_> {
     /// Whether `(x, y)` may carry the vehicle's centre: in the area, outside every box, and at
     /// least the safety clearance from every impassable cell.
     pub fn point_ok(&self, x: f64, y: f64) -> bool {
-        const EPS: f64 = 1e-9;
-        let a = &self.area;
-        x >= a.x0 - EPS
-            && x <= a.x1 + EPS
-            && y >= a.y0 - EPS
-            && y <= a.y1 + EPS
+        self.area.holds(x, y)
             && !(self.boxes_are_no_go && self.index.any_contains_strictly(&self.boxes, x, y))
             && self.map.clearance_to_impassable(x, y) >= self.params.safety_clearance_m
     }

@@ -60,6 +60,13 @@ impl Rect {
         x >= self.x0 && x <= self.x1 && y >= self.y0 && y <= self.y1
     }
 
+    /// [`Rect::contains`] up to 1e-9 m of rounding: the test of a vehicle's centre being in the
+    /// area (a pose on the area's edge, where rows end, must count as inside).
+    pub fn holds(&self, x: f64, y: f64) -> bool {
+        const EPS: f64 = 1e-9;
+        x >= self.x0 - EPS && x <= self.x1 + EPS && y >= self.y0 - EPS && y <= self.y1 + EPS
+    }
+
     /// Axis-aligned gap to `other`: the larger of the x and y separations, 0 when they touch or
     /// overlap.
     pub fn gap(&self, other: &Rect) -> f64 {

@@ -63,13 +63,7 @@ impl CrawlerGround {
     /// Whether the crawler's centre may be at `(x, y)` on the map alone: inside the area and
     /// at least the safety clearance from impassable ground (the coverage planner's test).
     pub fn passable(&self, x: f64, y: f64) -> bool {
-        const EPS: f64 = 1e-9;
-        let a = &self.area;
-        x >= a.x0 - EPS
-            && x <= a.x1 + EPS
-            && y >= a.y0 - EPS
-            && y <= a.y1 + EPS
-            && self.map.clearance_to_impassable(x, y) >= self.safety_clearance_m
+        self.area.holds(x, y) && self.map.clearance_to_impassable(x, y) >= self.safety_clearance_m
     }
 
     /// The ways round the places where `keep_out` (given the crawler's reference point) is
