@@ -6,7 +6,9 @@
 use crate::feasibility::claim_failures;
 use crate::figures::{fleet_figures, vehicle_figures};
 use crate::geometry::{self, dist, point};
-use crate::model::{parse_plan, parse_scenario, Plan, PlanVehicle, Scenario, Vehicle};
+use crate::model::{
+    parse_plan, parse_scenario, parse_scenario_file, Plan, PlanVehicle, Scenario, Vehicle,
+};
 use crate::report::Report;
 use crate::{SEPARATION_TOL, TOL};
 
@@ -28,6 +30,14 @@ fn within(x: f64, [lo, hi]: [f64; 2], slack: f64) -> bool {
 /// Parses both files and checks the plan against the scenario.
 pub fn check(scenario_toml: &str, plan_json: &str) -> Result<Report, String> {
     let scenario = parse_scenario(scenario_toml)?;
+    let plan = parse_plan(plan_json)?;
+    Ok(check_parsed(&scenario, &plan))
+}
+
+/// Reads the scenario file at `scenario_path` (with its measured seabed, if any: see
+/// [`parse_scenario_file`]) and checks the plan against it.
+pub fn check_file(scenario_path: &std::path::Path, plan_json: &str) -> Result<Report, String> {
+    let scenario = parse_scenario_file(scenario_path)?;
     let plan = parse_plan(plan_json)?;
     Ok(check_parsed(&scenario, &plan))
 }

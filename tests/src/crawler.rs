@@ -4,11 +4,13 @@
 //! hazard cylinder (eq. (4)); its reported figures are recomputed here from the samples:
 //! length (eq. (5)), undulation Σ|Δz| (eq. (6)), energy (eq. (7) at the vehicle's top speed,
 //! with the mining share), slip (eq. (9), decreasing ramp), hazard clearance and steepest leg.
-//! Measured (grid) seabeds are not re-evaluated: only the geometric figures are checked there.
+//! A measured (grid) seabed is read by the checker's own [`crate::seabed_grid`] when the scenario
+//! was read from its file ([`crate::parse_scenario_file`]); from text alone it is not judged.
 
 use serde::Deserialize;
 
 use crate::model::{Scenario, Vehicle};
+use crate::seabed_grid::{Grid, GridRef};
 
 /// `[seabed]` as far as the checker reads it.
 #[derive(Debug, Clone, Deserialize)]
@@ -18,9 +20,12 @@ pub struct Seabed {
     /// Eq. (3) mountains.
     #[serde(default)]
     pub mountains: Vec<Mountain>,
-    /// A measured grid (not re-evaluated here: its presence is all the checker reads).
+    /// A measured grid: where its file is.
     #[serde(default)]
-    pub grid: Option<serde::de::IgnoredAny>,
+    pub grid: Option<GridRef>,
+    /// The grid's heights, once read relative to the scenario file ([`Seabed::load_grid`]).
+    #[serde(skip)]
+    pub measured: Option<Grid>,
     /// Height an AUV of a fleet mission keeps above the seabed, metres (default 2).
     #[serde(default)]
     pub auv_clearance_m: Option<f64>,
@@ -55,6 +60,14 @@ pub struct Mountain {
 }
 
 impl Seabed {
+    /// Reads the measured grid, if there is one, relative to `dir` (the scenario's directory).
+    pub fn load_grid(&mut self, dir: &std::path::Path) -> Result<(), String> {
+        if let Some(g) = &self.grid {
+            self.measured = Some(Grid::load(g, dir)?);
+        }
+        Ok(())
+    }
+
     /// The sum of the Gaussian hills alone (seed 001 eq. (1), a seabed without `relief`).
     pub fn hills_elevation(&self, x: f64, y: f64) -> f64 {
         self.mountains
@@ -172,11 +185,44 @@ impl<'a> Seafloor<'a> {
     }
 }
 
+/// The seabed's height wherever the checker can tell it.
+pub enum Floor<'a> {
+    /// Eq. (2) + (3).
+    Analytic(Seafloor<'a>),
+    /// Seed 001's hills on a flat floor (no relief).
+    Hills(&'a Seabed),
+    /// A measured grid, read from its file.
+    Measured(&'a Grid),
+}
+
+impl<'a> Floor<'a> {
+    /// The seabed of `scenario`; `None` without one, or for a grid that was not read (the
+    /// scenario was parsed from text, not from its file).
+    pub fn of(scenario: &'a Scenario) -> Option<Floor<'a>> {
+        let seabed = scenario.seabed.as_ref()?;
+        if seabed.grid.is_some() {
+            return seabed.measured.as_ref().map(Floor::Measured);
+        }
+        Some(match Seafloor::of(scenario) {
+            Some(f) => Floor::Analytic(f),
+            None => Floor::Hills(seabed),
+        })
+    }
+
+    /// z of the seabed at (x, y).
+    pub fn z(&self, x: f64, y: f64) -> f64 {
+        match self {
+            Floor::Analytic(f) => f.z(x, y),
+            Floor::Hills(s) => s.hills_elevation(x, y),
+            Floor::Measured(g) => g.z(x, y),
+        }
+    }
+}
+
 /// Checks an AUV's trajectory against the seabed: its lowest height above it, every 0.5 m
 /// along each leg (the seabed is not straight under a straight leg), must be at least
 /// `required` (minus 5 cm: the planner samples every 1 m), and must match the reported
-/// `min_seabed_clearance_m` to 5 cm. Analytic seabeds only (eq. (2) + (3), or seed 001's
-/// hills alone); a measured grid is not re-evaluated.
+/// `min_seabed_clearance_m` to 5 cm. Any [`Floor`]; a grid that was not read is not judged.
 pub fn check_swimmer_seabed(
     scenario: &Scenario,
     id: &str,
@@ -187,14 +233,10 @@ pub fn check_swimmer_seabed(
     const STEP: f64 = 0.5;
     const SLACK: f64 = 0.05;
     let mut out = CrawlerFindings::default();
-    let Some(seabed) = scenario.seabed.as_ref().filter(|s| s.grid.is_none()) else {
+    let Some(floor) = Floor::of(scenario) else {
         return out;
     };
-    let floor = Seafloor::of(scenario);
-    let z = |x: f64, y: f64| match &floor {
-        Some(f) => f.z(x, y),
-        None => seabed.hills_elevation(x, y),
-    };
+    let z = |x: f64, y: f64| floor.z(x, y);
     let mut lowest = traj.first().map_or(f64::INFINITY, |s| s[3] - z(s[1], s[2]));
     for w in traj.windows(2) {
         let d = [w[1][1] - w[0][1], w[1][2] - w[0][2], w[1][3] - w[0][3]];
@@ -299,7 +341,7 @@ pub fn check(
             ));
         }
     }
-    if let Some(floor) = Seafloor::of(scenario) {
+    if let Some(floor) = Floor::of(scenario) {
         let off = traj
             .iter()
             .map(|s| (s[3] - floor.z(s[1], s[2]) - settings.sensor_height_m).abs())
@@ -402,9 +444,34 @@ mod tests {
         assert_eq!(off.mismatches.len(), 1, "{:?}", off.mismatches);
         let unreported = check_swimmer_seabed(&s, "a", &leg(102.5), 2.0, None);
         assert_eq!(unreported.mismatches.len(), 1);
+        // A grid seabed parsed from text alone (its file never read) is not judged.
         let grid = crate::model::parse_scenario(&text("[seabed.grid]\nfile = \"x.asc\"\n"))?;
         let g = check_swimmer_seabed(&grid, "a", &leg(50.0), 2.0, None);
         assert!(g.broken.is_empty() && g.mismatches.is_empty());
+
+        // The same 100 m rise as a measured grid read from the scenario's directory: nodes
+        // 500 m apart, 100 m in the middle, so along y = 500 the seabed is a tent peaking at
+        // x = 500 and the leg at z = 50 is 50 m into it.
+        let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+        let asc = "ncols 3\nnrows 3\nxllcenter 0\nyllcenter 0\ncellsize 500\n\
+                   0 0 0\n0 100 0\n0 0 0\n";
+        std::fs::write(dir.path().join("rise.asc"), asc).map_err(|e| e.to_string())?;
+        let path = dir.path().join("s.toml");
+        let grid_toml = text("[seabed.grid]\nfile = \"rise.asc\"\n");
+        std::fs::write(&path, grid_toml).map_err(|e| e.to_string())?;
+        let s = crate::model::parse_scenario_file(&path)?;
+        let low = check_swimmer_seabed(&s, "a", &leg(50.0), 2.0, Some(-50.0));
+        assert_eq!(low.broken.len(), 1, "{:?}", low.broken);
+        assert!(low.mismatches.is_empty(), "{:?}", low.mismatches);
+        let high = check_swimmer_seabed(&s, "a", &leg(102.5), 2.0, Some(2.5));
+        assert!(high.broken.is_empty() && high.mismatches.is_empty());
+        // A grid file that is not there is an error naming it.
+        std::fs::remove_file(dir.path().join("rise.asc")).map_err(|e| e.to_string())?;
+        let missing = crate::model::parse_scenario_file(&path);
+        assert!(
+            missing.as_ref().is_err_and(|e| e.contains("rise.asc")),
+            "{missing:?}"
+        );
         Ok(())
     }
 }

@@ -32,12 +32,13 @@ pub mod geometry;
 pub mod mobility;
 mod model;
 mod report;
+pub mod seabed_grid;
 
-pub use check::{check, check_parsed, close};
+pub use check::{check, check_file, check_parsed, close};
 pub use figures::{fleet_figures, vehicle_figures, FleetFigures, VehicleFigures};
 pub use model::{
-    parse_plan, parse_scenario, Bounds, Fleet, Obstacle, ObstacleKind, Plan, PlanFleet,
-    PlanVehicle, Scenario, Vehicle,
+    parse_plan, parse_scenario, parse_scenario_file, Bounds, Fleet, Obstacle, ObstacleKind, Plan,
+    PlanFleet, PlanVehicle, Scenario, Vehicle,
 };
 pub use report::Report;
 

@@ -229,8 +229,13 @@ pub fn check_energy(scenario: &Scenario, v: &Vehicle, traj: &[[f64; 4]], e: &Pla
             }
         }
     }
-    // Seabed of Gaussian hills alone (seed 001 eq. (1)); other seabeds are the crawler check's.
-    if let Some(seabed) = scenario.seabed.as_ref().filter(|s| s.relief.is_none()) {
+    // Seabed of Gaussian hills alone (seed 001 eq. (1)); other seabeds are the crawler check's
+    // (`check_swimmer_seabed`).
+    if let Some(seabed) = scenario
+        .seabed
+        .as_ref()
+        .filter(|s| s.relief.is_none() && s.grid.is_none())
+    {
         let lowest = pts
             .iter()
             .map(|p| p[2] - seabed.hills_elevation(p[0], p[1]) - section.terrain_clearance_m)

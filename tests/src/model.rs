@@ -217,6 +217,21 @@ pub fn parse_scenario(text: &str) -> Result<Scenario, String> {
     toml::from_str(text).map_err(|e| format!("scenario does not parse: {e}"))
 }
 
+/// Reads and parses a scenario file, with its measured seabed grid (if any) read relative to
+/// the file's directory, so the seabed checks judge it.
+pub fn parse_scenario_file(path: &std::path::Path) -> Result<Scenario, String> {
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| format!("cannot read {}: {e}", path.display()))?;
+    let mut scenario = parse_scenario(&text).map_err(|e| format!("{}: {e}", path.display()))?;
+    if let Some(seabed) = scenario.seabed.as_mut() {
+        let dir = path.parent().unwrap_or(std::path::Path::new("."));
+        seabed
+            .load_grid(dir)
+            .map_err(|e| format!("{}: seabed.grid: {e}", path.display()))?;
+    }
+    Ok(scenario)
+}
+
 /// Parses a `plan.json` text.
 pub fn parse_plan(text: &str) -> Result<Plan, String> {
     serde_json::from_str(text).map_err(|e| format!("plan.json does not parse: {e}"))

@@ -1,14 +1,17 @@
 //! Crawlers on the seabed end to end (seed 000 as a Shoal capability): the DSMV scenario of
 //! §5.1 planned in process by every seed 000 algorithm, and a mixed fleet of two crawlers and an
 //! AUV planned in process and by one agent process per vehicle; every plan passes the
-//! independent checker, which re-evaluates the seabed and the hazards itself.
+//! independent checker, which re-evaluates the seabed and the hazards itself, a measured
+//! seabed (an ESRI ASCII grid file) included.
 
 mod common;
 
 use std::time::{Duration, Instant};
 
 use common::fleet::Fleet;
-use common::{check_plan_run, key, number, plan_and_check, scenario, TestResult};
+use common::{
+    check_plan_run, check_plan_run_at, key, number, plan, plan_and_check, scenario, TestResult,
+};
 use serde_json::Value;
 
 /// The `crawler` block of vehicle `id`.
@@ -113,5 +116,85 @@ fn a_mixed_fleet_keeps_crawlers_apart_in_process_and_distributed() -> TestResult
         assert_eq!(c["hazard_intrusions"].as_u64(), Some(0), "{id}: {c}");
     }
     fleet.passed();
+    Ok(())
+}
+
+/// The DSMV seabed sampled every metre into an ESRI ASCII grid (north row first), written as
+/// `dsmv.asc` beside a copy of the scenario that names it instead of its relief and mountains;
+/// `flip` writes the rows south first, a grid the checker must read as a different seabed.
+/// Returns the copy's path.
+fn dsmv_on_a_grid(
+    dir: &std::path::Path,
+    flip: bool,
+) -> Result<std::path::PathBuf, Box<dyn std::error::Error>> {
+    let text = std::fs::read_to_string(scenario("ipso-dsmv"))?;
+    let analytic = shoal_tests::parse_scenario(&text)?;
+    let Some(floor) = shoal_tests::crawler::Floor::of(&analytic) else {
+        panic!("ipso-dsmv has no analytic seabed");
+    };
+    let mut rows: Vec<String> = (0..=200)
+        .rev()
+        .map(|y| {
+            let row: Vec<String> = (0..=200)
+                .map(|x| format!("{:.4}", floor.z(f64::from(x), f64::from(y))))
+                .collect();
+            row.join(" ")
+        })
+        .collect();
+    if flip {
+        rows.reverse();
+    }
+    let asc = format!(
+        "ncols 201\nnrows 201\nxllcenter 0\nyllcenter 0\ncellsize 1\nNODATA_value -9999\n{}\n",
+        rows.join("\n")
+    );
+    std::fs::write(dir.join("dsmv.asc"), asc)?;
+    let mut doc: toml::Table = toml::from_str(&text)?;
+    let Some(seabed) = doc.get_mut("seabed").and_then(toml::Value::as_table_mut) else {
+        panic!("ipso-dsmv has no [seabed]");
+    };
+    seabed.remove("relief");
+    seabed.remove("mountains");
+    let mut grid = toml::Table::new();
+    grid.insert("file".into(), toml::Value::String("dsmv.asc".into()));
+    seabed.insert("grid".into(), toml::Value::Table(grid));
+    let path = dir.join("dsmv-grid.toml");
+    std::fs::write(&path, toml::to_string(&doc)?)?;
+    Ok(path)
+}
+
+#[test]
+fn a_crawler_planned_on_a_measured_seabed_is_checked_on_that_grid() -> TestResult {
+    let dir = tempfile::tempdir()?;
+    let path = dsmv_on_a_grid(dir.path(), false)?;
+    let out = dir.path().join("out");
+    let r = plan(&path, &out, &["--iterations", "10", "--seed", "4"]);
+    let json = check_plan_run_at(&path, &out, &r)?;
+    assert_eq!(key(&json, "feasible").as_bool(), Some(true), "{r}");
+    let c = crawler(&json, "dsmv");
+    assert_eq!(c["hazard_intrusions"].as_u64(), Some(0), "{c}");
+    assert!(c["off_seabed_m"].as_f64().is_some_and(|d| d < 1e-9), "{c}");
+
+    // The checker judges the path on the grid it reads itself: the same plan over the grid
+    // written south row first, or with one sample lifted 30 cm, leaves the seabed.
+    let plan_text = std::fs::read_to_string(out.join("plan.json"))?;
+    let flipped_dir = dir.path().join("flipped");
+    std::fs::create_dir(&flipped_dir)?;
+    let flipped = dsmv_on_a_grid(&flipped_dir, true)?;
+    let report = shoal_tests::check_file(&flipped, &plan_text)?;
+    assert!(
+        format!("{report}").contains("leaves the seabed"),
+        "{report}"
+    );
+    let mut lifted = json.clone();
+    let Some(samples) = lifted["vehicles"][0]["trajectory"].as_array_mut() else {
+        panic!("no trajectory");
+    };
+    let mid = samples.len() / 2;
+    let z = samples[mid][3].as_f64().unwrap_or(f64::NAN);
+    samples[mid][3] = serde_json::json!(z + 0.3);
+    let report = shoal_tests::check_file(&path, &lifted.to_string())?;
+    let all = format!("{report}");
+    assert!(all.contains("leaves the seabed by 0.3000 m"), "{all}");
     Ok(())
 }

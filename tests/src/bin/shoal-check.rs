@@ -4,9 +4,10 @@
 //! arrival. `--degraded auv2` also requires exactly those vehicles (comma-separated; empty for
 //! none) to be named as planned in degraded mode. Exit 0 when every check passes, 1 otherwise.
 
+use std::path::Path;
 use std::process::ExitCode;
 
-use shoal_tests::{check, parse_plan, parse_scenario, MAX_ARRIVAL_SPREAD_S};
+use shoal_tests::{check_file, parse_plan, parse_scenario_file, MAX_ARRIVAL_SPREAD_S};
 
 fn main() -> ExitCode {
     match run() {
@@ -38,15 +39,16 @@ fn run() -> Result<String, String> {
         (None, _) => None,
         (Some(other), _) => return Err(format!("unknown argument {other:?}")),
     };
-    let read = |p: &str| std::fs::read_to_string(p).map_err(|e| format!("cannot read {p}: {e}"));
-    let (scenario_text, plan_text) = (read(scenario_path)?, read(plan_path)?);
-    let report = check(&scenario_text, &plan_text).map_err(|e| format!("{plan_path}: {e}"))?;
+    let plan_text =
+        std::fs::read_to_string(plan_path).map_err(|e| format!("cannot read {plan_path}: {e}"))?;
+    let report = check_file(Path::new(scenario_path), &plan_text)
+        .map_err(|e| format!("{plan_path}: {e}"))?;
     if !report.is_clean() {
         return Err(format!(
             "{plan_path} disagrees with its trajectories:\n{report}"
         ));
     }
-    let scenario = parse_scenario(&scenario_text).map_err(|e| e.to_string())?;
+    let scenario = parse_scenario_file(Path::new(scenario_path))?;
     let plan = parse_plan(&plan_text).map_err(|e| e.to_string())?;
     // The checker found the reported fleet figures equal to its own recomputation.
     let fleet = &plan.fleet;

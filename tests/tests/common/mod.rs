@@ -20,7 +20,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use serde_json::Value;
-use shoal_tests::{check, geometry, parse_plan};
+use shoal_tests::{check_file, geometry, parse_plan};
 
 pub use process::{agent, coordinator, root, Run};
 use process::{run, RUN_TIMEOUT};
@@ -85,7 +85,15 @@ pub fn plan_and_check(name: &str, out: &Path, extra: &[&str]) -> Result<Value, B
 /// summary on stdout; the independent checker agrees with `plan.json`; exact and sampled
 /// separations agree; `plan.svg` is an SVG. Returns the plan JSON.
 pub fn check_plan_run(name: &str, out: &Path, r: &Run) -> Result<Value, Box<dyn Error>> {
-    let scenario_path = scenario(name);
+    check_plan_run_at(&scenario(name), out, r)
+}
+
+/// [`check_plan_run`] of the scenario file at `scenario_path`.
+pub fn check_plan_run_at(
+    scenario_path: &Path,
+    out: &Path,
+    r: &Run,
+) -> Result<Value, Box<dyn Error>> {
     let code = r.code();
     assert!(
         code == Some(0) || code == Some(3),
@@ -120,8 +128,7 @@ pub fn check_plan_run(name: &str, out: &Path, r: &Run) -> Result<Value, Box<dyn 
     }
     assert!(!r.stdout.trim().is_empty(), "no summary on stdout:\n{r}");
 
-    let scenario_text = std::fs::read_to_string(&scenario_path)?;
-    let report = match check(&scenario_text, &text) {
+    let report = match check_file(scenario_path, &text) {
         Ok(rep) => rep,
         Err(e) => panic!("checker cannot read the files: {e}\n{r}"),
     };
@@ -172,7 +179,7 @@ pub fn problems_of(
         return Ok(vec![format!("unexpected exit status:\n{r}")]);
     }
     let text = std::fs::read_to_string(out.join("plan.json"))?;
-    let report = check(&std::fs::read_to_string(scenario_path)?, &text)?;
+    let report = check_file(scenario_path, &text)?;
     let mut problems = report.problems();
     let parsed = parse_plan(&text)?;
     if (r.code() == Some(0)) != parsed.feasible {
