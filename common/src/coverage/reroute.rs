@@ -66,6 +66,34 @@ impl CrawlerGround {
         self.area.holds(x, y) && self.map.clearance_to_impassable(x, y) >= self.safety_clearance_m
     }
 
+    /// Whether a straight drive from `a` to `b` (checked every half metre) stays on ground the
+    /// crawler may drive: inside the area and at least the safety clearance from impassable
+    /// ground. From a start already closer than that, or outside the area (a crawler off its
+    /// path), the drive may not come closer to impassable ground than the start is, nor go
+    /// farther outside the area, and never onto impassable ground. Clearances are compared
+    /// with half a metre of slack: the planner checks its own path every metre and thins it by
+    /// 5 cm, so a leg of a plan may dip that little under the clearance between its checks.
+    pub fn drivable(&self, a: &Vec3, b: &Vec3) -> bool {
+        const STEP_M: f64 = 0.5;
+        const SLACK_M: f64 = 0.5;
+        let clearance = |x: f64, y: f64| self.map.clearance_to_impassable(x, y);
+        let outside = |x: f64, y: f64| {
+            let r = &self.area;
+            let dx = (r.x0 - x).max(x - r.x1).max(0.0);
+            let dy = (r.y0 - y).max(y - r.y1).max(0.0);
+            dx.hypot(dy)
+        };
+        let need = self.safety_clearance_m.min(clearance(a.x, a.y));
+        let out_at_start = outside(a.x, a.y);
+        let n = ((b.x - a.x).hypot(b.y - a.y) / STEP_M).ceil().max(1.0) as usize;
+        (0..=n).all(|k| {
+            let u = k as f64 / n as f64;
+            let (x, y) = (a.x + u * (b.x - a.x), a.y + u * (b.y - a.y));
+            let c = clearance(x, y);
+            c > 0.0 && c >= need - SLACK_M && outside(x, y) <= out_at_start + 1e-9
+        })
+    }
+
     /// The ways round the places where `keep_out` (given the crawler's reference point) is
     /// true: the free ground is rasterised once here, for every way asked of the result.
     pub fn ways_round<'g>(&'g self, keep_out: &'g dyn Fn(&Vec3) -> bool) -> WaysRound<'g> {

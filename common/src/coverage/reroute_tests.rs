@@ -125,3 +125,33 @@ fn the_crawler_point_is_on_the_map_plus_the_sensor_height() {
     assert!(!g.passable(-1.0, 100.0));
     assert!(!g.passable(100.0, 199.0));
 }
+
+#[test]
+fn a_straight_drive_is_judged_by_the_clearance_it_keeps_from_impassable_ground() {
+    // A 50 m cliff across the whole map from x = 120 m (cells 60..100): its foot is
+    // impassable, the crawler must keep 8 m from it.
+    let g = ground(Some([60, 100, 0, 100]));
+    let edge = (0..1200)
+        .map(|k| f64::from(k) * 0.1)
+        .find(|x| g.map.clearance_to_impassable(*x, 100.0) <= 0.0)
+        .unwrap_or(f64::NAN);
+    assert!(
+        edge > 110.0 && edge < 121.0,
+        "the cliff's foot at x = {edge}"
+    );
+    let at = |x: f64, y: f64| Vec3::new(x, y, 0.0);
+    // Far from the cliff: drivable; ending 4 m from its foot (8 m asked, 0.5 m of slack): not.
+    assert!(g.drivable(&at(20.0, 100.0), &at(edge - 10.0, 100.0)));
+    assert!(!g.drivable(&at(20.0, 100.0), &at(edge - 4.0, 100.0)));
+    // A crawler already 5 m from the foot may drive away from it, or along it, not closer.
+    assert!(g.drivable(&at(edge - 5.0, 100.0), &at(edge - 30.0, 100.0)));
+    assert!(g.drivable(&at(edge - 5.0, 100.0), &at(edge - 5.0, 60.0)));
+    assert!(!g.drivable(&at(edge - 5.0, 100.0), &at(edge - 4.0, 100.0)));
+    assert!(g.drivable(&at(edge - 5.0, 100.0), &at(edge - 4.6, 100.0)));
+    // On the map but never across the cliff's foot, wherever it starts.
+    assert!(!g.drivable(&at(20.0, 100.0), &at(180.0, 100.0)));
+    // Outside the area (x < 0), it may drive back in but not farther out.
+    assert!(g.drivable(&at(-3.0, 100.0), &at(20.0, 100.0)));
+    assert!(!g.drivable(&at(20.0, 100.0), &at(-3.0, 100.0)));
+    assert!(!g.drivable(&at(-3.0, 100.0), &at(-6.0, 100.0)));
+}

@@ -21,9 +21,10 @@
 //! A coverage crawler (seed 002) is repaired the same way, but its way round a blocked run
 //! must stay on passable seabed, which the detour's 3-D grid does not know: it is searched on
 //! the seabed map instead ([`shoal_common::coverage::reroute`]: the coverage planner's safety
-//! clearance and turning radius, the obstacle's keep-out sphere at the crawler's height). A
-//! crawler with no way round (none within the search budget, or no map) holds until the
-//! obstacle is gone.
+//! clearance and turning radius, the obstacle's keep-out sphere at the crawler's height). Its
+//! rejoin is searched there too when the straight line back would cross ground it may not
+//! drive. A crawler with no way (none within the search budget, or no map) holds until the
+//! obstacle is gone (or, for a rejoin, retries from where it stopped).
 //!
 //! A repair that still meets a hard obstacle, or comes within d_min of another vehicle's
 //! predicted track at every timing, is not safe: the coordinator then holds the vehicle and
@@ -66,6 +67,22 @@ fn repaired_path(r: &Request) -> Option<(Vec<Vec3>, Vec<f64>)> {
         .map(|(p, t)| (p[1] - p[0]).norm() / (t[1] - t[0]).max(1e-9))
         .collect();
     if crawler {
+        // The rejoin, from where the crawler will be to its plan's next point, is a straight
+        // line where that line keeps to ground it may drive, else a way on the map, else none
+        // (the crawler holds rather than drive over impassable ground).
+        if let Some(g) = r
+            .ground
+            .filter(|g| pts.len() >= 2 && !g.drivable(&pts[0], &pts[1]))
+        {
+            let ways = ways.get_or_insert_with(|| Some(g.ways_round(&keep_out)));
+            let way = crawler_rejoin(r, ways.as_ref()?, &pts)?;
+            if started.elapsed() > r.budget {
+                return None;
+            }
+            let rejoin_speed = speeds[0];
+            pts.splice(0..2, way.iter().copied());
+            speeds.splice(0..1, std::iter::repeat_n(rejoin_speed, way.len() - 1));
+        }
         (pts, speeds) = split_legs(&pts, &speeds, CRAWLER_LEG_M);
     }
     let runs = blocked_runs(r, &pts);
@@ -224,6 +241,31 @@ fn crawler_way_round(
         *last = pts[j + 1];
     }
     way[0] = pts[k];
+    Some(way)
+}
+
+/// A crawler's way from where it will be (`pts[0]`, on its course) back to its plan's next
+/// point `pts[1]`, arriving on the heading of the plan's leg from there: for a straight rejoin
+/// that would cross ground the crawler may not drive ([`CrawlerGround::drivable`]). `None`
+/// without a way.
+///
+/// [`CrawlerGround::drivable`]: shoal_common::coverage::reroute::CrawlerGround::drivable
+fn crawler_rejoin(r: &Request, ways: &WaysRound, pts: &[Vec3]) -> Option<Vec<Vec3>> {
+    let heading = |d: Vec3| (d.x.hypot(d.y) > 1e-6).then(|| d.y.atan2(d.x));
+    let chord = pts[1] - pts[0];
+    let start = r.heading.and_then(heading).or_else(|| heading(chord))?;
+    let end = pts
+        .get(2)
+        .and_then(|p| heading(p - pts[1]))
+        .or_else(|| heading(chord))?;
+    let mut way = ways.between(
+        Pose2::new(pts[0].x, pts[0].y, start),
+        Pose2::new(pts[1].x, pts[1].y, end),
+    )?;
+    if let Some(last) = way.last_mut() {
+        *last = pts[1];
+    }
+    way[0] = pts[0];
     Some(way)
 }
 

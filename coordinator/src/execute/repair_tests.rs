@@ -1,6 +1,7 @@
 //! Unit tests of `execute::repair`.
 
 use super::*;
+use shoal_common::coverage::reroute::CrawlerGround;
 use shoal_common::scenario::{Obstacle, ObstacleKind};
 use std::time::Duration;
 
@@ -273,5 +274,65 @@ fn a_crawlers_blocked_run_is_widened_by_two_turning_radii() -> Result<(), Box<dy
     r.scenario = &crawler;
     r.ground = Some(&ground);
     assert_eq!(blocked_runs(&r, &pts), vec![(47, 52)]);
+    Ok(())
+}
+
+/// A crawler's 198 m square of flat seabed with a 50 m pillar on cells 50..60 × 33..43 (x 100–
+/// 120 m, y 66–86 m): the crawler keeps 8 m from impassable ground and turns at 5 m.
+fn pillar_ground() -> Result<CrawlerGround, Box<dyn std::error::Error>> {
+    let n = 100;
+    let mut z = vec![0.0; n * n];
+    for j in 33..43 {
+        for i in 50..60 {
+            z[j * n + i] = 50.0;
+        }
+    }
+    let grid = shoal_common::terrain::HeightGrid::new([0.0, 0.0], 2.0, n, n, z)?;
+    Ok(CrawlerGround {
+        map: shoal_common::coverage::TerrainMap25::from_grid(&grid, &Default::default())?,
+        area: shoal_common::coverage::boxes::Rect::new(0.0, 0.0, 198.0, 198.0),
+        safety_clearance_m: 8.0,
+        min_turn_radius_m: 5.0,
+        sensor_height_m: 0.0,
+    })
+}
+
+#[test]
+fn a_crawlers_rejoin_goes_round_ground_it_may_not_drive() -> Result<(), Box<dyn std::error::Error>>
+{
+    let mut s = scenario()?;
+    s.coverage = Some(Default::default());
+    let ground = pillar_ground()?;
+    // The plan: east along y = 100 from x = 20 to 180 (14 m north of the pillar), then north.
+    let p = |x: f64, y: f64| Vec3::new(x, y, 0.0);
+    let plan = Trajectory {
+        times: vec![0.0, 160.0, 240.0],
+        points: vec![p(20.0, 100.0), p(180.0, 100.0), p(180.0, 180.0)],
+    };
+    assert!(ground.drivable(&p(20.0, 100.0), &p(180.0, 100.0)));
+    // At t = 40 the crawler is 40 m south of its row, heading east: the straight line back to
+    // (180, 100) crosses the pillar.
+    let mut r = request(&s, &plan, &[]);
+    r.t0 = 40.0;
+    r.p0 = p(60.0, 60.0);
+    r.arrival_s = 240.0;
+    r.ground = Some(&ground);
+    assert!(!ground.drivable(&r.p0, &p(180.0, 100.0)));
+    let repaired = repair(&r);
+    assert!(repaired.safe, "{repaired:?}");
+    let pts = &repaired.trajectory.points;
+    assert!((pts[0] - r.p0).norm() < 1e-9);
+    for w in pts.windows(2) {
+        assert!(ground.drivable(&w[0], &w[1]), "{} → {}", w[0], w[1]);
+    }
+    // It still rejoins its plan at (180, 100) and ends where the plan ends.
+    assert!(pts.iter().any(|q| (q - p(180.0, 100.0)).norm() < 1e-9));
+    assert!((pts[pts.len() - 1] - p(180.0, 180.0)).norm() < 1e-9);
+
+    // 3 m from the pillar's foot, facing it, the crawler has no way it may drive: it holds.
+    r.p0 = p(96.0, 76.0);
+    let held = repair(&r);
+    assert!(!held.safe);
+    assert_eq!(held.trajectory.points, plan.points);
     Ok(())
 }
