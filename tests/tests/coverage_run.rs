@@ -171,3 +171,35 @@ fn a_crawler_whose_finish_an_obstacle_covers_holds_where_it_is() -> TestResult {
     fleet.passed();
     Ok(())
 }
+
+#[test]
+fn a_crawler_goes_round_a_crawler_held_near_its_path() -> TestResult {
+    let mut fleet = Fleet::new();
+    let file = small_fleet(fleet.dir(), &|t| t)?;
+    let out = fleet.dir().join("out");
+    // The obstacle of the test above, dropped at t = 100 s: crawler2 holds near its start
+    // at (5, 155) for the rest of the mission. crawler1's last rows (y 95–145) end at
+    // (5, 105), within d_min of where crawler2 stands. Before, crawler1's repair could only
+    // re-time those rows, was never safe, and crawler1 held behind crawler2 until the mission
+    // gave up: both never arrived. Now crawler2 is gone round like an obstacle.
+    let c = fleet.spawn(
+        "coordinator",
+        run(&file, &out, &["--inject-obstacle=100:-40,195,0,5"]),
+    );
+    let r = fleet.wait(c, Instant::now() + LIMIT);
+    assert_eq!(r.code(), Some(3), "{}\n{}", r.stdout, r.stderr);
+    assert!(r.stdout.contains("crawler2 never arrived"), "{}", r.stdout);
+    assert!(!r.stdout.contains("crawler1 never arrived"), "{}", r.stdout);
+    let report = read_json(&out.join("execution.json"))?;
+    let f = &report["figures"];
+    let c1 = &f["vehicles"][0];
+    assert_eq!(c1["vehicle"], "crawler1");
+    assert!(c1["arrived_s"].as_f64().is_some(), "{c1}");
+    assert!(number(c1, "revision") >= 1.0, "{c1}");
+    assert_eq!(number(c1, "impassable_m"), 0.0, "{c1}");
+    // Its way keeps d_min from where crawler2 stands (its finish is 51 m from there, inside
+    // the buffer); the crawlers track to within a few metres of their paths.
+    assert!(number(f, "min_separation_m") >= 45.0, "{f}");
+    fleet.passed();
+    Ok(())
+}

@@ -23,8 +23,9 @@
 //! the seabed map instead ([`shoal_common::coverage::reroute`]: the coverage planner's safety
 //! clearance and turning radius, the obstacle's keep-out sphere at the crawler's height). Its
 //! rejoin is searched there too when the straight line back would cross ground it may not
-//! drive. A crawler with no way (none within the search budget, or no map) holds until the
-//! obstacle is gone (or, for a rejoin, retries from where it stopped).
+//! drive, and a vehicle standing still near its path is gone round like an obstacle
+//! ([`with_stopped_vehicles`]). A crawler with no way (none within the search budget, or no
+//! map) holds until the obstacle is gone (or, for a rejoin, retries from where it stopped).
 //!
 //! A repair that still meets a hard obstacle, or comes within d_min of another vehicle's
 //! predicted track at every timing, is not safe: the coordinator then holds the vehicle and
@@ -35,7 +36,7 @@ use std::time::Instant;
 use shoal_common::coverage::path::Pose2;
 use shoal_common::coverage::reroute::WaysRound;
 use shoal_common::geometry::{segment_hits_sphere, Vec3};
-use shoal_common::scenario::Scenario;
+use shoal_common::scenario::{Obstacle, ObstacleKind, Scenario};
 use shoal_common::separation::{motion_separation, Motion};
 use shoal_common::trajectory::Trajectory;
 
@@ -53,7 +54,9 @@ fn blocked(scenario: &Scenario, a: &Vec3, b: &Vec3) -> bool {
 /// request's budget).
 fn repaired_path(r: &Request) -> Option<(Vec<Vec3>, Vec<f64>)> {
     let started = Instant::now();
-    let scenario = r.scenario;
+    // Vehicles that stand still are gone round as obstacles (see `with_stopped_vehicles`).
+    let with_stopped = with_stopped_vehicles(r);
+    let scenario = with_stopped.as_ref().unwrap_or(r.scenario);
     let crawler = scenario.coverage.is_some();
     // A crawler's ways round, rasterised on first use (see `crawler_way_round`).
     let keep_out = |p: &Vec3| near_obstacle(scenario, p);
@@ -74,8 +77,17 @@ fn repaired_path(r: &Request) -> Option<(Vec<Vec3>, Vec<f64>)> {
             .ground
             .filter(|g| pts.len() >= 2 && !g.drivable(&pts[0], &pts[1]))
         {
+            let id = &scenario.vehicles[r.vehicle].id;
             let ways = ways.get_or_insert_with(|| Some(g.ways_round(&keep_out)));
-            let way = crawler_rejoin(r, ways.as_ref()?, &pts)?;
+            let Some(way) = crawler_rejoin(r, ways.as_ref()?, &pts) else {
+                tracing::info!("{id}: no way back to its path on ground it may drive");
+                return None;
+            };
+            let metres: f64 = way.windows(2).map(|w| (w[1] - w[0]).norm()).sum();
+            tracing::info!(
+                "{id}: the straight way back to its path crosses ground it may not drive; \
+                 rejoining by {metres:.0} m searched on the seabed map"
+            );
             if started.elapsed() > r.budget {
                 return None;
             }
@@ -85,7 +97,7 @@ fn repaired_path(r: &Request) -> Option<(Vec<Vec3>, Vec<f64>)> {
         }
         (pts, speeds) = split_legs(&pts, &speeds, CRAWLER_LEG_M);
     }
-    let runs = blocked_runs(r, &pts);
+    let runs = blocked_runs(scenario, r, &pts);
     let mut out = vec![pts[0]];
     let mut out_speeds = Vec::new();
     let mut k = 0;
@@ -136,8 +148,7 @@ fn repaired_path(r: &Request) -> Option<(Vec<Vec3>, Vec<f64>)> {
 /// that come within two turning radii of the keep-out, so the way round leaves and rejoins
 /// the path where the crawler has room to turn (a rejoin on the edge of the keep-out, on the
 /// path's heading, may not be reachable at all).
-fn blocked_runs(r: &Request, pts: &[Vec3]) -> Vec<(usize, usize)> {
-    let scenario = r.scenario;
+fn blocked_runs(scenario: &Scenario, r: &Request, pts: &[Vec3]) -> Vec<(usize, usize)> {
     let hit: Vec<bool> = pts
         .windows(2)
         .map(|w| blocked(scenario, &w[0], &w[1]))
@@ -178,6 +189,60 @@ fn blocked_runs(r: &Request, pts: &[Vec3]) -> Vec<(usize, usize)> {
     }
     runs
 }
+
+/// For a coverage crawler, `r.scenario` with every other vehicle that stands still over the
+/// rest of its prediction (held, lost, faulted or arrived) as a hard sphere of d_min plus the
+/// separation buffer round where it stands; `None` when there is none. A re-timing cannot pass
+/// a vehicle that stands on the path (the repair would be unsafe at every timing, and the
+/// crawler would wait behind it as long as it stands): the repair goes round it as round an
+/// obstacle, leaving the ground near it uncovered. A crawler that will already be inside such
+/// a sphere at `t0` (a conflict is seen only `--horizon` ahead) gets a smaller one, down to
+/// d_min, that leaves it room to turn away (and its finish outside, when that keeps d_min);
+/// one already within d_min of the standing vehicle is left to the
+/// separation check, which lets it move away. A tour still waits: the way round would skip
+/// the inspection points near the standing vehicle.
+fn with_stopped_vehicles(r: &Request) -> Option<Scenario> {
+    r.scenario.coverage.as_ref()?;
+    let d_min = r.scenario.fleet.d_min_m;
+    let d = d_min + r.separation_buffer_m.max(0.0);
+    let turn = r.ground.map_or(0.0, |g| g.min_turn_radius_m);
+    let finish = r.current.points.last().copied().unwrap_or(r.p0);
+    let stopped: Vec<Obstacle> = r
+        .others
+        .iter()
+        .enumerate()
+        .filter(|(j, _)| *j != r.vehicle)
+        .filter_map(|(j, o)| {
+            let at = o.position_at(r.t0);
+            let rest = o.since(r.t0);
+            let still = rest.points.iter().all(|p| (p - at).norm() < STILL_M);
+            // Room left outside the sphere for the crawler's start, which the search needs
+            // free, and for a turn away from it; and for its finish.
+            let dist = (r.p0 - at).norm();
+            let to_finish = (finish - at).norm();
+            let radius = (dist - WAY_ROUND_MARGIN_M - STILL_M - turn)
+                .min(to_finish - WAY_ROUND_MARGIN_M - STILL_M)
+                .clamp(d_min, d);
+            let room = dist >= d_min + WAY_ROUND_MARGIN_M + STILL_M;
+            (still && room).then(|| Obstacle {
+                id: format!("{} (standing still)", r.scenario.vehicles[j].id),
+                kind: ObstacleKind::Hard,
+                centre: at.into(),
+                radius_m: radius,
+                inflation_m: 0.0,
+            })
+        })
+        .collect();
+    if stopped.is_empty() || d_min <= 0.0 {
+        return None;
+    }
+    let mut s = r.scenario.clone();
+    s.obstacles.extend(stopped);
+    Some(s)
+}
+
+/// A vehicle whose prediction stays within this of where it is at `t0` stands still, metres.
+const STILL_M: f64 = 1.0;
 
 /// Legs of a crawler's path are cut to at most this long before its blocked runs are found, so
 /// a way round replaces only the stretch near the obstacle, not a whole row.

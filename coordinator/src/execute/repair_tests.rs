@@ -258,7 +258,7 @@ fn a_crawlers_blocked_run_is_widened_by_two_turning_radii() -> Result<(), Box<dy
         .collect();
     let plan = tour();
     let mut r = request(&s, &plan, &[]);
-    assert_eq!(blocked_runs(&r, &pts), vec![(49, 50)]);
+    assert_eq!(blocked_runs(r.scenario, &r, &pts), vec![(49, 50)]);
     // A crawler turning at 5 m: the run takes every leg within 9.5 + 1 + 2 × 5 = 20.5 m of the
     // centre, legs 47 (470–480, 20 m) to 52 (520–530); 46 and 53 are 30 m off.
     let mut crawler = s.clone();
@@ -273,7 +273,7 @@ fn a_crawlers_blocked_run_is_widened_by_two_turning_radii() -> Result<(), Box<dy
     };
     r.scenario = &crawler;
     r.ground = Some(&ground);
-    assert_eq!(blocked_runs(&r, &pts), vec![(47, 52)]);
+    assert_eq!(blocked_runs(r.scenario, &r, &pts), vec![(47, 52)]);
     Ok(())
 }
 
@@ -334,5 +334,58 @@ fn a_crawlers_rejoin_goes_round_ground_it_may_not_drive() -> Result<(), Box<dyn 
     let held = repair(&r);
     assert!(!held.safe);
     assert_eq!(held.trajectory.points, plan.points);
+    Ok(())
+}
+
+#[test]
+fn a_crawler_goes_round_a_vehicle_standing_near_its_path() -> Result<(), Box<dyn std::error::Error>>
+{
+    let mut s = scenario()?;
+    s.coverage = Some(Default::default());
+    let ground = pillar_ground()?;
+    // East along y = 150 from x = 10 to 190 at 0.5 m/s (north of the pillar); the other
+    // vehicle stands 40 m north of that row at x = 100 for the rest of the mission.
+    let p = |x: f64, y: f64| Vec3::new(x, y, 0.0);
+    let plan = Trajectory {
+        times: vec![0.0, 360.0],
+        points: vec![p(10.0, 150.0), p(190.0, 150.0)],
+    };
+    let standing = Trajectory {
+        times: vec![0.0, 1000.0],
+        points: vec![p(100.0, 190.0), p(100.0, 190.0)],
+    };
+    let others = [plan.clone(), standing];
+    let mut r = request(&s, &plan, &others);
+    r.t0 = 20.0;
+    r.p0 = p(20.0, 150.0);
+    r.arrival_s = 360.0;
+    r.budget = Duration::from_secs(2);
+    r.separation_buffer_m = 10.0;
+    r.ground = Some(&ground);
+    let repaired = repair(&r);
+    // It goes round: d_min plus the buffer (60 m) from the standing vehicle, every leg on
+    // drivable ground, and it still ends at the row's end.
+    assert!(repaired.safe, "{repaired:?}");
+    assert!(repaired.min_separation_m >= 60.0, "{repaired:?}");
+    let pts = &repaired.trajectory.points;
+    for w in pts.windows(2) {
+        assert!(ground.drivable(&w[0], &w[1]), "{} → {}", w[0], w[1]);
+    }
+    assert!((pts[pts.len() - 1] - p(190.0, 150.0)).norm() < 1e-9);
+
+    // At x = 65 (53.2 m from it, inside d_min plus the buffer) it goes round at d_min: a
+    // sphere any larger would leave it no room to turn away at its 5 m radius.
+    r.t0 = 110.0;
+    r.p0 = p(65.0, 150.0);
+    let near = repair(&r);
+    assert!(near.safe, "{near:?}");
+    assert!(near.min_separation_m >= 50.0, "{near:?}");
+
+    // At x = 80 (44.7 m, already within d_min) it is not gone round: the row passes 40 m from
+    // it at every timing, so the repair is not safe, as before.
+    r.t0 = 140.0;
+    r.p0 = p(80.0, 150.0);
+    let close = repair(&r);
+    assert!(!close.safe, "{close:?}");
     Ok(())
 }
