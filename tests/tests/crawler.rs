@@ -119,24 +119,31 @@ fn a_mixed_fleet_keeps_crawlers_apart_in_process_and_distributed() -> TestResult
     Ok(())
 }
 
-/// The DSMV seabed sampled every metre into an ESRI ASCII grid (north row first), written as
-/// `dsmv.asc` beside a copy of the scenario that names it instead of its relief and mountains;
-/// `flip` writes the rows south first, a grid the checker must read as a different seabed.
-/// Returns the copy's path.
-fn dsmv_on_a_grid(
+/// The seabed of scenario `name` sampled every metre over its bounds into an ESRI ASCII grid
+/// (north row first), written as `seabed.asc` beside a copy of the scenario that names it
+/// instead of its relief and mountains; `flip` writes the rows south first, a grid the checker
+/// must read as a different seabed. Returns the copy's path.
+fn on_a_grid(
+    name: &str,
     dir: &std::path::Path,
     flip: bool,
 ) -> Result<std::path::PathBuf, Box<dyn std::error::Error>> {
-    let text = std::fs::read_to_string(scenario("ipso-dsmv"))?;
+    let text = std::fs::read_to_string(scenario(name))?;
     let analytic = shoal_tests::parse_scenario(&text)?;
     let Some(floor) = shoal_tests::crawler::Floor::of(&analytic) else {
-        panic!("ipso-dsmv has no analytic seabed");
+        panic!("{name} has no analytic seabed");
     };
-    let mut rows: Vec<String> = (0..=200)
+    let (lo, hi) = (analytic.bounds.min, analytic.bounds.max);
+    // Whole metres from the lower corner, covering the bounds.
+    let (nx, ny) = (
+        (hi[0] - lo[0]).ceil() as usize,
+        (hi[1] - lo[1]).ceil() as usize,
+    );
+    let mut rows: Vec<String> = (0..=ny)
         .rev()
-        .map(|y| {
-            let row: Vec<String> = (0..=200)
-                .map(|x| format!("{:.4}", floor.z(f64::from(x), f64::from(y))))
+        .map(|j| {
+            let row: Vec<String> = (0..=nx)
+                .map(|i| format!("{:.4}", floor.z(lo[0] + i as f64, lo[1] + j as f64)))
                 .collect();
             row.join(" ")
         })
@@ -145,20 +152,24 @@ fn dsmv_on_a_grid(
         rows.reverse();
     }
     let asc = format!(
-        "ncols 201\nnrows 201\nxllcenter 0\nyllcenter 0\ncellsize 1\nNODATA_value -9999\n{}\n",
+        "ncols {}\nnrows {}\nxllcenter {}\nyllcenter {}\ncellsize 1\nNODATA_value -9999\n{}\n",
+        nx + 1,
+        ny + 1,
+        lo[0],
+        lo[1],
         rows.join("\n")
     );
-    std::fs::write(dir.join("dsmv.asc"), asc)?;
+    std::fs::write(dir.join("seabed.asc"), asc)?;
     let mut doc: toml::Table = toml::from_str(&text)?;
     let Some(seabed) = doc.get_mut("seabed").and_then(toml::Value::as_table_mut) else {
-        panic!("ipso-dsmv has no [seabed]");
+        panic!("{name} has no [seabed]");
     };
     seabed.remove("relief");
     seabed.remove("mountains");
     let mut grid = toml::Table::new();
-    grid.insert("file".into(), toml::Value::String("dsmv.asc".into()));
+    grid.insert("file".into(), toml::Value::String("seabed.asc".into()));
     seabed.insert("grid".into(), toml::Value::Table(grid));
-    let path = dir.join("dsmv-grid.toml");
+    let path = dir.join(format!("{name}-grid.toml"));
     std::fs::write(&path, toml::to_string(&doc)?)?;
     Ok(path)
 }
@@ -166,7 +177,7 @@ fn dsmv_on_a_grid(
 #[test]
 fn a_crawler_planned_on_a_measured_seabed_is_checked_on_that_grid() -> TestResult {
     let dir = tempfile::tempdir()?;
-    let path = dsmv_on_a_grid(dir.path(), false)?;
+    let path = on_a_grid("ipso-dsmv", dir.path(), false)?;
     let out = dir.path().join("out");
     let r = plan(&path, &out, &["--iterations", "10", "--seed", "4"]);
     let json = check_plan_run_at(&path, &out, &r)?;
@@ -180,7 +191,7 @@ fn a_crawler_planned_on_a_measured_seabed_is_checked_on_that_grid() -> TestResul
     let plan_text = std::fs::read_to_string(out.join("plan.json"))?;
     let flipped_dir = dir.path().join("flipped");
     std::fs::create_dir(&flipped_dir)?;
-    let flipped = dsmv_on_a_grid(&flipped_dir, true)?;
+    let flipped = on_a_grid("ipso-dsmv", &flipped_dir, true)?;
     let report = shoal_tests::check_file(&flipped, &plan_text)?;
     assert!(
         format!("{report}").contains("leaves the seabed"),
@@ -196,5 +207,42 @@ fn a_crawler_planned_on_a_measured_seabed_is_checked_on_that_grid() -> TestResul
     let report = shoal_tests::check_file(&path, &lifted.to_string())?;
     let all = format!("{report}");
     assert!(all.contains("leaves the seabed by 0.3000 m"), "{all}");
+    Ok(())
+}
+
+#[test]
+fn a_mixed_fleet_planned_over_a_measured_seabed_is_checked_on_that_grid() -> TestResult {
+    let dir = tempfile::tempdir()?;
+    let path = on_a_grid("seabed-fleet", dir.path(), false)?;
+    let out = dir.path().join("out");
+    let r = plan(&path, &out, &["--seed", "2"]);
+    let json = check_plan_run_at(&path, &out, &r)?;
+    for id in ["crawler1", "crawler2"] {
+        let c = crawler(&json, id);
+        assert_eq!(c["hazard_intrusions"].as_u64(), Some(0), "{id}: {c}");
+        assert!(c["off_seabed_m"].as_f64().is_some_and(|d| d < 1e-9), "{c}");
+    }
+    // The AUV's lowest height over the grid is reported, and the checker agreed with it.
+    let vehicles = key(&json, "vehicles");
+    let auv = vehicles
+        .as_array()
+        .and_then(|l| l.iter().find(|v| v["id"] == "auv1"));
+    assert!(
+        auv.is_some_and(|v| v["min_seabed_clearance_m"].as_f64().is_some()),
+        "{vehicles}"
+    );
+    // Over the grid flipped north to south, the crawlers leave the seabed and the AUV's
+    // seabed clearance is not what was reported.
+    let flipped_dir = dir.path().join("flipped");
+    std::fs::create_dir(&flipped_dir)?;
+    let flipped = on_a_grid("seabed-fleet", &flipped_dir, true)?;
+    let report =
+        shoal_tests::check_file(&flipped, &std::fs::read_to_string(out.join("plan.json"))?)?;
+    let all = format!("{report}");
+    assert!(
+        all.contains("crawler1 is a crawler but leaves the seabed"),
+        "{all}"
+    );
+    assert!(all.contains("auv1.min_seabed_clearance_m"), "{all}");
     Ok(())
 }
