@@ -79,7 +79,13 @@ fn repaired_path(r: &Request) -> Option<(Vec<Vec3>, Vec<f64>)> {
         {
             let id = &scenario.vehicles[r.vehicle].id;
             let ways = ways.get_or_insert_with(|| Some(g.ways_round(&keep_out)));
-            let Some(way) = crawler_rejoin(r, ways.as_ref()?, &pts) else {
+            // Arriving on the plan's leg from its next point (the chord's direction at its end).
+            let along = pts
+                .get(2)
+                .map(|p| p - pts[1])
+                .filter(|d| d.x.hypot(d.y) > 1e-6)
+                .unwrap_or(pts[1] - pts[0]);
+            let Some(way) = crawler_way_round(r, ways.as_ref()?, &pts, (0, 0), along) else {
                 tracing::info!("{id}: no way back to its path on ground it may drive");
                 return None;
             };
@@ -114,7 +120,7 @@ fn repaired_path(r: &Request) -> Option<(Vec<Vec3>, Vec<f64>)> {
             // detour does not know: its way round is searched on the seabed map. Without the
             // map (it could not be built) there is none, and the crawler holds.
             let ways = ways.get_or_insert_with(|| r.ground.map(|g| g.ways_round(&keep_out)));
-            let way = crawler_way_round(r, ways.as_ref()?, &pts, k, j)?;
+            let way = crawler_way_round(r, ways.as_ref()?, &pts, (k, j), pts[j + 1] - pts[j])?;
             // Past its budget the repair gives up: the crawler holds, and the retry has longer.
             if started.elapsed() > r.budget {
                 return None;
@@ -275,15 +281,16 @@ fn near_obstacle(scenario: &Scenario, p: &Vec3) -> bool {
         .any(|o| (p - o.centre()).norm() < o.inflated_radius() + WAY_ROUND_MARGIN_M)
 }
 
-/// A crawler's way round the blocked legs `k..=j` of `pts` ([`WaysRound::between`]), from
-/// `pts[k]` on the heading it arrives there with to `pts[j + 1]` on the heading of the last
-/// blocked leg, ending exactly there. `None` without a way.
+/// A crawler's way round the legs `k..=j` of `pts` ([`WaysRound::between`]), from `pts[k]` on
+/// the heading it arrives there with to `pts[j + 1]`, arriving along `arrive_along` (for a
+/// blocked run its last leg; for a rejoin the plan's leg from there), ending exactly there.
+/// `None` without a way.
 fn crawler_way_round(
     r: &Request,
     ways: &WaysRound,
     pts: &[Vec3],
-    k: usize,
-    j: usize,
+    (k, j): (usize, usize),
+    arrive_along: Vec3,
 ) -> Option<Vec<Vec3>> {
     let heading = |d: Vec3| (d.x.hypot(d.y) > 1e-6).then(|| d.y.atan2(d.x));
     // Arriving at pts[k]: the leg before it, or (at the vehicle) its course, else the
@@ -296,7 +303,7 @@ fn crawler_way_round(
     let start = before
         .and_then(heading)
         .or_else(|| heading(pts[k + 1] - pts[k]))?;
-    let end = heading(pts[j + 1] - pts[j])?;
+    let end = heading(arrive_along)?;
     let mut way = ways.between(
         Pose2::new(pts[k].x, pts[k].y, start),
         Pose2::new(pts[j + 1].x, pts[j + 1].y, end),
@@ -306,31 +313,6 @@ fn crawler_way_round(
         *last = pts[j + 1];
     }
     way[0] = pts[k];
-    Some(way)
-}
-
-/// A crawler's way from where it will be (`pts[0]`, on its course) back to its plan's next
-/// point `pts[1]`, arriving on the heading of the plan's leg from there: for a straight rejoin
-/// that would cross ground the crawler may not drive ([`CrawlerGround::drivable`]). `None`
-/// without a way.
-///
-/// [`CrawlerGround::drivable`]: shoal_common::coverage::reroute::CrawlerGround::drivable
-fn crawler_rejoin(r: &Request, ways: &WaysRound, pts: &[Vec3]) -> Option<Vec<Vec3>> {
-    let heading = |d: Vec3| (d.x.hypot(d.y) > 1e-6).then(|| d.y.atan2(d.x));
-    let chord = pts[1] - pts[0];
-    let start = r.heading.and_then(heading).or_else(|| heading(chord))?;
-    let end = pts
-        .get(2)
-        .and_then(|p| heading(p - pts[1]))
-        .or_else(|| heading(chord))?;
-    let mut way = ways.between(
-        Pose2::new(pts[0].x, pts[0].y, start),
-        Pose2::new(pts[1].x, pts[1].y, end),
-    )?;
-    if let Some(last) = way.last_mut() {
-        *last = pts[1];
-    }
-    way[0] = pts[0];
     Some(way)
 }
 
