@@ -197,16 +197,16 @@ fn blocked_runs(scenario: &Scenario, r: &Request, pts: &[Vec3]) -> Vec<(usize, u
 }
 
 /// For a coverage crawler, `r.scenario` with every other vehicle that stands still over the
-/// rest of its prediction (held, lost, faulted or arrived) as a hard sphere of d_min plus the
-/// separation buffer round where it stands; `None` when there is none. A re-timing cannot pass
-/// a vehicle that stands on the path (the repair would be unsafe at every timing, and the
-/// crawler would wait behind it as long as it stands): the repair goes round it as round an
-/// obstacle, leaving the ground near it uncovered. A crawler that will already be inside such
-/// a sphere at `t0` (a conflict is seen only `--horizon` ahead) gets a smaller one, down to
-/// d_min, that leaves it room to turn away (and its finish outside, when that keeps d_min);
-/// one already within d_min of the standing vehicle is left to the
-/// separation check, which lets it move away. A tour still waits: the way round would skip
-/// the inspection points near the standing vehicle.
+/// rest of its prediction (held, lost or faulted; arrived, once its prediction has settled on
+/// its end point) as a hard sphere of d_min plus the separation buffer round where it stands;
+/// `None` when there is none. A re-timing cannot pass a vehicle that stands on the path (the
+/// repair would be unsafe at every timing, and the crawler would wait behind it as long as it
+/// stands): the repair goes round it as round an obstacle, leaving the ground near it
+/// uncovered. A crawler that will already be inside such a sphere at `t0` (a conflict is seen
+/// only `--horizon` ahead) gets a smaller one, down to d_min, that leaves it room to turn away
+/// (and its finish outside, when that keeps d_min); one already within d_min of the standing
+/// vehicle is left to the separation check, which lets it move away. A tour still waits: the
+/// way round would skip the inspection points near the standing vehicle.
 fn with_stopped_vehicles(r: &Request) -> Option<Scenario> {
     r.scenario.coverage.as_ref()?;
     let d_min = r.scenario.fleet.d_min_m;
