@@ -23,9 +23,10 @@
 //! the seabed map instead ([`shoal_common::coverage::reroute`]: the coverage planner's safety
 //! clearance and turning radius, the obstacle's keep-out sphere at the crawler's height). Its
 //! rejoin is searched there too when the straight line back would cross ground it may not
-//! drive, and a vehicle standing still near its path is gone round like an obstacle
-//! ([`with_stopped_vehicles`]). A crawler with no way (none within the search budget, or no
-//! map) holds until the obstacle is gone (or, for a rejoin, retries from where it stopped).
+//! drive. A vehicle standing still near its path is gone round like an obstacle, and an
+//! obstacle's margin the crawler is already inside is eased to let it out
+//! ([`crawler_scenario`]). A crawler with no way (none within the search budget, or no map)
+//! holds until the obstacle is gone (or, for a rejoin, retries from where it stopped).
 //!
 //! A repair that still meets a hard obstacle, or comes within d_min of another vehicle's
 //! predicted track at every timing, is not safe: the coordinator then holds the vehicle and
@@ -49,14 +50,11 @@ fn blocked(scenario: &Scenario, a: &Vec3, b: &Vec3) -> bool {
         .any(|o| segment_hits_sphere(a, b, &o.centre(), o.inflated_radius()))
 }
 
-/// The rest of the tour from `p0` as points and the plan's own speed on each leg; `None` for
-/// a way round a blocked run that the grid cannot find (or, for a crawler, not within the
-/// request's budget).
-fn repaired_path(r: &Request) -> Option<(Vec<Vec3>, Vec<f64>)> {
+/// The rest of the tour from `p0` as points and the plan's own speed on each leg, planned in
+/// `scenario` (`r.scenario`, or a crawler's [`crawler_scenario`]); `None` for a way round a
+/// blocked run that the grid cannot find (or, for a crawler, not within the request's budget).
+fn repaired_path(r: &Request, scenario: &Scenario) -> Option<(Vec<Vec3>, Vec<f64>)> {
     let started = Instant::now();
-    // Vehicles that stand still are gone round as obstacles (see `with_stopped_vehicles`).
-    let with_stopped = with_stopped_vehicles(r);
-    let scenario = with_stopped.as_ref().unwrap_or(r.scenario);
     let crawler = scenario.coverage.is_some();
     // A crawler's ways round, rasterised on first use (see `crawler_way_round`).
     let keep_out = |p: &Vec3| near_obstacle(scenario, p);
@@ -196,10 +194,10 @@ fn blocked_runs(scenario: &Scenario, r: &Request, pts: &[Vec3]) -> Vec<(usize, u
     runs
 }
 
-/// For a coverage crawler, `r.scenario` with every other vehicle that stands still over the
-/// rest of its prediction (held, lost or faulted; arrived, once its prediction has settled on
-/// its end point) as a hard sphere of d_min plus the separation buffer round where it stands;
-/// `None` when there is none. A re-timing cannot pass a vehicle that stands on the path (the
+/// Every other vehicle that stands still over the rest of its prediction (held, lost or
+/// faulted; arrived, once its prediction has settled on its end point), as a hard sphere of
+/// d_min plus the separation buffer round where it stands (a crawler's repair goes round it,
+/// see [`crawler_scenario`]). A re-timing cannot pass a vehicle that stands on the path (the
 /// repair would be unsafe at every timing, and the crawler would wait behind it as long as it
 /// stands): the repair goes round it as round an obstacle, leaving the ground near it
 /// uncovered. A crawler that will already be inside such a sphere at `t0` (a conflict is seen
@@ -207,14 +205,15 @@ fn blocked_runs(scenario: &Scenario, r: &Request, pts: &[Vec3]) -> Vec<(usize, u
 /// (and its finish outside, when that keeps d_min); one already within d_min of the standing
 /// vehicle is left to the separation check, which lets it move away. A tour still waits: the
 /// way round would skip the inspection points near the standing vehicle.
-fn with_stopped_vehicles(r: &Request) -> Option<Scenario> {
-    r.scenario.coverage.as_ref()?;
+fn stopped_vehicles(r: &Request) -> Vec<Obstacle> {
     let d_min = r.scenario.fleet.d_min_m;
     let d = d_min + r.separation_buffer_m.max(0.0);
     let turn = r.ground.map_or(0.0, |g| g.min_turn_radius_m);
     let finish = r.current.points.last().copied().unwrap_or(r.p0);
-    let stopped: Vec<Obstacle> = r
-        .others
+    if d_min <= 0.0 {
+        return Vec::new();
+    }
+    r.others
         .iter()
         .enumerate()
         .filter(|(j, _)| *j != r.vehicle)
@@ -238,13 +237,38 @@ fn with_stopped_vehicles(r: &Request) -> Option<Scenario> {
                 inflation_m: 0.0,
             })
         })
-        .collect();
-    if stopped.is_empty() || d_min <= 0.0 {
-        return None;
-    }
+        .collect()
+}
+
+/// The scenario a coverage crawler's repair plans in (`None`: `r.scenario` as it is).
+///
+/// - Every vehicle standing still near its path is an obstacle ([`stopped_vehicles`]).
+/// - A hard obstacle whose margin (its inflation) the crawler is already inside at `t0` (it
+///   appeared there, or the crawler stopped short of it inside), or too near to turn away at
+///   its turning radius, has its margin eased, down to none, to leave it that room: the way
+///   round then takes it out of the margin, where it would otherwise hold (a search cannot
+///   start in a keep-out) until the obstacle is gone. Its physical sphere is never eased.
+fn crawler_scenario(r: &Request) -> Option<Scenario> {
+    r.scenario.coverage.as_ref()?;
+    let turn = r.ground.map_or(0.0, |g| g.min_turn_radius_m);
     let mut s = r.scenario.clone();
+    let mut changed = false;
+    for o in s
+        .obstacles
+        .iter_mut()
+        .filter(|o| o.kind == ObstacleKind::Hard)
+    {
+        let dist = (r.p0 - o.centre()).norm();
+        let room = dist - WAY_ROUND_MARGIN_M - STILL_M - turn - o.radius_m;
+        if room < o.inflation_m {
+            o.inflation_m = room.max(0.0);
+            changed = true;
+        }
+    }
+    let stopped = stopped_vehicles(r);
+    changed |= !stopped.is_empty();
     s.obstacles.extend(stopped);
-    Some(s)
+    changed.then_some(s)
 }
 
 /// A vehicle whose prediction stays within this of where it is at `t0` stands still, metres.
@@ -393,7 +417,9 @@ pub fn repair(r: &Request) -> Replanned {
     let started = Instant::now();
     let v = &r.scenario.vehicles[r.vehicle];
     let d_min = r.scenario.fleet.d_min_m;
-    let Some((points, speeds)) = repaired_path(r) else {
+    let shaped = crawler_scenario(r);
+    let scenario = shaped.as_ref().unwrap_or(r.scenario);
+    let Some((points, speeds)) = repaired_path(r, scenario) else {
         return Replanned {
             trajectory: r.current.clone(),
             safe: false,
@@ -402,10 +428,18 @@ pub fn repair(r: &Request) -> Replanned {
             elapsed: started.elapsed(),
         };
     };
-    // The path, hence its obstacle intrusions, is the same at every timing.
+    // The path, hence its obstacle intrusions, is the same at every timing. They are counted
+    // on the scenario's own obstacles (a margin the crawler was inside eased as it planned);
+    // the standing vehicles are the separation check's.
+    let own = &scenario.obstacles[..r.scenario.obstacles.len()];
     let hard_hits = points
         .windows(2)
-        .filter(|w| blocked(r.scenario, &w[0], &w[1]))
+        .filter(|w| {
+            own.iter().any(|o| {
+                o.kind == ObstacleKind::Hard
+                    && segment_hits_sphere(&w[0], &w[1], &o.centre(), o.inflated_radius())
+            })
+        })
         .count();
     let range = (v.speed_min_mps, v.speed_max_mps);
     let on_time = timed(points, &speeds, r.t0, r.current.arrival() - r.t0, range);

@@ -389,3 +389,62 @@ fn a_crawler_goes_round_a_vehicle_standing_near_its_path() -> Result<(), Box<dyn
     assert!(!close.safe, "{close:?}");
     Ok(())
 }
+
+#[test]
+fn a_crawler_inside_an_obstacles_margin_drives_out_of_it() -> Result<(), Box<dyn std::error::Error>>
+{
+    let mut s = scenario()?;
+    s.coverage = Some(Default::default());
+    // A rock of 5 m with a 30 m margin 15 m north of the row y = 150, at x = 60.
+    s.obstacles.push(Obstacle {
+        id: "rock".into(),
+        kind: ObstacleKind::Hard,
+        centre: [60.0, 165.0, 0.0],
+        radius_m: 5.0,
+        inflation_m: 30.0,
+    });
+    let ground = pillar_ground()?;
+    let p = |x: f64, y: f64| Vec3::new(x, y, 0.0);
+    let plan = Trajectory {
+        times: vec![0.0, 360.0],
+        points: vec![p(10.0, 150.0), p(190.0, 150.0)],
+    };
+    // At x = 40 the crawler is 25 m from the rock's centre, 10 m inside its margin. The search
+    // cannot start inside a keep-out: before, it held there until the rock was gone. Now the
+    // margin is eased to 25 − 1 − 1 − 5 (its turn) − 5 = 13 m, and it goes round outside that.
+    let mut r = request(&s, &plan, &[]);
+    r.t0 = 60.0;
+    r.p0 = p(40.0, 150.0);
+    r.arrival_s = 360.0;
+    r.budget = Duration::from_secs(2);
+    r.ground = Some(&ground);
+    let repaired = repair(&r);
+    assert!(repaired.safe, "{repaired:?}");
+    let pts = &repaired.trajectory.points;
+    let rock = p(60.0, 165.0);
+    for w in pts.windows(2) {
+        assert!(ground.drivable(&w[0], &w[1]), "{} → {}", w[0], w[1]);
+        assert!(
+            !segment_hits_sphere(&w[0], &w[1], &rock, 18.0),
+            "{} → {}",
+            w[0],
+            w[1]
+        );
+    }
+    assert!((pts[pts.len() - 1] - p(190.0, 150.0)).norm() < 1e-9);
+    // Its margin is not eased for a crawler with room outside it: from x = 10 (51.9 m away),
+    // the way round keeps the whole 35 m.
+    r.t0 = 0.0;
+    r.p0 = p(10.0, 150.0);
+    let outside = repair(&r);
+    assert!(outside.safe, "{outside:?}");
+    for w in outside.trajectory.points.windows(2) {
+        assert!(
+            !segment_hits_sphere(&w[0], &w[1], &rock, 35.0),
+            "{} → {}",
+            w[0],
+            w[1]
+        );
+    }
+    Ok(())
+}
