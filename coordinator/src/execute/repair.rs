@@ -244,10 +244,11 @@ fn stopped_vehicles(r: &Request) -> Vec<Obstacle> {
 ///
 /// - Every vehicle standing still near its path is an obstacle ([`stopped_vehicles`]).
 /// - A hard obstacle whose margin (its inflation) the crawler is already inside at `t0` (it
-///   appeared there, or the crawler stopped short of it inside), or too near to turn away at
-///   its turning radius, has its margin eased, down to none, to leave it that room: the way
-///   round then takes it out of the margin, where it would otherwise hold (a search cannot
-///   start in a keep-out) until the obstacle is gone. Its physical sphere is never eased.
+///   appeared there, or the crawler stopped short of it inside) has its margin eased, down to
+///   none, to leave the crawler room to turn away at its turning radius: the way round then
+///   takes it out of the margin, where it would otherwise hold (a search cannot start in a
+///   keep-out) until the obstacle is gone. Its physical sphere is never eased, nor is the
+///   margin of an obstacle the crawler is outside.
 fn crawler_scenario(r: &Request) -> Option<Scenario> {
     r.scenario.coverage.as_ref()?;
     let turn = r.ground.map_or(0.0, |g| g.min_turn_radius_m);
@@ -260,7 +261,7 @@ fn crawler_scenario(r: &Request) -> Option<Scenario> {
     {
         let dist = (r.p0 - o.centre()).norm();
         let room = dist - WAY_ROUND_MARGIN_M - STILL_M - turn - o.radius_m;
-        if room < o.inflation_m {
+        if dist < o.inflated_radius() + WAY_ROUND_MARGIN_M && room < o.inflation_m {
             o.inflation_m = room.max(0.0);
             changed = true;
         }

@@ -432,13 +432,25 @@ fn a_crawler_inside_an_obstacles_margin_drives_out_of_it() -> Result<(), Box<dyn
         );
     }
     assert!((pts[pts.len() - 1] - p(190.0, 150.0)).norm() < 1e-9);
-    // Its margin is not eased for a crawler with room outside it: from x = 10 (51.9 m away),
-    // the way round keeps the whole 35 m.
+    // Its margin is not eased for a crawler outside it: from x = 10 (51.9 m away), the way
+    // round keeps the whole 35 m; from x = 25.1 (38 m away, 2 m outside the keep-out, too near
+    // to turn away), it keeps the whole 35 m too, or finds no way and holds.
     r.t0 = 0.0;
     r.p0 = p(10.0, 150.0);
     let outside = repair(&r);
     assert!(outside.safe, "{outside:?}");
     for w in outside.trajectory.points.windows(2) {
+        assert!(
+            !segment_hits_sphere(&w[0], &w[1], &rock, 35.0),
+            "{} → {}",
+            w[0],
+            w[1]
+        );
+    }
+    r.t0 = 30.2;
+    r.p0 = p(60.0 - (38.0f64.powi(2) - 15.0f64.powi(2)).sqrt(), 150.0);
+    let near = repair(&r);
+    for w in near.trajectory.points.windows(2).filter(|_| near.safe) {
         assert!(
             !segment_hits_sphere(&w[0], &w[1], &rock, 35.0),
             "{} → {}",
