@@ -43,11 +43,11 @@ use shoal_common::trajectory::Trajectory;
 
 use super::replan::{rebase, Replanned, Request};
 
-/// Whether the leg `a`–`b` enters a hard obstacle's inflated sphere.
-fn blocked(scenario: &Scenario, a: &Vec3, b: &Vec3) -> bool {
-    scenario
-        .hard_obstacles()
-        .any(|o| segment_hits_sphere(a, b, &o.centre(), o.inflated_radius()))
+/// Whether the leg `a`–`b` enters the inflated sphere of a hard obstacle of `obstacles`.
+fn blocked(obstacles: &[Obstacle], a: &Vec3, b: &Vec3) -> bool {
+    obstacles.iter().any(|o| {
+        o.kind == ObstacleKind::Hard && segment_hits_sphere(a, b, &o.centre(), o.inflated_radius())
+    })
 }
 
 /// The rest of the tour from `p0` as points and the plan's own speed on each leg, planned in
@@ -155,7 +155,7 @@ fn repaired_path(r: &Request, scenario: &Scenario) -> Option<(Vec<Vec3>, Vec<f64
 fn blocked_runs(scenario: &Scenario, r: &Request, pts: &[Vec3]) -> Vec<(usize, usize)> {
     let hit: Vec<bool> = pts
         .windows(2)
-        .map(|w| blocked(scenario, &w[0], &w[1]))
+        .map(|w| blocked(&scenario.obstacles, &w[0], &w[1]))
         .collect();
     let room = match (scenario.coverage.is_some(), r.ground) {
         (true, Some(g)) => WAY_ROUND_MARGIN_M + 2.0 * g.min_turn_radius_m,
@@ -435,12 +435,7 @@ pub fn repair(r: &Request) -> Replanned {
     let own = &scenario.obstacles[..r.scenario.obstacles.len()];
     let hard_hits = points
         .windows(2)
-        .filter(|w| {
-            own.iter().any(|o| {
-                o.kind == ObstacleKind::Hard
-                    && segment_hits_sphere(&w[0], &w[1], &o.centre(), o.inflated_radius())
-            })
-        })
+        .filter(|w| blocked(own, &w[0], &w[1]))
         .count();
     let range = (v.speed_min_mps, v.speed_max_mps);
     let on_time = timed(points, &speeds, r.t0, r.current.arrival() - r.t0, range);

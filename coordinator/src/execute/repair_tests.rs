@@ -117,7 +117,7 @@ fn a_blocked_leg_is_gone_round_and_every_later_corner_kept(
     let r = repair(&request(&s, &plan, &[]));
     assert!(r.safe, "{r:?}");
     for w in r.trajectory.points.windows(2) {
-        assert!(!blocked(&s, &w[0], &w[1]));
+        assert!(!blocked(&s.obstacles, &w[0], &w[1]));
     }
     // The inspection corners are all still there, in order, after the detour.
     let corners = &plan.points[1..];
