@@ -115,7 +115,7 @@ pub fn run(
     let mut heard = Instant::now();
     let outcome = loop {
         if stop.load(Ordering::Relaxed) {
-            let _ = link.hold();
+            let _ = link.hold(order.clock.now());
             break "the agent is shutting down: vehicle told to hold".to_string();
         }
         let now = Instant::now();
@@ -172,7 +172,7 @@ pub fn run(
                     },
                     CoordinatorToAgent::Hold { reason, .. } => {
                         tracing::warn!("mission {}: hold: {reason}", order.mission);
-                        if let Err(e) = link.hold() {
+                        if let Err(e) = link.hold(order.clock.now()) {
                             tracing::warn!("mission {}: hold failed: {e}", order.mission);
                         }
                     }
@@ -185,7 +185,7 @@ pub fn run(
             }
             Err(RecvTimeoutError::Timeout) => {}
             Err(RecvTimeoutError::Disconnected) => {
-                let _ = link.hold();
+                let _ = link.hold(order.clock.now());
                 break "the agent is shutting down: vehicle told to hold".to_string();
             }
         }
@@ -236,7 +236,7 @@ mod tests {
                 arrived_s: None,
             })
         }
-        fn hold(&mut self) -> Result<(), LinkError> {
+        fn hold(&mut self, _now: f64) -> Result<(), LinkError> {
             self.calls
                 .lock()
                 .map_err(|e| LinkError::Io(e.to_string()))?

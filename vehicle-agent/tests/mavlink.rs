@@ -296,7 +296,7 @@ fn upload_survives_lost_messages_then_position_arrival_and_hold_come_through() -
     let s = wait_state(&mut link, |s| s.status == VehicleStatus::Arrived)?;
     assert!(s.arrived_s.is_some_and(|t| t <= 42.0));
 
-    link.hold()?;
+    link.hold(0.0)?;
     assert_eq!(link.state(43.0)?.status, VehicleStatus::Holding);
     assert_eq!(
         mock.board().commands.last(),
@@ -325,7 +325,7 @@ fn a_silent_vehicle_times_out_after_the_retries() -> TestResult {
         3,
         "the first MISSION_COUNT and two resends"
     );
-    assert!(matches!(link.hold(), Err(LinkError::Timeout(_))));
+    assert!(matches!(link.hold(0.0), Err(LinkError::Timeout(_))));
     Ok(())
 }
 

@@ -498,7 +498,7 @@ impl VehicleLink for MavlinkLink {
         })
     }
 
-    fn hold(&mut self) -> Result<(), LinkError> {
+    fn hold(&mut self, _now: f64) -> Result<(), LinkError> {
         self.pause(VehicleStatus::Holding)
     }
 

@@ -41,8 +41,10 @@ pub trait VehicleLink: Send {
     /// The vehicle's state at mission time `now` (a simulator advances to it; a real vehicle
     /// reports its latest fix, stamped `now`).
     fn state(&mut self, now: f64) -> Result<VehicleState, LinkError>;
-    /// Hold where it is until the next upload.
-    fn hold(&mut self) -> Result<(), LinkError>;
+    /// Hold where it is at mission time `now` until the next upload (a simulator first drives
+    /// on to `now`: it is advanced only when asked for its state, up to a report interval ago,
+    /// which is 250 mission seconds at 2 Hz and 500×).
+    fn hold(&mut self, now: f64) -> Result<(), LinkError>;
     /// Stop: the mission is over for this vehicle.
     fn stop(&mut self) -> Result<(), LinkError>;
 }

@@ -117,7 +117,8 @@ impl VehicleLink for SimLink {
         Ok(self.sim.state())
     }
 
-    fn hold(&mut self) -> Result<(), LinkError> {
+    fn hold(&mut self, now: f64) -> Result<(), LinkError> {
+        self.sim.advance_to(now);
         self.sim.hold();
         Ok(())
     }
@@ -171,6 +172,32 @@ mod tests {
         let late = link.state(12.0 * 3600.0).map_err(|e| e.to_string())?;
         assert_eq!(late.status, VehicleStatus::Arrived);
         assert!((late.battery - 1.0).abs() < 1e-12, "{}", late.battery);
+        Ok(())
+    }
+
+    /// A hold between two reports takes effect where the vehicle is when it comes, not where
+    /// it was at the last report: at 500× two reports at 2 Hz are 250 mission seconds apart.
+    #[test]
+    fn a_hold_between_reports_holds_where_the_vehicle_is_then() -> Result<(), String> {
+        let s = scenario("cpp-seabed.toml")?;
+        let mut link = SimLink::new(&s, 0, 0.0, 1).map_err(|e| e.to_string())?;
+        // East along y = 5 m from x = 50 at 0.5 m/s.
+        let plan = Trajectory {
+            times: vec![0.0, 1800.0],
+            points: vec![Vec3::new(50.0, 5.0, 0.0), Vec3::new(950.0, 5.0, 0.0)],
+        };
+        link.upload(&plan).map_err(|e| e.to_string())?;
+        let report = link.state(100.0).map_err(|e| e.to_string())?;
+        // Told to hold at t = 350 s, with no report since t = 100 s (x ≈ 100 m then).
+        link.hold(350.0).map_err(|e| e.to_string())?;
+        let held = link.state(600.0).map_err(|e| e.to_string())?;
+        assert_eq!(held.status, VehicleStatus::Holding);
+        assert!(
+            (held.position[0] - 225.0).abs() < 10.0,
+            "{:?}",
+            held.position
+        );
+        assert!(held.position[0] - report.position[0] > 100.0);
         Ok(())
     }
 
