@@ -111,6 +111,28 @@ pub struct Fleet {
     pub published: Vec<Vec<usize>>,
 }
 
+/// The earliest plan time in `[from, to]` (sampled every second) at which `plan` comes within
+/// [`STOP_MATCH_M`] of its closest approach there to `p`: where a vehicle that drove on along
+/// its plan from `from` stopped. The earliest, not the closest: a path that comes back near
+/// itself (a loop, the next row) passes the stop again later, where the vehicle never went.
+fn first_near(plan: &Trajectory, p: Vec3, from: f64, to: f64) -> f64 {
+    let n = (to - from).ceil().max(1.0) as usize;
+    let dist: Vec<(f64, f64)> = (0..=n)
+        .map(|k| {
+            let tau = from + (to - from) * k as f64 / n as f64;
+            (tau, (plan.position_at(tau) - p).norm())
+        })
+        .collect();
+    let closest = dist.iter().map(|d| d.1).fold(f64::INFINITY, f64::min);
+    dist.iter()
+        .find(|d| d.1 <= closest + STOP_MATCH_M)
+        .map_or(from, |d| d.0)
+}
+
+/// Slack of [`first_near`] over the closest approach, metres: a few times a vehicle's tracking
+/// error and fix noise.
+const STOP_MATCH_M: f64 = 3.0;
+
 impl Fleet {
     /// Every vehicle at the start of its plan, nothing heard yet.
     pub fn new(ids: &[String], plans: &[Trajectory], d_min: f64, horizon_s: f64) -> Fleet {
@@ -190,7 +212,7 @@ impl Fleet {
             let offset = p - v.plan.position_at(tau);
             // A vehicle told to hold stays where it is: its fixes are joined directly, not
             // along the plan it has left (which would draw it driving on, past whatever it
-            // was holding for).
+            // was holding for), but for the drive from its last fix under way to the stop.
             let held = v.holding || t.state.status == VehicleStatus::Holding;
             if let (Some((tau0, offset0, revision)), Some(&t0), Some(&q0)) =
                 (v.anchor, v.track.times.last(), v.track.points.last())
@@ -205,12 +227,28 @@ impl Fleet {
                     let tau = picture::progress(&v.plan, q0, t0, PROGRESS_WINDOW_S).plan_time_s;
                     (tau, q0 - v.plan.position_at(tau))
                 };
-                if !held {
-                    let corners = along_plan(&v.plan, (t0, tau0, offset0), (now, tau, offset));
-                    for (t, q) in corners {
-                        v.track.times.push(t);
-                        v.track.points.push(q);
-                    }
+                let was_underway = v
+                    .last
+                    .as_ref()
+                    .is_some_and(|l| l.state.status != VehicleStatus::Holding);
+                let corners = if !held {
+                    along_plan(&v.plan, (t0, tau0, offset0), (now, tau, offset))
+                } else if was_underway && now > t0 {
+                    // Told to hold since the last fix: it drove on along its plan until the
+                    // hold came (up to a report interval, 250 m for a crawler at 1000×), then
+                    // stood. The stop is matched on the plan between the two fixes' times.
+                    let stop = first_near(&v.plan, p, tau0, tau0 + (now - t0));
+                    let at = t0 + (stop - tau0);
+                    let offset_stop = p - v.plan.position_at(stop);
+                    let mut c = along_plan(&v.plan, (t0, tau0, offset0), (at, stop, offset_stop));
+                    c.push((at, p));
+                    c
+                } else {
+                    Vec::new()
+                };
+                for (t, q) in corners {
+                    v.track.times.push(t);
+                    v.track.points.push(q);
                 }
             }
             v.track.times.push(now);

@@ -335,11 +335,53 @@ fn a_holding_vehicles_fixes_are_joined_directly_not_along_its_plan() {
         f.report(report("a", 1, 236.0, [1.0, 3.0, 0.0], status), 1_002_000);
         f.vehicles[0].track.clone()
     };
+    // Held, it stopped where it was at its first fix (the plan first comes within 3 m of
+    // (1, 3) there): it stands, never out along the loop.
     let held = track_of(true);
-    assert_eq!(held.points.len(), 2, "{held:?}");
-    assert!((held.points[1] - p(1.0, 3.0)).norm() < 1e-9);
+    assert!(held.points.iter().all(|q| q.x <= 2.0 + 1e-9), "{held:?}");
+    assert!((held.points[held.points.len() - 1] - p(1.0, 3.0)).norm() < 1e-9);
     // Under way, the same fixes are joined along the plan's corners (the loop's far end).
     let driven = track_of(false);
     let far = driven.points.iter().map(|q| q.x).fold(0.0, f64::max);
     assert!(far > 90.0, "{driven:?}");
+}
+
+#[test]
+fn a_vehicle_told_to_hold_between_fixes_drove_its_plan_to_the_stop() {
+    // East 100 m then north 100 m at 1 m/s. Under way at (50, 0) at t = 50; told to hold,
+    // it reports (100, 30) holding at t = 180: it drove round the corner, stopped at t = 130.
+    let p = |x: f64, y: f64| Vec3::new(x, y, 0.0);
+    let plan = Trajectory {
+        times: vec![0.0, 100.0, 200.0],
+        points: vec![p(0.0, 0.0), p(100.0, 0.0), p(100.0, 100.0)],
+    };
+    let ids = vec!["a".to_string()];
+    let mut f = Fleet::new(&ids, std::slice::from_ref(&plan), 50.0, 60.0);
+    f.report(
+        report("a", 0, 50.0, [50.0, 0.0, 0.0], VehicleStatus::Underway),
+        1,
+    );
+    f.vehicles[0].holding = true;
+    f.report(
+        report("a", 1, 180.0, [100.0, 30.0, 0.0], VehicleStatus::Holding),
+        2,
+    );
+    // Round the corner (not the chord across it, which passes 30 m from it), at the stop by
+    // t = 130, standing after. The stop is matched where the plan first comes within 3 m of
+    // it, (100, 27), and that 3 m offset is spread over the way: the corner is drawn 2 m north.
+    let track = &f.vehicles[0].track;
+    let corner = track
+        .points
+        .iter()
+        .map(|q| (q - p(100.0, 0.0)).norm())
+        .fold(f64::INFINITY, f64::min);
+    assert!(corner < 2.5, "{track:?}");
+    assert!(
+        (track.position_at(130.0) - p(100.0, 30.0)).norm() < 1.5,
+        "{track:?}"
+    );
+    assert!(
+        (track.position_at(160.0) - p(100.0, 30.0)).norm() < 1e-9,
+        "{track:?}"
+    );
 }
