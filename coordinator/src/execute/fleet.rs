@@ -16,7 +16,9 @@ use shoal_common::stats::quantile;
 use shoal_common::trajectory::Trajectory;
 use shoal_common::wire::open::{FleetStatus, Telemetry, VehicleStatusRow, OPEN_VERSION};
 
-use super::track::{along_plan, hazard_clearance, obstacle_clearance, seabed_clearance};
+use super::track::{
+    along_plan, first_near, hazard_clearance, obstacle_clearance, seabed_clearance,
+};
 
 /// How far either side of the mission time a report's nearest plan point is searched,
 /// mission seconds (a path that passes near itself must not make progress jump).
@@ -73,7 +75,27 @@ impl Tracked {
     /// without it). `None` when it is not holding.
     pub fn resume_s(&self) -> Option<f64> {
         let since = self.held_since_s.filter(|_| self.holding)?;
-        Some(picture::progress(&self.plan, self.position(), since, PROGRESS_WINDOW_S).plan_time_s)
+        Some(picture::progress(&self.plan, self.standing(), since, PROGRESS_WINDOW_S).plan_time_s)
+    }
+
+    /// Where a vehicle told to hold stands: where its plan, followed from its latest fix, had
+    /// it when the hold was commanded, until a fix taken after that comes (then that fix). A
+    /// hold takes effect where the vehicle is when it gets it (the agent's link holds at that
+    /// mission time), up to a report interval after the latest fix: 250 mission seconds at
+    /// 2 Hz and 500×, 125 m of a crawler's path. Picturing it at its latest fix would put a
+    /// way round it where it was, not where it stopped. Not holding: its latest fix.
+    pub fn standing(&self) -> Vec3 {
+        let p = self.position();
+        let (Some(since), Some(last)) = (self.held_since_s.filter(|_| self.holding), &self.last)
+        else {
+            return p;
+        };
+        let at = last.state.t_s;
+        if last.state.status != VehicleStatus::Underway || since <= at {
+            return p;
+        }
+        let pr = picture::progress(&self.plan, p, at, PROGRESS_WINDOW_S);
+        picture::predict(&self.plan, p, &pr, at, since - at, CONVERGE_S).position_at(since)
     }
 
     /// Latest position fix, or the plan's start before any.
@@ -110,28 +132,6 @@ pub struct Fleet {
     /// when it came (see [`Fleet::obstacle_published`]).
     pub published: Vec<Vec<usize>>,
 }
-
-/// The earliest plan time in `[from, to]` (sampled every second) at which `plan` comes within
-/// [`STOP_MATCH_M`] of its closest approach there to `p`: where a vehicle that drove on along
-/// its plan from `from` stopped. The earliest, not the closest: a path that comes back near
-/// itself (a loop, the next row) passes the stop again later, where the vehicle never went.
-fn first_near(plan: &Trajectory, p: Vec3, from: f64, to: f64) -> f64 {
-    let n = (to - from).ceil().max(1.0) as usize;
-    let dist: Vec<(f64, f64)> = (0..=n)
-        .map(|k| {
-            let tau = from + (to - from) * k as f64 / n as f64;
-            (tau, (plan.position_at(tau) - p).norm())
-        })
-        .collect();
-    let closest = dist.iter().map(|d| d.1).fold(f64::INFINITY, f64::min);
-    dist.iter()
-        .find(|d| d.1 <= closest + STOP_MATCH_M)
-        .map_or(from, |d| d.0)
-}
-
-/// Slack of [`first_near`] over the closest approach, metres: a few times a vehicle's tracking
-/// error and fix noise.
-const STOP_MATCH_M: f64 = 3.0;
 
 impl Fleet {
     /// Every vehicle at the start of its plan, nothing heard yet.
@@ -285,13 +285,14 @@ impl Fleet {
 
     /// Each vehicle's predicted trajectory from `now` over `horizon_s`: along its plan from its
     /// latest fix, from the fix's time (from where its plan has it, before its first report); a
-    /// lost, holding or faulted vehicle stays where it was last seen.
+    /// lost or faulted vehicle stays where it was last seen, a holding one where it stopped
+    /// ([`Tracked::standing`]).
     pub fn predictions_over(&self, now: f64, horizon_s: f64) -> Vec<Trajectory> {
         self.vehicles
             .iter()
             .map(|v| {
                 if v.lost || v.holding || v.fault_s.is_some() {
-                    let p = v.position();
+                    let p = v.standing();
                     return Trajectory {
                         times: vec![now, now + horizon_s],
                         points: vec![p, p],

@@ -385,3 +385,43 @@ fn a_vehicle_told_to_hold_between_fixes_drove_its_plan_to_the_stop() {
         "{track:?}"
     );
 }
+
+/// A vehicle told to hold after a fix under way drove on until the hold came: it is pictured
+/// where its plan had it then (and predicted to stand there), not at that fix, until a fix
+/// taken after the hold places it. Lost, it stays at its last fix.
+#[test]
+fn a_vehicle_told_to_hold_is_pictured_where_its_plan_had_it_at_the_hold() {
+    let ids = vec!["a".to_string()];
+    let mut f = Fleet::new(&ids, &[straight(0.0)], 50.0, 60.0);
+    f.report(
+        report("a", 0, 20.0, [20.0, 0.0, 0.0], VehicleStatus::Underway),
+        1,
+    );
+    // Told to hold at t = 45 s: 25 m on along its plan at 1 m/s.
+    f.vehicles[0].holding = true;
+    f.vehicles[0].held_since_s = Some(45.0);
+    let at = f.vehicles[0].standing();
+    assert!((at - Vec3::new(45.0, 0.0, 0.0)).norm() < 1e-6, "{at:?}");
+    let p = &f.predictions(50.0)[0];
+    for t in [50.0, 80.0, 110.0] {
+        assert!((p.position_at(t) - at).norm() < 1e-9, "{t}: {p:?}");
+    }
+    let resume = f.vehicles[0].resume_s().unwrap_or(f64::NAN);
+    assert!((resume - 45.0).abs() < 1e-6, "{resume}");
+    // Its first holding fix, a little short of that, places it.
+    f.report(
+        report("a", 1, 60.0, [44.0, 0.5, 0.0], VehicleStatus::Holding),
+        2,
+    );
+    let at = f.vehicles[0].standing();
+    assert!((at - Vec3::new(44.0, 0.5, 0.0)).norm() < 1e-9, "{at:?}");
+    // A lost vehicle is not known to have driven on.
+    let mut g = Fleet::new(&ids, &[straight(0.0)], 50.0, 60.0);
+    g.report(
+        report("a", 0, 20.0, [20.0, 0.0, 0.0], VehicleStatus::Underway),
+        1,
+    );
+    g.vehicles[0].lost = true;
+    let p = &g.predictions(50.0)[0];
+    assert!((p.position_at(60.0) - Vec3::new(20.0, 0.0, 0.0)).norm() < 1e-9);
+}

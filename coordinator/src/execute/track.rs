@@ -88,6 +88,28 @@ pub(super) fn hazard_clearance(track: &Trajectory, hazards: &[Hazard]) -> Option
     Some(path_min_hazard_clearance(hazards, &xy))
 }
 
+/// The earliest plan time in `[from, to]` (sampled every second) at which `plan` comes within
+/// [`STOP_MATCH_M`] of its closest approach there to `p`: where a vehicle that drove on along
+/// its plan from `from` stopped. The earliest, not the closest: a path that comes back near
+/// itself (a loop, the next row) passes the stop again later, where the vehicle never went.
+pub fn first_near(plan: &Trajectory, p: Vec3, from: f64, to: f64) -> f64 {
+    let n = (to - from).ceil().max(1.0) as usize;
+    let dist: Vec<(f64, f64)> = (0..=n)
+        .map(|k| {
+            let tau = from + (to - from) * k as f64 / n as f64;
+            (tau, (plan.position_at(tau) - p).norm())
+        })
+        .collect();
+    let closest = dist.iter().map(|d| d.1).fold(f64::INFINITY, f64::min);
+    dist.iter()
+        .find(|d| d.1 <= closest + STOP_MATCH_M)
+        .map_or(from, |d| d.0)
+}
+
+/// Slack of [`first_near`] over the closest approach, metres: a few times a vehicle's tracking
+/// error and fix noise.
+const STOP_MATCH_M: f64 = 3.0;
+
 #[cfg(test)]
 mod tests {
     use super::*;
