@@ -13,6 +13,7 @@ pub mod log;
 mod react;
 mod repair;
 pub mod replan;
+mod standing;
 mod track;
 pub mod verdict;
 
@@ -91,6 +92,8 @@ pub(crate) struct Exec<'a> {
     last_reaction: Vec<Option<Instant>>,
     /// Per vehicle: failed replans since it was told to hold (each retry doubles the budget).
     hold_retries: Vec<u32>,
+    /// (crawler, standing vehicle): repaired for this stand of it (see [`standing`]).
+    rounded: Vec<(usize, usize)>,
     /// Per vehicle: the revision sent and when, to time its delivery.
     pending: Vec<Option<(u32, Instant)>>,
     /// Delivery times of updates (decision → first report on the new revision), ms.
@@ -281,6 +284,7 @@ pub fn execute_trajectories(
         holds: 0,
         last_reaction: vec![None; ids.len()],
         hold_retries: vec![0; ids.len()],
+        rounded: Vec::new(),
         pending: vec![None; ids.len()],
         deliveries_ms: Vec::new(),
         decisions_ms: Vec::new(),
@@ -391,6 +395,7 @@ fn run_loop(
         if tick.elapsed() >= Duration::from_millis(100) {
             tick = Instant::now();
             react::check(x, now);
+            standing::check(x, now);
         }
         if publish.elapsed() >= Duration::from_secs(1) {
             publish = Instant::now();

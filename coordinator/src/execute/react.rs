@@ -199,15 +199,8 @@ fn remaining_hits(
     p: Vec3,
     o: &Obstacle,
 ) -> bool {
-    let mut pts = vec![p];
-    pts.extend(
-        plan.times
-            .iter()
-            .zip(&plan.points)
-            .filter(|(t, _)| **t > from)
-            .map(|(_, q)| *q),
-    );
-    pts.windows(2)
+    super::standing::rest_of(plan, from, p)
+        .windows(2)
         .any(|w| segment_hits_sphere(&w[0], &w[1], &o.centre(), o.inflated_radius()))
 }
 
