@@ -11,6 +11,19 @@ fn straight(y: f64) -> Trajectory {
     }
 }
 
+/// A point at sea level.
+fn p(x: f64, y: f64) -> Vec3 {
+    Vec3::new(x, y, 0.0)
+}
+
+/// East 100 m then north 100 m, at 1 m/s.
+fn corner() -> Trajectory {
+    Trajectory {
+        times: vec![0.0, 100.0, 200.0],
+        points: vec![p(0.0, 0.0), p(100.0, 0.0), p(100.0, 100.0)],
+    }
+}
+
 fn report(vehicle: &str, seq: u64, t: f64, p: [f64; 3], status: VehicleStatus) -> Telemetry {
     Telemetry {
         version: OPEN_VERSION,
@@ -36,11 +49,7 @@ fn report(vehicle: &str, seq: u64, t: f64, p: [f64; 3], status: VehicleStatus) -
 #[test]
 fn between_two_fixes_the_track_follows_the_plan_round_its_corners() {
     // East 100 m then north 100 m at 1 m/s; an obstacle of 10 m inside the corner.
-    let p = |x: f64, y: f64| Vec3::new(x, y, 0.0);
-    let plan = Trajectory {
-        times: vec![0.0, 100.0, 200.0],
-        points: vec![p(0.0, 0.0), p(100.0, 0.0), p(100.0, 100.0)],
-    };
+    let plan = corner();
     let ids = vec!["a".to_string()];
     let mut f = Fleet::new(&ids, std::slice::from_ref(&plan), 50.0, 60.0);
     // Fixes 2 m left of the plan at t = 50 and 2 m short of it at t = 150.
@@ -306,7 +315,6 @@ fn an_obstacle_published_mid_run_is_measured_on_the_track_from_then_on() {
 #[test]
 fn a_holding_vehicles_fixes_are_joined_directly_not_along_its_plan() {
     // Out along y = 0 to (100, 0), up to (100, 20), back to (0, 20) and down to (0, 2).
-    let p = |x: f64, y: f64| Vec3::new(x, y, 0.0);
     let plan = Trajectory {
         times: vec![0.0, 100.0, 120.0, 220.0, 238.0],
         points: vec![
@@ -350,11 +358,7 @@ fn a_holding_vehicles_fixes_are_joined_directly_not_along_its_plan() {
 fn a_vehicle_told_to_hold_between_fixes_drove_its_plan_to_the_stop() {
     // East 100 m then north 100 m at 1 m/s. Under way at (50, 0) at t = 50; told to hold,
     // it reports (100, 30) holding at t = 180: it drove round the corner, stopped at t = 130.
-    let p = |x: f64, y: f64| Vec3::new(x, y, 0.0);
-    let plan = Trajectory {
-        times: vec![0.0, 100.0, 200.0],
-        points: vec![p(0.0, 0.0), p(100.0, 0.0), p(100.0, 100.0)],
-    };
+    let plan = corner();
     let ids = vec!["a".to_string()];
     let mut f = Fleet::new(&ids, std::slice::from_ref(&plan), 50.0, 60.0);
     f.report(
