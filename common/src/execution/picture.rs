@@ -90,6 +90,27 @@ fn on_segment(plan: &Trajectory, k: usize, p: &Vec3, now: f64, along0: f64) -> N
 /// A plan of one sample is a point held from its time on; an empty plan is held at the origin,
 /// as [`Trajectory::position_at`] reads it. A negative or NaN window counts as 0.
 pub fn progress(plan: &Trajectory, position: Vec3, now: f64, window_s: f64) -> Progress {
+    progress_near(plan, position, now, window_s, now, 0.0)
+}
+
+/// [`progress`] for a vehicle whose plan time is expected near `expected_s` (where its previous
+/// fix put it, carried on by the time since): where the plan passes the vehicle more than
+/// once within `slack_m` of the nearest pass (out round an obstacle and back by the same way,
+/// a loop), the pass whose nearest point's plan time is closest to `expected_s` is taken, not
+/// the one a metre nearer. Tracking error decides between such passes by chance: a crawler
+/// 3 m off track on its way back can be nearer its way out, and a fix matched there jumps
+/// hundreds of seconds back along the plan. A pass is a run of consecutive segments within the
+/// slack, and within a pass the nearest point is taken, so along-track progress is as exact as
+/// [`progress`]'s. A slack of 0 (or negative, or NaN) is [`progress`] with ties broken by
+/// `expected_s`.
+pub fn progress_near(
+    plan: &Trajectory,
+    position: Vec3,
+    now: f64,
+    window_s: f64,
+    expected_s: f64,
+    slack_m: f64,
+) -> Progress {
     let n = samples(plan);
     let arrival = if n > 0 { plan.times[n - 1] } else { 0.0 };
     let mut starts = Vec::with_capacity(n);
@@ -104,20 +125,43 @@ pub fn progress(plan: &Trajectory, position: Vec3, now: f64, window_s: f64) -> P
     if segs.is_empty() {
         segs = (0..starts.len()).collect();
     }
-    let mut best: Option<Nearest> = None;
-    for k in segs {
-        let c = on_segment(plan, k, &position, now, starts[k]);
-        best = match best {
-            None => Some(c),
-            Some(b) => {
+    let found: Vec<(usize, Nearest)> = segs
+        .into_iter()
+        .map(|k| (k, on_segment(plan, k, &position, now, starts[k])))
+        .collect();
+    let nearest_dist = found.iter().map(|c| c.1.dist).fold(f64::INFINITY, f64::min);
+    let slack = if slack_m > 0.0 { slack_m } else { 0.0 };
+    let reach = nearest_dist + slack + 1e-9 * (1.0 + nearest_dist);
+    // The nearest point of each pass (a run of consecutive segments within reach; a NaN
+    // distance, from a NaN fix, is let through so that a fix is always placed somewhere).
+    let mut passes: Vec<Nearest> = Vec::new();
+    let mut previous: Option<usize> = None;
+    for (k, c) in found
+        .into_iter()
+        .filter(|c| c.1.dist <= reach || c.1.dist.is_nan())
+    {
+        let same_pass = previous.is_some_and(|p| p + 1 == k);
+        previous = Some(k);
+        match passes.last_mut() {
+            Some(b) if same_pass => {
                 let tol = 1e-9 * (1.0 + b.dist);
                 let nearer = c.dist < b.dist - tol;
                 let tie = (c.dist - b.dist).abs() <= tol
-                    && (c.plan_time - now).abs() < (b.plan_time - now).abs();
-                Some(if nearer || tie { c } else { b })
+                    && (c.plan_time - expected_s).abs() < (b.plan_time - expected_s).abs();
+                if nearer || tie {
+                    *b = c;
+                }
             }
-        };
+            _ => passes.push(c),
+        }
     }
+    let best = passes.into_iter().reduce(|b, c| {
+        if (c.plan_time - expected_s).abs() < (b.plan_time - expected_s).abs() {
+            c
+        } else {
+            b
+        }
+    });
     let nearest = best.unwrap_or_else(|| {
         // No segment: the plan is a single held point (or nothing, read as the origin).
         let point = plan.points.first().copied().unwrap_or_else(Vec3::zeros);
@@ -355,6 +399,45 @@ mod tests {
         // Without a window in reach the nearest leg of all wins.
         let far = progress(&plan, pos, 1000.0, 30.0);
         assert_abs_diff_eq!(far.plan_time_s, 50.0, epsilon = 1e-9);
+    }
+
+    #[test]
+    fn a_pass_by_the_same_point_is_chosen_by_the_expected_time() {
+        // Out along y = 0 over 0..100, round a corner 5 m wide, back along y = 3 over 110..210:
+        // (50, 1) is 1 m from the way out (plan time 50) and 2 m from the way back (160).
+        let plan = traj(&[
+            (0.0, [0., 0., 0.]),
+            (100.0, [100., 0., 0.]),
+            (105.0, [100., 3., 0.]),
+            (110.0, [100., 3., 0.]),
+            (210.0, [0., 3., 0.]),
+        ]);
+        let pos = Vec3::new(50., 1., 0.);
+        // Both passes in the window: the nearest wins without a slack.
+        let nearest = progress(&plan, pos, 120.0, 300.0);
+        assert_abs_diff_eq!(nearest.plan_time_s, 50.0, epsilon = 1e-9);
+        // Expected at 158 (the previous fix carried on): the way back, 1 m farther.
+        let back = progress_near(&plan, pos, 120.0, 300.0, 158.0, 5.0);
+        assert_abs_diff_eq!(back.plan_time_s, 160.0, epsilon = 1e-9);
+        assert_abs_diff_eq!(back.cross_track_m, 2.0, epsilon = 1e-9);
+        assert_abs_diff_eq!(back.along_m, 100.0 + 3.0 + 50.0, epsilon = 1e-9);
+        assert_abs_diff_eq!(back.lag_s, -40.0, epsilon = 1e-9);
+        // Expected on the way out: the way out.
+        let out = progress_near(&plan, pos, 120.0, 300.0, 45.0, 5.0);
+        assert_abs_diff_eq!(out.plan_time_s, 50.0, epsilon = 1e-9);
+        // A slack under the 1 m between the passes keeps the nearest.
+        let tight = progress_near(&plan, pos, 120.0, 300.0, 158.0, 0.5);
+        assert_abs_diff_eq!(tight.plan_time_s, 50.0, epsilon = 1e-9);
+        // Within one pass the nearest point is kept, however far the expected time: no pull
+        // along the track towards it.
+        // (48, 2) is 2 m from the first segment at 48 and 2.83 m from the second at its start.
+        let line = traj(&[
+            (0.0, [0., 0., 0.]),
+            (50.0, [50., 0., 0.]),
+            (100.0, [100., 0., 0.]),
+        ]);
+        let on_line = progress_near(&line, Vec3::new(48., 2., 0.), 48.0, 300.0, 90.0, 5.0);
+        assert_abs_diff_eq!(on_line.plan_time_s, 48.0, epsilon = 1e-9);
     }
 
     #[test]

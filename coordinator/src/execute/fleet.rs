@@ -7,7 +7,7 @@
 use std::time::Instant;
 
 use serde::{Deserialize, Serialize};
-use shoal_common::execution::picture::{self, Conflict, Progress};
+use shoal_common::execution::picture::{self, Conflict};
 use shoal_common::execution::VehicleStatus;
 use shoal_common::geometry::Vec3;
 use shoal_common::scenario::{Obstacle, Scenario, VehicleKind};
@@ -19,98 +19,8 @@ use shoal_common::wire::open::{FleetStatus, Telemetry, VehicleStatusRow, OPEN_VE
 use super::track::{
     along_plan, first_near, hazard_clearance, obstacle_clearance, seabed_clearance,
 };
-
-/// How far either side of the mission time a report's nearest plan point is searched,
-/// mission seconds (a path that passes near itself must not make progress jump).
-const PROGRESS_WINDOW_S: f64 = 300.0;
-/// Seconds over which a prediction closes the vehicle's cross-track offset.
-const CONVERGE_S: f64 = 60.0;
-
-/// One vehicle as the coordinator sees it.
-#[derive(Debug, Clone)]
-pub struct Tracked {
-    /// Vehicle id.
-    pub id: String,
-    /// The trajectory it follows (mission-timed).
-    pub plan: Trajectory,
-    /// Revision of `plan`.
-    pub revision: u32,
-    /// Its latest report.
-    pub last: Option<Telemetry>,
-    /// When that report came (wall).
-    pub heard: Option<Instant>,
-    /// Where the latest report puts it on its plan.
-    pub progress: Option<Progress>,
-    /// Executed track: every reported fix and, between two fixes, the corners of the plan at
-    /// the later one shifted by the fixes' offsets from it (the earlier fix placed on that plan
-    /// when the vehicle was replanned in between; fixes of a holding vehicle are joined
-    /// directly): [`Fleet::report`].
-    pub track: Trajectory,
-    /// Fixes in `track`.
-    pub fixes: usize,
-    /// The last fix in `track`: its plan time, its offset from the plan there, the plan's
-    /// revision.
-    anchor: Option<(f64, Vec3, u32)>,
-    /// Cross-track error of every report, metres.
-    pub cross_track: Vec<f64>,
-    /// Mission time of its first `arrived` report.
-    pub arrived_s: Option<f64>,
-    /// When its first plan has it arrive, mission seconds: its arrival window is around this
-    /// (the common arrival of a synchronised fleet; a coverage crawler's own finish).
-    pub planned_arrival_s: f64,
-    /// Declared lost (silent too long).
-    pub lost: bool,
-    /// Commanded to hold.
-    pub holding: bool,
-    /// When the hold was commanded, mission seconds (`None` unless holding).
-    pub held_since_s: Option<f64>,
-    /// Since when its link reports a fault (its latest report does), mission seconds: it is
-    /// not driven any more, so it is neither re-planned nor waited for.
-    pub fault_s: Option<f64>,
-}
-
-impl Tracked {
-    /// Where on its plan a holding vehicle stopped, as a plan time: the nearest point of the
-    /// plan to where it is, searched around the time it was told to hold (its plan went on
-    /// without it). `None` when it is not holding.
-    pub fn resume_s(&self) -> Option<f64> {
-        let since = self.held_since_s.filter(|_| self.holding)?;
-        Some(picture::progress(&self.plan, self.standing(), since, PROGRESS_WINDOW_S).plan_time_s)
-    }
-
-    /// Where a vehicle told to hold stands: where its plan, followed from its latest fix, had
-    /// it when the hold was commanded, until a fix taken after that comes (then that fix). A
-    /// hold takes effect where the vehicle is when it gets it (the agent's link holds at that
-    /// mission time), up to a report interval after the latest fix: 250 mission seconds at
-    /// 2 Hz and 500×, 125 m of a crawler's path. Picturing it at its latest fix would put a
-    /// way round it where it was, not where it stopped. Not holding: its latest fix.
-    pub fn standing(&self) -> Vec3 {
-        let p = self.position();
-        let (Some(since), Some(last)) = (self.held_since_s.filter(|_| self.holding), &self.last)
-        else {
-            return p;
-        };
-        let at = last.state.t_s;
-        if last.state.status != VehicleStatus::Underway || since <= at {
-            return p;
-        }
-        let pr = picture::progress(&self.plan, p, at, PROGRESS_WINDOW_S);
-        picture::predict(&self.plan, p, &pr, at, since - at, CONVERGE_S).position_at(since)
-    }
-
-    /// Latest position fix, or the plan's start before any.
-    pub fn position(&self) -> Vec3 {
-        match &self.last {
-            Some(t) => Vec3::from(t.state.position),
-            None => self
-                .plan
-                .points
-                .first()
-                .copied()
-                .unwrap_or_else(Vec3::zeros),
-        }
-    }
-}
+pub use super::tracked::Tracked;
+use super::tracked::{CONVERGE_S, MATCH_SLACK_M, PROGRESS_WINDOW_S};
 
 /// The fleet.
 #[derive(Debug, Clone)]
@@ -147,6 +57,7 @@ impl Fleet {
                     last: None,
                     heard: None,
                     progress: None,
+                    progress_revision: 0,
                     track: Trajectory {
                         times: Vec::new(),
                         points: Vec::new(),
@@ -200,13 +111,50 @@ impl Fleet {
         self.reports += 1;
         let p = Vec3::from(t.state.position);
         let now = t.state.t_s;
-        let progress = picture::progress(&v.plan, p, now, PROGRESS_WINDOW_S);
+        let was_underway = v
+            .last
+            .as_ref()
+            .is_some_and(|l| l.state.status != VehicleStatus::Holding);
+        // The last fix in the track, on the current plan: when the vehicle was replanned since,
+        // that fix is placed on the new plan (which keeps the old one up to the replan, so near
+        // the plan time it had). Fixes are 250 m apart for a crawler at 1000×.
+        let anchored = match (v.anchor, v.track.times.last(), v.track.points.last()) {
+            (Some((tau0, offset0, revision)), Some(&t0), Some(&q0)) => {
+                Some(if revision == v.revision {
+                    (t0, tau0, offset0)
+                } else {
+                    let tau = picture::progress_near(
+                        &v.plan,
+                        q0,
+                        t0,
+                        PROGRESS_WINDOW_S,
+                        tau0,
+                        MATCH_SLACK_M,
+                    )
+                    .plan_time_s;
+                    (t0, tau, q0 - v.plan.position_at(tau))
+                })
+            }
+            _ => None,
+        };
+        // This fix is expected where the last one, carried on at planned pace (or standing, for
+        // a vehicle already holding then), has it: of two passes of a path by the same point,
+        // that picks the one it is on.
+        let (expected, slack) = match anchored {
+            Some((t0, tau0, _)) if now >= t0 => {
+                let driven = if was_underway { now - t0 } else { 0.0 };
+                (tau0 + driven, MATCH_SLACK_M)
+            }
+            _ => (now, 0.0),
+        };
+        let progress = picture::progress_near(&v.plan, p, now, PROGRESS_WINDOW_S, expected, slack);
         // A vehicle told to hold is off its plan by command: its distance from it is no
         // tracking error.
         if !v.holding {
             v.cross_track.push(progress.cross_track_m);
         }
         v.progress = Some(progress);
+        v.progress_revision = v.revision;
         if v.track.times.last().is_none_or(|&last| now >= last) {
             let tau = progress.plan_time_s;
             let offset = p - v.plan.position_at(tau);
@@ -214,23 +162,9 @@ impl Fleet {
             // along the plan it has left (which would draw it driving on, past whatever it
             // was holding for), but for the drive from its last fix under way to the stop.
             let held = v.holding || t.state.status == VehicleStatus::Holding;
-            if let (Some((tau0, offset0, revision)), Some(&t0), Some(&q0)) =
-                (v.anchor, v.track.times.last(), v.track.points.last())
-            {
-                // Replanned since the last fix: that fix is placed on the new plan (which keeps
-                // the old one up to the replan), so the track between follows the plan the
-                // vehicle was switching to rather than a chord across whatever lies between
-                // (fixes are 250 m apart for a crawler at 1000×).
-                let (tau0, offset0) = if revision == v.revision {
-                    (tau0, offset0)
-                } else {
-                    let tau = picture::progress(&v.plan, q0, t0, PROGRESS_WINDOW_S).plan_time_s;
-                    (tau, q0 - v.plan.position_at(tau))
-                };
-                let was_underway = v
-                    .last
-                    .as_ref()
-                    .is_some_and(|l| l.state.status != VehicleStatus::Holding);
+            // Replanned since the last fix, the track between follows the plan the vehicle was
+            // switching to rather than a chord across whatever lies between.
+            if let Some((t0, tau0, offset0)) = anchored {
                 let corners = if !held {
                     along_plan(&v.plan, (t0, tau0, offset0), (now, tau, offset))
                 } else if was_underway && now > t0 {
@@ -305,7 +239,10 @@ impl Fleet {
                     Some(t) => (v.position(), t.state.t_s.min(now)),
                     None => (v.plan.position_at(now), now),
                 };
-                let pr = picture::progress(&v.plan, p, at, PROGRESS_WINDOW_S);
+                let pr = match v.fix_progress() {
+                    Some(pr) if v.last.as_ref().is_some_and(|t| t.state.t_s <= now) => pr,
+                    _ => picture::progress(&v.plan, p, at, PROGRESS_WINDOW_S),
+                };
                 picture::predict(&v.plan, p, &pr, at, horizon_s + (now - at), CONVERGE_S).since(now)
             })
             .collect()

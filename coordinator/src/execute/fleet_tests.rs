@@ -429,3 +429,36 @@ fn a_vehicle_told_to_hold_is_pictured_where_its_plan_had_it_at_the_hold() {
     let p = &g.predictions(50.0)[0];
     assert!((p.position_at(60.0) - Vec3::new(20.0, 0.0, 0.0)).norm() < 1e-9);
 }
+
+#[test]
+fn a_fix_on_the_way_back_by_the_same_point_is_placed_on_the_way_back() {
+    // East 100 m along y = 0, 3 m north, back west along y = 3, at 1 m/s: the way out and the
+    // way back pass every point 3 m apart, both well inside the 300 s search window.
+    let plan = Trajectory {
+        times: vec![0.0, 100.0, 103.0, 203.0],
+        points: vec![p(0.0, 0.0), p(100.0, 0.0), p(100.0, 3.0), p(0.0, 3.0)],
+    };
+    let ids = vec!["a".to_string()];
+    let mut f = Fleet::new(&ids, std::slice::from_ref(&plan), 50.0, 60.0);
+    f.report(
+        report("a", 0, 60.0, [60.0, 0.5, 0.0], VehicleStatus::Underway),
+        1,
+    );
+    // On its way back, 2 m south of it at x = 53: 1 m from the way out (plan time 53), 2 m
+    // from the way back (150), where the first fix carried on for 90 s has it.
+    f.report(
+        report("a", 1, 150.0, [53.0, 1.0, 0.0], VehicleStatus::Underway),
+        1,
+    );
+    let v = &f.vehicles[0];
+    let pr = v.progress.unwrap_or_else(|| panic!("no progress"));
+    assert!((pr.plan_time_s - 150.0).abs() < 1e-9, "{pr:?}");
+    assert!((pr.cross_track_m - 2.0).abs() < 1e-9, "{pr:?}");
+    // So the track goes round the end at x = 100 instead of a chord from x = 60 back to 53.
+    let east = v.track.points.iter().map(|q| q.x).fold(f64::MIN, f64::max);
+    assert!((east - 100.0).abs() < 1e-9, "{:?}", v.track.points);
+    assert_eq!(v.track.points.len(), 4);
+    // Its prediction goes on west along the way back.
+    let ahead = f.predictions_over(150.0, 10.0)[0].position_at(160.0);
+    assert!(ahead.x < 53.0, "{ahead:?}");
+}

@@ -15,6 +15,7 @@ mod repair;
 pub mod replan;
 mod standing;
 mod track;
+mod tracked;
 pub mod verdict;
 
 use std::path::PathBuf;
