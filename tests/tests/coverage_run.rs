@@ -212,3 +212,34 @@ fn a_crawler_goes_round_a_crawler_held_near_its_path() -> TestResult {
     fleet.passed();
     Ok(())
 }
+
+#[test]
+fn a_crawler_caught_inside_an_obstacles_margin_is_let_out() -> TestResult {
+    let mut fleet = Fleet::new();
+    let file = small_fleet(fleet.dir(), &|t| t)?;
+    let out = fleet.dir().join("out");
+    // At t = 2000 s crawler2 drives west along y ≈ 200 m; a 3 m obstacle (53 m inflated by its
+    // 50 m margin) dropped at (240, 210) is on its course: it is told to hold at once and stops
+    // about 30 m from the centre, 23 m inside the margin. A way round cannot start inside a
+    // keep-out: before the margin was eased for a crawler inside it, it held to the end.
+    let c = fleet.spawn(
+        "coordinator",
+        run(&file, &out, &["--inject-obstacle=2000:240,210,0,3"]),
+    );
+    let r = fleet.wait(c, Instant::now() + LIMIT);
+    assert_eq!(r.code(), Some(0), "{}\n{}", r.stdout, r.stderr);
+    let report = read_json(&out.join("execution.json"))?;
+    let f = &report["figures"];
+    assert!(number(&report, "holds") >= 1.0, "{report}");
+    let c2 = &f["vehicles"][1];
+    assert_eq!(c2["vehicle"], "crawler2");
+    assert!(number(c2, "revision") >= 1.0, "{c2}");
+    // Out of the margin it was caught in, never into the obstacle's body.
+    let clearance = number(c2, "min_obstacle_clearance_m");
+    assert!(clearance > 5.0 && clearance < 45.0, "{c2}");
+    assert_eq!(number(c2, "impassable_m"), 0.0, "{c2}");
+    assert_eq!(f["all_arrived_in_window"], Value::Bool(true), "{f}");
+    assert!(number(f, "min_separation_m") >= 50.0, "{f}");
+    fleet.passed();
+    Ok(())
+}
