@@ -29,7 +29,8 @@ pub struct RunArgs {
     /// Telemetry reports per wall second and vehicle.
     #[arg(long, env = "SHOAL_TELEMETRY_HZ", default_value_t = 2.0)]
     pub telemetry_hz: f64,
-    /// Prediction horizon of the separation check, mission seconds.
+    /// Prediction horizon of the separation check, mission seconds, counted from when a
+    /// replan's update could take effect (the replan budget plus 250 ms of wall time ahead).
     #[arg(long, env = "SHOAL_HORIZON", default_value_t = 180.0)]
     pub horizon: f64,
     /// Cross-track error that triggers a replan, metres (default: d_min / 2; 10 m for a lone

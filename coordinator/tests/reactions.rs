@@ -46,18 +46,28 @@ fn steady(points: &[[f64; 3]], speed: f64) -> Trajectory {
     Trajectory { times, points }
 }
 
+/// The report and the log's events of an execution.
+type Executed = Result<(ExecutionReport, Vec<Value>), Box<dyn std::error::Error>>;
+
 /// Executes `plans` with one agent per vehicle at 40× real time; the report and the log's
 /// events.
-fn execute(
+fn execute(s: &Scenario, plans: &[Trajectory], deviation_m: f64, dir: &Path) -> Executed {
+    execute_with(s, plans, deviation_m, dir, &|_| {})
+}
+
+/// [`execute`] with the settings changed by `edit`.
+fn execute_with(
     s: &Scenario,
     plans: &[Trajectory],
     deviation_m: f64,
     dir: &Path,
-) -> Result<(ExecutionReport, Vec<Value>), Box<dyn std::error::Error>> {
+    edit: &dyn Fn(&mut ExecOptions),
+) -> Executed {
     let endpoint = free_endpoint()?;
     let agents: Vec<_> = s.vehicles.iter().map(|v| agent(&v.id, &endpoint)).collect();
     let arrival = plans.iter().map(Trajectory::arrival).fold(0.0, f64::max);
-    let (distributed, options) = settings(s, &endpoint, deviation_m, dir);
+    let (distributed, mut options) = settings(s, &endpoint, deviation_m, dir);
+    edit(&mut options);
     let stop = AtomicBool::new(false);
     let report = execute_trajectories(s, plans, arrival, &distributed, &options, &stop)?;
     finish(agents)?;
@@ -166,9 +176,10 @@ fn a_predicted_conflict_replans_the_later_vehicle_and_separation_holds() -> Test
     let f = &report.figures;
     let conflicts = events(&log, "conflict_predicted", "auv1");
     assert!(!conflicts.is_empty(), "no conflict predicted: {log:?}");
-    // Seen ahead of time: the 180 s horizon sees the meeting from t ≈ 420 s.
+    // Seen ahead of time: they come within d_min from t ≈ 576 s, which the 180 s horizon past
+    // the 50 s update lead sees from t ≈ 346 s.
     let first = conflicts[0]["t_s"].as_f64().ok_or("no t_s")?;
-    assert!((380.0..600.0).contains(&first), "predicted at {first} s");
+    assert!((330.0..600.0).contains(&first), "predicted at {first} s");
     // The later vehicle in scenario order gives way; the first keeps its plan.
     let replans = events(&log, "replanned", "auv2");
     assert!(!replans.is_empty(), "auv2 not replanned: {log:?}");
@@ -186,6 +197,76 @@ fn a_predicted_conflict_replans_the_later_vehicle_and_separation_holds() -> Test
     assert!(d >= 50.0, "executed separation {d} m: {f:?}");
     assert!(f.all_arrived_in_window, "{f:?}\n{log:#?}");
     assert_eq!(report.holds, 0);
+    Ok(())
+}
+
+#[test]
+fn at_500x_a_predicted_conflict_is_seen_in_time_to_replan_rather_than_hold() -> TestResult {
+    // The crossing above at 500×: an update takes effect (0.3 s + 0.25 s) × 500 = 275 mission
+    // seconds after the replan starts. Within the bare 180 s horizon the meeting (closer than
+    // d_min from t ≈ 576 s) was seen from t ≈ 396 s, too late for any update: the vehicle had
+    // to hold. Looked for 180 s past the lead, it is seen from t ≈ 121 s, and re-timed.
+    let s = scenario(&[
+        ("auv1", [100.0, 1000.0, 200.0], [1900.0, 1000.0, 200.0]),
+        ("auv2", [1000.0, 100.0, 200.0], [1000.0, 1900.0, 200.0]),
+    ])?;
+    let plans: Vec<Trajectory> = s
+        .vehicles
+        .iter()
+        .map(|v| steady(&[v.start, v.goal], 1.5))
+        .collect();
+    let dir = tempfile::tempdir()?;
+    let (report, log) = execute_with(&s, &plans, 25.0, dir.path(), &|o| {
+        o.time_scale = 500.0;
+        o.replan_budget = Duration::from_millis(300);
+    })?;
+    let f = &report.figures;
+    let conflicts = events(&log, "conflict_predicted", "auv1");
+    let first = conflicts
+        .first()
+        .and_then(|c| c["t_s"].as_f64())
+        .ok_or("no conflict predicted")?;
+    assert!(first < 576.0 - 275.0, "predicted at {first} s: {log:?}");
+    let replans = events(&log, "replanned", "auv2");
+    assert!(!replans.is_empty(), "auv2 not replanned: {log:?}");
+    assert_eq!(report.holds, 0, "{log:?}");
+    let d = f.min_separation_m.ok_or("no separation figure")?;
+    assert!(d >= 50.0, "executed separation {d} m: {f:?}");
+    assert!(f.all_arrived_in_window, "{f:?}\n{log:#?}");
+    Ok(())
+}
+
+#[test]
+fn a_conflict_nearer_than_the_update_lead_is_met_by_a_hold() -> TestResult {
+    // The crossing above at 500× with a 1 s replan budget: an update takes effect
+    // (1 s + 0.25 s) × 500 = 625 mission seconds after the replan starts, past the meeting at
+    // t ≈ 576–624 s. A replan from there reported the separation after the meeting (930 m)
+    // and the vehicles met 0.7 m apart; now the vehicle that gives way holds at once.
+    let s = scenario(&[
+        ("auv1", [100.0, 1000.0, 200.0], [1900.0, 1000.0, 200.0]),
+        ("auv2", [1000.0, 100.0, 200.0], [1000.0, 1900.0, 200.0]),
+    ])?;
+    let plans: Vec<Trajectory> = s
+        .vehicles
+        .iter()
+        .map(|v| steady(&[v.start, v.goal], 1.5))
+        .collect();
+    let dir = tempfile::tempdir()?;
+    let (report, log) = execute_with(&s, &plans, 25.0, dir.path(), &|o| {
+        o.time_scale = 500.0;
+        o.replan_budget = Duration::from_secs(1);
+    })?;
+    let holds = events(&log, "hold", "auv2");
+    let hold = holds.first().ok_or("auv2 not told to hold")?;
+    assert!(
+        hold["detail"]
+            .as_str()
+            .is_some_and(|d| d.contains("its course comes") && d.contains("from auv1")),
+        "{hold}"
+    );
+    assert!(events(&log, "hold", "auv1").is_empty(), "{log:?}");
+    let d = report.figures.min_separation_m.ok_or("no separation")?;
+    assert!(d >= 50.0, "executed separation {d} m: {log:?}");
     Ok(())
 }
 

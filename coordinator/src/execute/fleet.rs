@@ -250,7 +250,12 @@ impl Fleet {
 
     /// Pairs predicted to come closer than d_min over the horizon, closest first.
     pub fn conflicts(&self, now: f64) -> Vec<Conflict> {
-        picture::predicted_conflicts(&self.predictions(now), self.d_min)
+        self.conflicts_over(now, self.horizon_s)
+    }
+
+    /// Pairs predicted to come closer than d_min over the next `horizon_s`, closest first.
+    pub fn conflicts_over(&self, now: f64, horizon_s: f64) -> Vec<Conflict> {
+        picture::predicted_conflicts(&self.predictions_over(now, horizon_s), self.d_min)
     }
 
     /// The live picture at mission time `now`.

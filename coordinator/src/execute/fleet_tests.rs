@@ -191,6 +191,29 @@ fn a_vehicle_predicted_into_a_lost_one_is_a_conflict() {
 }
 
 #[test]
+fn a_conflict_beyond_the_horizon_is_found_over_a_longer_one() {
+    // Head-on along y = 0 at 1 m/s each, 600 m apart at t = 0: they meet at t = 300 s.
+    let ids = vec!["a".to_string(), "b".to_string()];
+    let west = Trajectory {
+        times: vec![0.0, 600.0],
+        points: vec![p(600.0, 0.0), p(0.0, 0.0)],
+    };
+    let east = Trajectory {
+        times: vec![0.0, 600.0],
+        points: vec![p(0.0, 0.0), p(600.0, 0.0)],
+    };
+    let f = Fleet::new(&ids, &[east, west], 50.0, 180.0);
+    // Within 180 s they close to 600 − 2·180 = 240 m: nothing.
+    assert!(f.conflicts(0.0).is_empty());
+    assert!(f.conflicts_over(0.0, 180.0).is_empty());
+    // Within 455 s they meet, at t = 300.
+    let c = f.conflicts_over(0.0, 455.0);
+    assert_eq!(c.len(), 1, "{c:?}");
+    assert!(c[0].min_distance_m.abs() < 1e-6, "{c:?}");
+    assert!((c[0].at_s - 300.0).abs() < 1e-6, "{c:?}");
+}
+
+#[test]
 fn a_prediction_starts_from_the_fix_carried_forward_to_now() {
     let ids = vec!["a".to_string()];
     let mut f = Fleet::new(&ids, &[straight(0.0)], 50.0, 60.0);

@@ -9,6 +9,7 @@
 mod detour;
 pub mod fleet;
 mod ground;
+mod lead;
 pub mod log;
 mod react;
 mod repair;
@@ -46,7 +47,8 @@ pub struct ExecOptions {
     pub time_scale: f64,
     /// Telemetry reports per wall second and vehicle.
     pub telemetry_hz: f64,
-    /// How far ahead separation is predicted, mission seconds.
+    /// How far ahead separation is predicted for the live status, mission seconds; conflicts
+    /// are looked for this far past the update lead (`react::conflict_horizon_s`).
     pub horizon_s: f64,
     /// Cross-track error beyond which a vehicle is replanned, metres.
     pub deviation_m: f64,

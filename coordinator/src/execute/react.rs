@@ -11,13 +11,13 @@
 use std::time::{Duration, Instant};
 
 use shoal_common::geometry::{segment_hits_sphere, Vec3};
-use shoal_common::scenario::{Obstacle, ObstacleKind, Scenario};
-use shoal_common::trajectory::Trajectory;
+use shoal_common::scenario::{Obstacle, ObstacleKind};
 use shoal_common::wire::codec;
 use shoal_common::wire::coordinator_to_agent::CoordinatorToAgent;
 use shoal_common::wire::open::{FleetStatus, Telemetry, OPEN_VERSION};
 use shoal_common::wire::WireTrajectory;
 
+use super::lead::{conflict_horizon_s, course_conflict, course_enters_obstacle, update_lead_s};
 use super::log::{Record, EVENT_FAULT, EVENT_HOLD, EVENT_LOST};
 use super::repair;
 use super::replan::{self, Request};
@@ -261,7 +261,7 @@ pub(super) fn check(x: &mut Exec, now: f64) {
             }
         }
     }
-    for c in x.fleet.conflicts(now) {
+    for c in x.fleet.conflicts_over(now, conflict_horizon_s(o)) {
         let can = |i: usize| {
             let v = &x.fleet.vehicles[i];
             !v.lost && !v.holding && v.arrived_s.is_none() && v.fault_s.is_none()
@@ -306,26 +306,31 @@ pub(super) fn replan_vehicle(x: &mut Exec, i: usize, why: &str) -> bool {
     } else {
         o.replan_budget
     };
-    // The update must reach the vehicle before it is due: start it one budget (plus margin)
-    // of wall time ahead, in mission time.
-    let lead = (budget + Duration::from_millis(250)).as_secs_f64() * o.time_scale;
-    let t0 = now + lead;
+    let t0 = now + update_lead_s(budget, o.time_scale);
     let remaining = (x.common_arrival_s + o.arrival_window_s - now).max(o.horizon_s);
     let predictions = x.fleet.predictions_over(now, remaining);
-    // Until t0 the vehicle drives its predicted course: if that enters a hard obstacle, no
-    // update can take effect in time. A hold is obeyed at once; the retries start from there.
-    if !x.fleet.vehicles[i].holding && course_enters_obstacle(&predictions[i], now, t0, &x.scenario)
-    {
-        x.last_reaction[i] = Some(Instant::now());
-        hold(
-            x,
-            i,
-            why,
-            format!(
-                "its course enters a hard obstacle before an update could take effect at t = {t0:.0} s"
-            ),
-        );
-        return false;
+    // Until t0 the vehicle drives its predicted course: if that enters a hard obstacle or
+    // comes within d_min of another vehicle, no update can take effect in time. A hold is
+    // obeyed at once; the retries start from there.
+    if !x.fleet.vehicles[i].holding {
+        let course = x.fleet.predictions_over(now, t0 - now);
+        let detail = if course_enters_obstacle(&predictions[i], now, t0, &x.scenario) {
+            Some("its course enters a hard obstacle".to_string())
+        } else {
+            course_conflict(&course, i, x.fleet.d_min).map(|c| {
+                let other = if c.a == i { c.b } else { c.a };
+                format!(
+                    "its course comes {:.1} m from {} at t = {:.0} s",
+                    c.min_distance_m, x.fleet.vehicles[other].id, c.at_s
+                )
+            })
+        };
+        if let Some(detail) = detail {
+            x.last_reaction[i] = Some(Instant::now());
+            let when = format!("before an update could take effect at t = {t0:.0} s");
+            hold(x, i, why, format!("{detail} {when}"));
+            return false;
+        }
     }
     let p0 = predictions[i].position_at(t0);
     // The course there: where the prediction was heading over the last few seconds before.
@@ -458,26 +463,6 @@ fn hold(x: &mut Exec, i: usize, why: &str, detail: String) {
     );
 }
 
-/// Whether `course` between mission times `from` and `to` enters a hard obstacle's inflated
-/// sphere.
-fn course_enters_obstacle(course: &Trajectory, from: f64, to: f64, scenario: &Scenario) -> bool {
-    let mut pts = vec![course.position_at(from)];
-    pts.extend(
-        course
-            .times
-            .iter()
-            .zip(&course.points)
-            .filter(|(t, _)| **t > from && **t < to)
-            .map(|(_, q)| *q),
-    );
-    pts.push(course.position_at(to));
-    pts.windows(2).any(|w| {
-        scenario
-            .hard_obstacles()
-            .any(|o| segment_hits_sphere(&w[0], &w[1], &o.centre(), o.inflated_radius()))
-    })
-}
-
 /// The progress line on stderr.
 pub(super) fn progress_line(s: &FleetStatus, reports: u64) -> String {
     let fmt = |v: Option<f64>| v.map_or("–".to_string(), |d| format!("{d:.0} m"));
@@ -502,37 +487,4 @@ pub(super) fn progress_line(s: &FleetStatus, reports: u64) -> String {
         fmt(s.predicted.map(|c| c.min_distance_m)),
         vehicles.join(" | ")
     )
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn a_course_enters_an_obstacle_only_between_the_times_it_passes_it(
-    ) -> Result<(), Box<dyn std::error::Error>> {
-        let file = concat!(env!("CARGO_MANIFEST_DIR"), "/../scenarios/amp-pso-1.toml");
-        let mut s = Scenario::load(std::path::Path::new(file))?;
-        s.obstacles = vec![Obstacle {
-            id: "rock".into(),
-            kind: ObstacleKind::Hard,
-            centre: [50.0, 3.0, 0.0],
-            radius_m: 4.0,
-            inflation_m: 1.0,
-        }];
-        // 1 m/s along the x axis: it passes 3 m from the centre (inside 4 + 1 m) at t = 50 s.
-        let course = Trajectory {
-            times: vec![0.0, 100.0],
-            points: vec![Vec3::new(0.0, 0.0, 0.0), Vec3::new(100.0, 0.0, 0.0)],
-        };
-        // Up to (40, 0): √(10² + 3²) = 10.4 m from the centre; from (60, 0) on, the same.
-        assert!(!course_enters_obstacle(&course, 0.0, 40.0, &s));
-        assert!(!course_enters_obstacle(&course, 60.0, 100.0, &s));
-        assert!(course_enters_obstacle(&course, 0.0, 60.0, &s));
-        assert!(course_enters_obstacle(&course, 48.0, 52.0, &s));
-        // A soft obstacle is not in the way.
-        s.obstacles[0].kind = ObstacleKind::Soft;
-        assert!(!course_enters_obstacle(&course, 0.0, 60.0, &s));
-        Ok(())
-    }
 }

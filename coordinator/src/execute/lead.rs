@@ -1,0 +1,150 @@
+//! The update lead: a replan's update takes effect one replan budget (plus a delivery margin)
+//! of wall time ahead, 275 mission seconds at 500×, and until then the vehicle drives the course
+//! it is on. So conflicts are looked for that much further ahead, and a vehicle whose course
+//! until then enters a hard obstacle or comes within d_min of another vehicle is told to hold
+//! (obeyed at once) instead: no update could change that course in time.
+
+use std::time::Duration;
+
+use shoal_common::execution::picture::{self, Conflict};
+use shoal_common::geometry::segment_hits_sphere;
+use shoal_common::scenario::Scenario;
+use shoal_common::trajectory::Trajectory;
+
+/// How far ahead of now a replan's update takes effect, mission seconds: it must reach the
+/// vehicle before it is due, so it starts one replan budget (plus a margin for the delivery)
+/// of wall time ahead.
+pub(super) fn update_lead_s(budget: Duration, time_scale: f64) -> f64 {
+    (budget + UPDATE_MARGIN).as_secs_f64() * time_scale
+}
+
+/// How far ahead conflicts are looked for, mission seconds: the horizon beyond the update lead.
+/// A conflict seen less than the lead ahead can only be met by a hold (at 500× the lead is
+/// 275 mission seconds, more than the 180 s horizon), so each is seen at least the horizon
+/// before an update can act on it.
+pub(super) fn conflict_horizon_s(o: &super::ExecOptions) -> f64 {
+    o.horizon_s + update_lead_s(o.replan_budget, o.time_scale)
+}
+
+/// Wall time an update is given, over the replan budget, to reach the vehicle.
+const UPDATE_MARGIN: Duration = Duration::from_millis(250);
+
+/// Whether `course` between mission times `from` and `to` enters a hard obstacle's inflated
+/// sphere.
+pub(super) fn course_enters_obstacle(
+    course: &Trajectory,
+    from: f64,
+    to: f64,
+    scenario: &Scenario,
+) -> bool {
+    let mut pts = vec![course.position_at(from)];
+    pts.extend(
+        course
+            .times
+            .iter()
+            .zip(&course.points)
+            .filter(|(t, _)| **t > from && **t < to)
+            .map(|(_, q)| *q),
+    );
+    pts.push(course.position_at(to));
+    pts.windows(2).any(|w| {
+        scenario
+            .hard_obstacles()
+            .any(|o| segment_hits_sphere(&w[0], &w[1], &o.centre(), o.inflated_radius()))
+    })
+}
+
+/// The closest approach under `d_min` of vehicle `i`'s course to another vehicle's, both as
+/// `course` predicts them from now until the update lead is over (each trajectory of `course`
+/// ends there), or `None` when it keeps d_min. A replan answers only from the lead's end on:
+/// one that starts past a conflict on the way reports the separation after it, and the
+/// vehicles meet.
+pub(super) fn course_conflict(course: &[Trajectory], i: usize, d_min: f64) -> Option<Conflict> {
+    picture::predicted_conflicts(course, d_min)
+        .into_iter()
+        .find(|c| c.a == i || c.b == i)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use shoal_common::geometry::Vec3;
+    use shoal_common::scenario::{Obstacle, ObstacleKind};
+
+    #[test]
+    fn conflicts_are_looked_for_the_horizon_beyond_the_update_lead() {
+        let mut o = super::super::ExecOptions {
+            time_scale: 500.0,
+            telemetry_hz: 2.0,
+            horizon_s: 180.0,
+            deviation_m: 25.0,
+            separation_buffer_m: 10.0,
+            lost_after: Duration::from_secs(3),
+            replan_budget: Duration::from_millis(300),
+            arrival_window_s: 30.0,
+            log: std::path::PathBuf::from("mission.ndjson"),
+            inject: Vec::new(),
+            quiet: true,
+            seed: 1,
+        };
+        // (0.3 s + 0.25 s) · 500 = 275 s of lead.
+        assert!((update_lead_s(o.replan_budget, o.time_scale) - 275.0).abs() < 1e-9);
+        assert!((conflict_horizon_s(&o) - 455.0).abs() < 1e-9);
+        // At 50×, 27.5 s.
+        o.time_scale = 50.0;
+        assert!((conflict_horizon_s(&o) - 207.5).abs() < 1e-9);
+    }
+
+    #[test]
+    fn a_course_enters_an_obstacle_only_between_the_times_it_passes_it(
+    ) -> Result<(), Box<dyn std::error::Error>> {
+        let file = concat!(env!("CARGO_MANIFEST_DIR"), "/../scenarios/amp-pso-1.toml");
+        let mut s = Scenario::load(std::path::Path::new(file))?;
+        s.obstacles = vec![Obstacle {
+            id: "rock".into(),
+            kind: ObstacleKind::Hard,
+            centre: [50.0, 3.0, 0.0],
+            radius_m: 4.0,
+            inflation_m: 1.0,
+        }];
+        // 1 m/s along the x axis: it passes 3 m from the centre (inside 4 + 1 m) at t = 50 s.
+        let course = Trajectory {
+            times: vec![0.0, 100.0],
+            points: vec![Vec3::new(0.0, 0.0, 0.0), Vec3::new(100.0, 0.0, 0.0)],
+        };
+        // Up to (40, 0): √(10² + 3²) = 10.4 m from the centre; from (60, 0) on, the same.
+        assert!(!course_enters_obstacle(&course, 0.0, 40.0, &s));
+        assert!(!course_enters_obstacle(&course, 60.0, 100.0, &s));
+        assert!(course_enters_obstacle(&course, 0.0, 60.0, &s));
+        assert!(course_enters_obstacle(&course, 48.0, 52.0, &s));
+        // A soft obstacle is not in the way.
+        s.obstacles[0].kind = ObstacleKind::Soft;
+        assert!(!course_enters_obstacle(&course, 0.0, 60.0, &s));
+        Ok(())
+    }
+
+    #[test]
+    fn a_course_conflict_is_the_closest_approach_of_that_vehicle_under_d_min(
+    ) -> Result<(), Box<dyn std::error::Error>> {
+        let line = |from: [f64; 3], to: [f64; 3]| Trajectory {
+            times: vec![0.0, 100.0],
+            points: vec![Vec3::from(from), Vec3::from(to)],
+        };
+        // a east along y = 0 and b west along y = 30 pass 30 m apart at t = 50; c stands
+        // 200 m north.
+        let course = vec![
+            line([0., 0., 0.], [100., 0., 0.]),
+            line([100., 30., 0.], [0., 30., 0.]),
+            line([50., 200., 0.], [50., 200., 0.]),
+        ];
+        let c = course_conflict(&course, 1, 50.0).ok_or("no conflict")?;
+        assert_eq!((c.a, c.b), (0, 1));
+        assert!((c.min_distance_m - 30.0).abs() < 1e-9, "{c:?}");
+        assert!((c.at_s - 50.0).abs() < 1e-9, "{c:?}");
+        assert!(course_conflict(&course, 0, 50.0).is_some());
+        // c is 170 m from both at its closest: nothing under 50 m, nor for a or b under 20 m.
+        assert!(course_conflict(&course, 2, 50.0).is_none());
+        assert!(course_conflict(&course, 1, 20.0).is_none());
+        Ok(())
+    }
+}
