@@ -36,6 +36,21 @@ fn scenario(
     Ok(Scenario::parse(&text, Path::new("reactions.toml"))?)
 }
 
+/// auv1 runs east, auv2 north; at 1.5 m/s both reach (1000, 1000) at t = 600 s, and are within
+/// d_min (50 m) of each other from t ≈ 576 s to 624 s.
+fn crossing() -> Result<(Scenario, Vec<Trajectory>), Box<dyn std::error::Error>> {
+    let s = scenario(&[
+        ("auv1", [100.0, 1000.0, 200.0], [1900.0, 1000.0, 200.0]),
+        ("auv2", [1000.0, 100.0, 200.0], [1000.0, 1900.0, 200.0]),
+    ])?;
+    let plans = s
+        .vehicles
+        .iter()
+        .map(|v| steady(&[v.start, v.goal], 1.5))
+        .collect();
+    Ok((s, plans))
+}
+
 /// Through `points` at a steady `speed` from t = 0.
 fn steady(points: &[[f64; 3]], speed: f64) -> Trajectory {
     let points: Vec<Vec3> = points.iter().map(|p| Vec3::from(*p)).collect();
@@ -161,16 +176,7 @@ fn events<'a>(all: &'a [Value], kind: &str, vehicle: &str) -> Vec<&'a Value> {
 
 #[test]
 fn a_predicted_conflict_replans_the_later_vehicle_and_separation_holds() -> TestResult {
-    // auv1 runs east, auv2 north; at 1.5 m/s both reach (1000, 1000) at t = 600 s.
-    let s = scenario(&[
-        ("auv1", [100.0, 1000.0, 200.0], [1900.0, 1000.0, 200.0]),
-        ("auv2", [1000.0, 100.0, 200.0], [1000.0, 1900.0, 200.0]),
-    ])?;
-    let plans: Vec<Trajectory> = s
-        .vehicles
-        .iter()
-        .map(|v| steady(&[v.start, v.goal], 1.5))
-        .collect();
+    let (s, plans) = crossing()?;
     let dir = tempfile::tempdir()?;
     let (report, log) = execute(&s, &plans, 25.0, dir.path())?;
     let f = &report.figures;
@@ -206,15 +212,7 @@ fn at_500x_a_predicted_conflict_is_seen_in_time_to_replan_rather_than_hold() -> 
     // seconds after the replan starts. Within the bare 180 s horizon the meeting (closer than
     // d_min from t ≈ 576 s) was seen from t ≈ 396 s, too late for any update: the vehicle had
     // to hold. Looked for 180 s past the lead, it is seen from t ≈ 121 s, and re-timed.
-    let s = scenario(&[
-        ("auv1", [100.0, 1000.0, 200.0], [1900.0, 1000.0, 200.0]),
-        ("auv2", [1000.0, 100.0, 200.0], [1000.0, 1900.0, 200.0]),
-    ])?;
-    let plans: Vec<Trajectory> = s
-        .vehicles
-        .iter()
-        .map(|v| steady(&[v.start, v.goal], 1.5))
-        .collect();
+    let (s, plans) = crossing()?;
     let dir = tempfile::tempdir()?;
     let (report, log) = execute_with(&s, &plans, 25.0, dir.path(), &|o| {
         o.time_scale = 500.0;
@@ -242,15 +240,7 @@ fn a_conflict_nearer_than_the_update_lead_is_met_by_a_hold() -> TestResult {
     // (1 s + 0.25 s) × 500 = 625 mission seconds after the replan starts, past the meeting at
     // t ≈ 576–624 s. A replan from there reported the separation after the meeting (930 m)
     // and the vehicles met 0.7 m apart; now the vehicle that gives way holds at once.
-    let s = scenario(&[
-        ("auv1", [100.0, 1000.0, 200.0], [1900.0, 1000.0, 200.0]),
-        ("auv2", [1000.0, 100.0, 200.0], [1000.0, 1900.0, 200.0]),
-    ])?;
-    let plans: Vec<Trajectory> = s
-        .vehicles
-        .iter()
-        .map(|v| steady(&[v.start, v.goal], 1.5))
-        .collect();
+    let (s, plans) = crossing()?;
     let dir = tempfile::tempdir()?;
     let (report, log) = execute_with(&s, &plans, 25.0, dir.path(), &|o| {
         o.time_scale = 500.0;
