@@ -484,4 +484,11 @@ fn a_fix_on_the_way_back_by_the_same_point_is_placed_on_the_way_back() {
     // Its prediction goes on west along the way back.
     let ahead = f.predictions_over(150.0, 10.0)[0].position_at(160.0);
     assert!(ahead.x < 53.0, "{ahead:?}");
+    // Replanned since (the new plan keeps the old one up to the replan): the fix is found
+    // afresh on the new plan, and still on the way back.
+    f.vehicles[0].revision = 1;
+    let again = f.vehicles[0]
+        .fix_progress()
+        .unwrap_or_else(|| panic!("no fix"));
+    assert!((again.plan_time_s - 150.0).abs() < 1e-9, "{again:?}");
 }

@@ -90,12 +90,22 @@ impl Tracked {
     }
 
     /// Where the latest fix is on the current plan: as its report placed it, or, when the
-    /// vehicle was replanned since, found afresh on the new plan. `None` before any report.
+    /// vehicle was replanned since, found afresh on the new plan near the plan time its report
+    /// gave. `None` before any report.
     pub fn fix_progress(&self) -> Option<Progress> {
         let t = self.last.as_ref()?;
         match self.progress {
             Some(pr) if self.progress_revision == self.revision => Some(pr),
-            _ => Some(picture::progress(
+            // The new plan keeps the old one up to the replan: near the plan time it had.
+            Some(pr) => Some(picture::progress_near(
+                &self.plan,
+                self.position(),
+                t.state.t_s,
+                PROGRESS_WINDOW_S,
+                pr.plan_time_s,
+                MATCH_SLACK_M,
+            )),
+            None => Some(picture::progress(
                 &self.plan,
                 self.position(),
                 t.state.t_s,
