@@ -186,6 +186,20 @@ impl Trajectory {
         Trajectory { times, points }
     }
 
+    /// The trajectory up to mission time `t`: every earlier sample, then the position at `t`
+    /// (times unchanged). Empty stays empty.
+    pub fn until(&self, t: f64) -> Trajectory {
+        if self.times.is_empty() {
+            return self.clone();
+        }
+        let keep = self.times.partition_point(|&s| s < t);
+        let mut times = self.times[..keep].to_vec();
+        let mut points = self.points[..keep.min(self.points.len())].to_vec();
+        times.push(t);
+        points.push(self.position_at(t));
+        Trajectory { times, points }
+    }
+
     /// This trajectory up to where `next` begins, then `next`: what a vehicle under way is sent
     /// when its rest is replanned from a time ahead of now, so it keeps to its old course until
     /// the new one starts instead of being pulled straight to the new start. The samples of
@@ -389,6 +403,35 @@ mod tests {
             points: vec![],
         };
         assert_eq!(empty.since(1.0), empty);
+    }
+
+    #[test]
+    fn the_trajectory_until_a_time_ends_where_it_is_then() {
+        let v = |x: f64| Vec3::new(x, 0.0, 0.0);
+        let t = Trajectory {
+            times: vec![0.0, 100.0, 200.0],
+            points: vec![v(0.0), v(100.0), v(300.0)],
+        };
+        let r = t.until(150.0);
+        assert_eq!(r.times, vec![0.0, 100.0, 150.0]);
+        assert_eq!(r.points, vec![v(0.0), v(100.0), v(200.0)]);
+        // On a sample: that sample once; past the end: every sample, then the end held.
+        assert_eq!(t.until(100.0).times, vec![0.0, 100.0]);
+        assert_eq!(
+            t.until(500.0).points,
+            vec![v(0.0), v(100.0), v(300.0), v(300.0)]
+        );
+        // Before the start: the start alone; a clip of both ends is since then until.
+        assert_eq!(t.until(-10.0).points, vec![v(0.0)]);
+        assert_eq!(
+            t.since(50.0).until(150.0).points,
+            vec![v(50.0), v(100.0), v(200.0)]
+        );
+        let empty = Trajectory {
+            times: vec![],
+            points: vec![],
+        };
+        assert_eq!(empty.until(1.0), empty);
     }
 
     #[test]

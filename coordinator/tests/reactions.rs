@@ -51,6 +51,15 @@ fn crossing() -> Result<(Scenario, Vec<Trajectory>), Box<dyn std::error::Error>>
     Ok((s, plans))
 }
 
+/// The [`crossing`] executed at 500× real time with a replan budget of `budget`.
+fn crossing_at_500x(budget: Duration, dir: &Path) -> Executed {
+    let (s, plans) = crossing()?;
+    execute_with(&s, &plans, 25.0, dir, &|o| {
+        o.time_scale = 500.0;
+        o.replan_budget = budget;
+    })
+}
+
 /// Through `points` at a steady `speed` from t = 0.
 fn steady(points: &[[f64; 3]], speed: f64) -> Trajectory {
     let points: Vec<Vec3> = points.iter().map(|p| Vec3::from(*p)).collect();
@@ -212,12 +221,8 @@ fn at_500x_a_predicted_conflict_is_seen_in_time_to_replan_rather_than_hold() -> 
     // seconds after the replan starts. Within the bare 180 s horizon the meeting (closer than
     // d_min from t ≈ 576 s) was seen from t ≈ 396 s, too late for any update: the vehicle had
     // to hold. Looked for 180 s past the lead, it is seen from t ≈ 121 s, and re-timed.
-    let (s, plans) = crossing()?;
     let dir = tempfile::tempdir()?;
-    let (report, log) = execute_with(&s, &plans, 25.0, dir.path(), &|o| {
-        o.time_scale = 500.0;
-        o.replan_budget = Duration::from_millis(300);
-    })?;
+    let (report, log) = crossing_at_500x(Duration::from_millis(300), dir.path())?;
     let f = &report.figures;
     let conflicts = events(&log, "conflict_predicted", "auv1");
     let first = conflicts
@@ -240,12 +245,8 @@ fn a_conflict_nearer_than_the_update_lead_is_met_by_a_hold() -> TestResult {
     // (1 s + 0.25 s) × 500 = 625 mission seconds after the replan starts, past the meeting at
     // t ≈ 576–624 s. A replan from there reported the separation after the meeting (930 m)
     // and the vehicles met 0.7 m apart; now the vehicle that gives way holds at once.
-    let (s, plans) = crossing()?;
     let dir = tempfile::tempdir()?;
-    let (report, log) = execute_with(&s, &plans, 25.0, dir.path(), &|o| {
-        o.time_scale = 500.0;
-        o.replan_budget = Duration::from_secs(1);
-    })?;
+    let (report, log) = crossing_at_500x(Duration::from_secs(1), dir.path())?;
     let holds = events(&log, "hold", "auv2");
     let hold = holds.first().ok_or("auv2 not told to hold")?;
     assert!(

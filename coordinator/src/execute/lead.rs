@@ -29,25 +29,10 @@ pub(super) fn conflict_horizon_s(o: &super::ExecOptions) -> f64 {
 /// Wall time an update is given, over the replan budget, to reach the vehicle.
 const UPDATE_MARGIN: Duration = Duration::from_millis(250);
 
-/// Whether `course` between mission times `from` and `to` enters a hard obstacle's inflated
-/// sphere.
-pub(super) fn course_enters_obstacle(
-    course: &Trajectory,
-    from: f64,
-    to: f64,
-    scenario: &Scenario,
-) -> bool {
-    let mut pts = vec![course.position_at(from)];
-    pts.extend(
-        course
-            .times
-            .iter()
-            .zip(&course.points)
-            .filter(|(t, _)| **t > from && **t < to)
-            .map(|(_, q)| *q),
-    );
-    pts.push(course.position_at(to));
-    pts.windows(2).any(|w| {
+/// Whether `course` (a vehicle's, from now until the update lead is over) enters a hard
+/// obstacle's inflated sphere.
+pub(super) fn course_enters_obstacle(course: &Trajectory, scenario: &Scenario) -> bool {
+    course.points.windows(2).any(|w| {
         scenario
             .hard_obstacles()
             .any(|o| segment_hits_sphere(&w[0], &w[1], &o.centre(), o.inflated_radius()))
@@ -112,14 +97,15 @@ mod tests {
             times: vec![0.0, 100.0],
             points: vec![Vec3::new(0.0, 0.0, 0.0), Vec3::new(100.0, 0.0, 0.0)],
         };
+        let between = |from: f64, to: f64| course.since(from).until(to);
         // Up to (40, 0): √(10² + 3²) = 10.4 m from the centre; from (60, 0) on, the same.
-        assert!(!course_enters_obstacle(&course, 0.0, 40.0, &s));
-        assert!(!course_enters_obstacle(&course, 60.0, 100.0, &s));
-        assert!(course_enters_obstacle(&course, 0.0, 60.0, &s));
-        assert!(course_enters_obstacle(&course, 48.0, 52.0, &s));
+        assert!(!course_enters_obstacle(&between(0.0, 40.0), &s));
+        assert!(!course_enters_obstacle(&between(60.0, 100.0), &s));
+        assert!(course_enters_obstacle(&between(0.0, 60.0), &s));
+        assert!(course_enters_obstacle(&between(48.0, 52.0), &s));
         // A soft obstacle is not in the way.
         s.obstacles[0].kind = ObstacleKind::Soft;
-        assert!(!course_enters_obstacle(&course, 0.0, 60.0, &s));
+        assert!(!course_enters_obstacle(&between(0.0, 60.0), &s));
         Ok(())
     }
 

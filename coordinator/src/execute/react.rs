@@ -308,13 +308,14 @@ pub(super) fn replan_vehicle(x: &mut Exec, i: usize, why: &str) -> bool {
     };
     let t0 = now + update_lead_s(budget, o.time_scale);
     let remaining = (x.common_arrival_s + o.arrival_window_s - now).max(o.horizon_s);
-    let predictions = x.fleet.predictions_over(now, remaining);
+    // Long enough to cover the lead (near the end of a fast run it can be the longer).
+    let predictions = x.fleet.predictions_over(now, remaining.max(t0 - now));
     // Until t0 the vehicle drives its predicted course: if that enters a hard obstacle or
     // comes within d_min of another vehicle, no update can take effect in time. A hold is
     // obeyed at once; the retries start from there.
     if !x.fleet.vehicles[i].holding {
-        let course = x.fleet.predictions_over(now, t0 - now);
-        let detail = if course_enters_obstacle(&predictions[i], now, t0, &x.scenario) {
+        let course: Vec<_> = predictions.iter().map(|p| p.until(t0)).collect();
+        let detail = if course_enters_obstacle(&course[i], &x.scenario) {
             Some("its course enters a hard obstacle".to_string())
         } else {
             course_conflict(&course, i, x.fleet.d_min).map(|c| {
