@@ -403,11 +403,12 @@ pub(super) fn replan_vehicle(x: &mut Exec, i: usize, why: &str) -> bool {
             "replanned",
             vec![id.clone()],
             format!(
-                "{id} replanned ({why}) in {:.0} ms: revision {}, from t = {t0:.0} s, arrival {:.0} s, closest vehicle {:.1} m",
+                "{id} replanned ({why}) in {:.0} ms: revision {}, from t = {t0:.0} s, arrival {:.0} s, closest vehicle {:.1} m{}",
                 result.elapsed.as_secs_f64() * 1000.0,
                 x.revision,
                 result.trajectory.arrival(),
-                result.min_separation_m
+                result.min_separation_m,
+                result.note.as_ref().map_or(String::new(), |n| format!("; {n}"))
             ),
         );
         true
@@ -418,11 +419,10 @@ pub(super) fn replan_vehicle(x: &mut Exec, i: usize, why: &str) -> bool {
                 "still_holding",
                 vec![id.clone()],
                 format!(
-                    "{id} keeps holding: retry {} found no safe replan in {:.0} ms ({} obstacle intrusions, closest vehicle {:.1} m)",
+                    "{id} keeps holding: retry {} found no safe replan in {:.0} ms ({})",
                     x.hold_retries[i],
                     result.elapsed.as_secs_f64() * 1000.0,
-                    result.hard_hits,
-                    result.min_separation_m
+                    result.shortfall()
                 ),
             );
         } else {
@@ -431,10 +431,9 @@ pub(super) fn replan_vehicle(x: &mut Exec, i: usize, why: &str) -> bool {
                 i,
                 why,
                 format!(
-                    "no safe replan in {:.0} ms ({} obstacle intrusions, closest vehicle {:.1} m)",
+                    "no safe replan in {:.0} ms ({})",
                     result.elapsed.as_secs_f64() * 1000.0,
-                    result.hard_hits,
-                    result.min_separation_m
+                    result.shortfall()
                 ),
             );
         }

@@ -25,8 +25,10 @@
 //! rejoin is searched there too when the straight line back would cross ground it may not
 //! drive. A vehicle standing still near its path is gone round like an obstacle, and an
 //! obstacle's margin the crawler is already inside is eased to let it out
-//! ([`crawler_scenario`]). A crawler with no way (none within the search budget, or no map)
-//! holds until the obstacle is gone (or, for a rejoin, retries from where it stopped).
+//! ([`crawler_scenario`]). A crawler whose finish a keep-out covers ends its path before the
+//! stretch that leads there (its finish is only where its last row ends). A crawler with no
+//! way (none within the search budget, or no map) holds, and the retries start from where it
+//! stopped; the hold says why in words ([`Replanned::shortfall`]).
 //!
 //! A repair that still meets a hard obstacle, or comes within d_min of another vehicle's
 //! predicted track at every timing, is not safe: the coordinator then holds the vehicle and
@@ -50,12 +52,33 @@ fn blocked(obstacles: &[Obstacle], a: &Vec3, b: &Vec3) -> bool {
     })
 }
 
+/// A repaired path: its points, the plan's own speed on each leg, and what it gave up.
+struct Repaired {
+    points: Vec<Vec3>,
+    speeds: Vec<f64>,
+    /// Plain words, for the event (a crawler's finish given up).
+    note: Option<String>,
+}
+
 /// The rest of the tour from `p0` as points and the plan's own speed on each leg, planned in
-/// `scenario` (`r.scenario`, or a crawler's [`crawler_scenario`]); `None` for a way round a
-/// blocked run that the grid cannot find (or, for a crawler, not within the request's budget).
-fn repaired_path(r: &Request, scenario: &Scenario) -> Option<(Vec<Vec3>, Vec<f64>)> {
+/// `scenario` (`r.scenario`, or a crawler's [`crawler_scenario`]); `Err` in plain words for a
+/// way round a blocked run that the grid cannot find (or, for a crawler, not within the
+/// request's budget).
+///
+/// A coverage crawler's finish is only where its last row ends, so when a keep-out covers it
+/// the crawler ends its path before the blocked stretch that leads there (the same widened
+/// run a way round would replace), rather than hold where it is with the rest of its rows
+/// undone; a tour's or an energy plan's goal is the mission's, and it holds.
+fn repaired_path(r: &Request, scenario: &Scenario) -> Result<Repaired, String> {
     let started = Instant::now();
     let crawler = scenario.coverage.is_some();
+    let over_budget = || {
+        format!(
+            "no way round within the {:.0} ms budget",
+            r.budget.as_secs_f64() * 1000.0
+        )
+    };
+    const NO_MAP: &str = "no seabed map to search a way round on";
     // A crawler's ways round, rasterised on first use (see `crawler_way_round`).
     let keep_out = |p: &Vec3| near_obstacle(scenario, p);
     let mut ways: Option<Option<WaysRound>> = None;
@@ -83,9 +106,9 @@ fn repaired_path(r: &Request, scenario: &Scenario) -> Option<(Vec<Vec3>, Vec<f64
                 .map(|p| p - pts[1])
                 .filter(|d| d.x.hypot(d.y) > 1e-6)
                 .unwrap_or(pts[1] - pts[0]);
-            let Some(way) = crawler_way_round(r, ways.as_ref()?, &pts, (0, 0), along) else {
-                tracing::info!("{id}: no way back to its path on ground it may drive");
-                return None;
+            let ways = ways.as_ref().ok_or(NO_MAP)?;
+            let Some(way) = crawler_way_round(r, ways, &pts, (0, 0), along) else {
+                return Err("no way back to its path on ground it may drive".into());
             };
             let metres: f64 = way.windows(2).map(|w| (w[1] - w[0]).norm()).sum();
             tracing::info!(
@@ -93,7 +116,7 @@ fn repaired_path(r: &Request, scenario: &Scenario) -> Option<(Vec<Vec3>, Vec<f64
                  rejoining by {metres:.0} m searched on the seabed map"
             );
             if started.elapsed() > r.budget {
-                return None;
+                return Err(over_budget());
             }
             let rejoin_speed = speeds[0];
             pts.splice(0..2, way.iter().copied());
@@ -104,6 +127,7 @@ fn repaired_path(r: &Request, scenario: &Scenario) -> Option<(Vec<Vec3>, Vec<f64
     let runs = blocked_runs(scenario, r, &pts);
     let mut out = vec![pts[0]];
     let mut out_speeds = Vec::new();
+    let mut note = None;
     let mut k = 0;
     while k + 1 < pts.len() {
         let Some(&(_, j)) = runs.iter().find(|(a, _)| *a == k) else {
@@ -112,26 +136,50 @@ fn repaired_path(r: &Request, scenario: &Scenario) -> Option<(Vec<Vec3>, Vec<f64
             k += 1;
             continue;
         };
+        let (from, to) = (pts[k], pts[j + 1]);
+        let stretch = || {
+            format!(
+                "no way round the blocked stretch from ({:.0}, {:.0}) to ({:.0}, {:.0})",
+                from.x, from.y, to.x, to.y
+            )
+        };
         // The run k..=j, rejoined at its end point.
         let way = if crawler {
+            if let (true, Some(o)) = (j + 2 == pts.len(), keep_out_at(scenario, &to)) {
+                if k == 0 {
+                    return Err(format!(
+                        "its finish ({:.0}, {:.0}) is inside {}'s keep-out, and it stands on the last stretch before it",
+                        to.x, to.y, o.id
+                    ));
+                }
+                let short: f64 = (k..=j).map(|i| (pts[i + 1] - pts[i]).norm()).sum();
+                note = Some(format!(
+                    "its finish ({:.0}, {:.0}) is inside {}'s keep-out: its path now ends at ({:.0}, {:.0}), the last {short:.0} m undriven",
+                    to.x, to.y, o.id, from.x, from.y
+                ));
+                break;
+            }
             // A coverage crawler must stay on passable seabed, which the 3-D grid of the
             // detour does not know: its way round is searched on the seabed map. Without the
             // map (it could not be built) there is none, and the crawler holds.
             let ways = ways.get_or_insert_with(|| r.ground.map(|g| g.ways_round(&keep_out)));
-            let way = crawler_way_round(r, ways.as_ref()?, &pts, (k, j), pts[j + 1] - pts[j])?;
+            let ways = ways.as_ref().ok_or(NO_MAP)?;
+            let way = crawler_way_round(r, ways, &pts, (k, j), pts[j + 1] - pts[j])
+                .ok_or_else(|| format!("{} on ground it may drive", stretch()))?;
             // Past its budget the repair gives up: the crawler holds, and the retry has longer.
             if started.elapsed() > r.budget {
-                return None;
+                return Err(over_budget());
             }
             way
         } else {
             super::detour::detour(
                 scenario,
-                pts[k],
-                pts[j + 1],
+                from,
+                to,
                 scenario.vehicles[r.vehicle].max_pitch_deg,
                 super::detour::keep_off(scenario, r.vehicle),
-            )?
+            )
+            .ok_or_else(stretch)?
         };
         let run_length: f64 = (k..=j).map(|i| (pts[i + 1] - pts[i]).norm()).sum();
         let run_time: f64 = (k..=j)
@@ -144,7 +192,11 @@ fn repaired_path(r: &Request, scenario: &Scenario) -> Option<(Vec<Vec3>, Vec<f64
         }
         k = j + 1;
     }
-    Some((out, out_speeds))
+    Ok(Repaired {
+        points: out,
+        speeds: out_speeds,
+        note,
+    })
 }
 
 /// The legs of `pts` a way round replaces, as runs `(first, last)` of leg indices in order:
@@ -301,9 +353,14 @@ const WAY_ROUND_MARGIN_M: f64 = 1.0;
 
 /// Whether `p` is within [`WAY_ROUND_MARGIN_M`] of a hard obstacle's inflated sphere.
 fn near_obstacle(scenario: &Scenario, p: &Vec3) -> bool {
+    keep_out_at(scenario, p).is_some()
+}
+
+/// The first hard obstacle within [`WAY_ROUND_MARGIN_M`] of whose inflated sphere `p` is.
+fn keep_out_at<'s>(scenario: &'s Scenario, p: &Vec3) -> Option<&'s Obstacle> {
     scenario
         .hard_obstacles()
-        .any(|o| (p - o.centre()).norm() < o.inflated_radius() + WAY_ROUND_MARGIN_M)
+        .find(|o| (p - o.centre()).norm() < o.inflated_radius() + WAY_ROUND_MARGIN_M)
 }
 
 /// A crawler's way round the legs `k..=j` of `pts` ([`WaysRound::between`]), from `pts[k]` on
@@ -420,14 +477,23 @@ pub fn repair(r: &Request) -> Replanned {
     let d_min = r.scenario.fleet.d_min_m;
     let shaped = crawler_scenario(r);
     let scenario = shaped.as_ref().unwrap_or(r.scenario);
-    let Some((points, speeds)) = repaired_path(r, scenario) else {
-        return Replanned {
-            trajectory: r.current.clone(),
-            safe: false,
-            hard_hits: 1,
-            min_separation_m: f64::INFINITY,
-            elapsed: started.elapsed(),
-        };
+    let Repaired {
+        points,
+        speeds,
+        note,
+    } = match repaired_path(r, scenario) {
+        Ok(p) => p,
+        Err(why) => {
+            return Replanned {
+                trajectory: r.current.clone(),
+                safe: false,
+                hard_hits: 0,
+                min_separation_m: f64::INFINITY,
+                elapsed: started.elapsed(),
+                no_way: Some(why),
+                note: None,
+            }
+        }
     };
     // The path, hence its obstacle intrusions, is the same at every timing. They are counted
     // on the scenario's own obstacles (a margin the crawler was inside eased as it planned);
@@ -466,6 +532,8 @@ pub fn repair(r: &Request) -> Replanned {
         hard_hits,
         min_separation_m,
         elapsed: started.elapsed(),
+        no_way: None,
+        note,
     }
 }
 

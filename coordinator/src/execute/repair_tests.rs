@@ -334,6 +334,92 @@ fn a_crawlers_rejoin_goes_round_ground_it_may_not_drive() -> Result<(), Box<dyn 
     let held = repair(&r);
     assert!(!held.safe);
     assert_eq!(held.trajectory.points, plan.points);
+    // The hold says why in words, not as an obstacle intrusion it never had.
+    assert_eq!(held.hard_hits, 0);
+    assert_eq!(
+        held.shortfall(),
+        "no way back to its path on ground it may drive"
+    );
+    Ok(())
+}
+
+#[test]
+fn a_crawlers_finish_inside_a_keep_out_ends_its_path_before_the_stretch_to_it(
+) -> Result<(), Box<dyn std::error::Error>> {
+    let mut s = scenario()?;
+    s.coverage = Some(Default::default());
+    // A rock of 5 m with a 20 m margin 10 m beyond the row's end (190, 150): the finish is
+    // inside its keep-out.
+    s.obstacles.push(Obstacle {
+        id: "rock".into(),
+        kind: ObstacleKind::Hard,
+        centre: [200.0, 150.0, 0.0],
+        radius_m: 5.0,
+        inflation_m: 20.0,
+    });
+    let ground = pillar_ground()?;
+    let p = |x: f64, y: f64| Vec3::new(x, y, 0.0);
+    let plan = Trajectory {
+        times: vec![0.0, 360.0],
+        points: vec![p(10.0, 150.0), p(190.0, 150.0)],
+    };
+    let mut r = request(&s, &plan, &[]);
+    r.t0 = 20.0;
+    r.p0 = p(20.0, 150.0);
+    r.arrival_s = 360.0;
+    r.ground = Some(&ground);
+    let repaired = repair(&r);
+    assert!(repaired.safe, "{repaired:?}");
+    // Legs of 10 m from x = 20: 170–180 and 180–190 enter the 25 m sphere; the run is widened
+    // over the legs within 25 + 1 + 2 × 5 (its turns) = 36 m, so 160–170 (30 m) too, not
+    // 150–160 (40 m). The path ends at x = 160, 30 m short.
+    let pts = &repaired.trajectory.points;
+    assert_eq!(pts.len(), 15);
+    assert!((pts[0] - r.p0).norm() < 1e-9);
+    assert!((pts[pts.len() - 1] - p(160.0, 150.0)).norm() < 1e-9);
+    assert_eq!(
+        repaired.note.as_deref(),
+        Some("its finish (190, 150) is inside rock's keep-out: its path now ends at (160, 150), the last 30 m undriven")
+    );
+    // Re-timed to finish when planned (140 m in 340 s is 0.41 m/s), but no slower than its
+    // 0.5 m/s: it finishes at 20 + 140 / 0.5 = 300 s.
+    assert!((repaired.trajectory.arrival() - 300.0).abs() < 1e-9);
+
+    // Already on that last stretch, at x = 165, it has nowhere to go: it holds, and says why.
+    r.t0 = 310.0;
+    r.p0 = p(165.0, 150.0);
+    let held = repair(&r);
+    assert!(!held.safe);
+    assert_eq!(
+        held.shortfall(),
+        "its finish (190, 150) is inside rock's keep-out, and it stands on the last stretch before it"
+    );
+    Ok(())
+}
+
+#[test]
+fn a_tour_whose_goal_is_inside_an_obstacle_holds_and_says_so(
+) -> Result<(), Box<dyn std::error::Error>> {
+    // A tour's goal is the mission's, not only where its last leg ends: it is never given up.
+    let mut s = scenario()?;
+    s.obstacles.push(Obstacle {
+        id: "rock".into(),
+        kind: ObstacleKind::Hard,
+        centre: [200.0, 200.0, 200.0],
+        radius_m: 20.0,
+        inflation_m: 10.0,
+    });
+    let plan = tour();
+    let r = repair(&request(&s, &plan, &[]));
+    // The detour's last leg must still end on the goal, inside the rock: not safe.
+    assert!(!r.safe);
+    assert_eq!(r.note, None);
+    assert_eq!(r.hard_hits, 1);
+    assert!(
+        (r.trajectory.points[r.trajectory.points.len() - 1] - Vec3::new(200.0, 200.0, 200.0))
+            .norm()
+            < 1e-9
+    );
     Ok(())
 }
 

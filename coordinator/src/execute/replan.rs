@@ -87,6 +87,22 @@ pub struct Replanned {
     pub min_separation_m: f64,
     /// Wall time spent.
     pub elapsed: Duration,
+    /// Why no path was found at all (a repair with no way round), in plain words.
+    pub no_way: Option<String>,
+    /// What a safe repair gave up, in plain words (a crawler's finish inside a keep-out).
+    pub note: Option<String>,
+}
+
+impl Replanned {
+    /// Why the result is not safe, in plain words, for the hold events.
+    pub fn shortfall(&self) -> String {
+        self.no_way.clone().unwrap_or_else(|| {
+            format!(
+                "{} obstacle intrusions, closest vehicle {:.1} m",
+                self.hard_hits, self.min_separation_m
+            )
+        })
+    }
 }
 
 /// `t` from mission time `t0` on, re-based so `t0` is time 0.
@@ -363,6 +379,8 @@ pub fn replan(r: &Request) -> Replanned {
         hard_hits: best.terms.hard_hits,
         min_separation_m: best.min_separation,
         elapsed: started.elapsed(),
+        no_way: None,
+        note: None,
     }
 }
 
