@@ -258,6 +258,17 @@ fn a_conflict_nearer_than_the_update_lead_is_met_by_a_hold() -> TestResult {
     assert!(events(&log, "hold", "auv1").is_empty(), "{log:?}");
     let d = report.figures.min_separation_m.ok_or("no separation")?;
     assert!(d >= 50.0, "executed separation {d} m: {log:?}");
+    // Its retry comes 30 mission seconds after the hold (or once the last attempt's wall time
+    // twice over has passed), not after 2 s of wall time: it arrived at 1268 s in two runs, where
+    // with the 2 s (1000 mission seconds) it waited until t ≈ 967 s and arrived at 1730 s.
+    let auv2 = report
+        .figures
+        .vehicles
+        .iter()
+        .find(|v| v.vehicle == "auv2")
+        .and_then(|v| v.arrived_s)
+        .ok_or("auv2 did not arrive")?;
+    assert!(auv2 < 1500.0, "auv2 arrived at {auv2} s: {log:?}");
     Ok(())
 }
 

@@ -29,6 +29,25 @@ pub(super) fn conflict_horizon_s(o: &super::ExecOptions) -> f64 {
 /// Wall time an update is given, over the replan budget, to reach the vehicle.
 const UPDATE_MARGIN: Duration = Duration::from_millis(250);
 
+/// Mission seconds between two retries of a held vehicle's replan: the others move 15–90 m in
+/// that time at 0.5–3 m/s, enough for a way to open, and a real vehicle stands no longer.
+pub(super) const HOLD_RETRY_S: f64 = 30.0;
+
+/// Wall time from a held vehicle's last attempt (or its hold) to its next retry:
+/// [`HOLD_RETRY_S`] of mission time, at most `cool_down` (at 1× a retry every 2 s, as every
+/// other reaction), but never less than twice the wall time the last attempt took, so the
+/// retries keep at most a third of the loop from the reports and the other vehicles' checks.
+/// A fixed wall-time cool-down made a hold cost 1000 mission seconds per retry at 500×. (The
+/// checks run every 100 ms of wall time, 50 mission seconds at 500×: no retry comes sooner.)
+pub(super) fn hold_retry_after(
+    time_scale: f64,
+    last_attempt: Duration,
+    cool_down: Duration,
+) -> Duration {
+    let mission = Duration::from_secs_f64((HOLD_RETRY_S / time_scale.max(1e-9)).min(1e6));
+    mission.min(cool_down).max(last_attempt * 2)
+}
+
 /// Whether `course` (a vehicle's, from now until the update lead is over) enters a hard
 /// obstacle's inflated sphere.
 pub(super) fn course_enters_obstacle(course: &Trajectory, scenario: &Scenario) -> bool {
@@ -55,6 +74,24 @@ mod tests {
     use super::*;
     use shoal_common::geometry::Vec3;
     use shoal_common::scenario::{Obstacle, ObstacleKind};
+
+    #[test]
+    fn a_hold_is_retried_after_30_mission_seconds_bounded_by_the_loop() {
+        let two = Duration::from_secs(2);
+        let ms = Duration::from_millis;
+        // 500×: 30 s of mission time is 60 ms of wall time, when the last attempt took 5 ms.
+        assert_eq!(hold_retry_after(500.0, ms(5), two), ms(60));
+        // A 300 ms attempt: 600 ms (300 mission seconds), leaving the loop two thirds of its time.
+        assert_eq!(hold_retry_after(500.0, ms(300), two), ms(600));
+        // 1×: 30 s is capped at the 2 s cool-down of every reaction.
+        assert_eq!(hold_retry_after(1.0, ms(5), two), two);
+        // An 8 × budget attempt of 2.4 s at 1×: 4.8 s.
+        assert_eq!(hold_retry_after(1.0, ms(2400), two), ms(4800));
+        // 10×: 3 s → capped at 2 s.
+        assert_eq!(hold_retry_after(10.0, Duration::ZERO, two), two);
+        // 100×: 300 ms.
+        assert_eq!(hold_retry_after(100.0, Duration::ZERO, two), ms(300));
+    }
 
     #[test]
     fn conflicts_are_looked_for_the_horizon_beyond_the_update_lead() {

@@ -95,6 +95,8 @@ pub(crate) struct Exec<'a> {
     last_reaction: Vec<Option<Instant>>,
     /// Per vehicle: failed replans since it was told to hold (each retry doubles the budget).
     hold_retries: Vec<u32>,
+    /// Per vehicle: the wall time its last replan took (see [`lead::hold_retry_after`]).
+    last_attempt: Vec<Duration>,
     /// (crawler, standing vehicle): repaired for this stand of it (see [`standing`]).
     rounded: Vec<(usize, usize)>,
     /// Per vehicle: the revision sent and when, to time its delivery.
@@ -287,6 +289,7 @@ pub fn execute_trajectories(
         holds: 0,
         last_reaction: vec![None; ids.len()],
         hold_retries: vec![0; ids.len()],
+        last_attempt: vec![Duration::ZERO; ids.len()],
         rounded: Vec::new(),
         pending: vec![None; ids.len()],
         deliveries_ms: Vec::new(),

@@ -17,13 +17,16 @@ use shoal_common::wire::coordinator_to_agent::CoordinatorToAgent;
 use shoal_common::wire::open::{FleetStatus, Telemetry, OPEN_VERSION};
 use shoal_common::wire::WireTrajectory;
 
-use super::lead::{conflict_horizon_s, course_conflict, course_enters_obstacle, update_lead_s};
+use super::lead::{
+    conflict_horizon_s, course_conflict, course_enters_obstacle, hold_retry_after, update_lead_s,
+};
 use super::log::{Record, EVENT_FAULT, EVENT_HOLD, EVENT_LOST};
 use super::repair;
 use super::replan::{self, Request};
 use super::Exec;
 
-/// Shortest wall time between two reactions for one vehicle (a new obstacle does not wait).
+/// Shortest wall time between two reactions for one vehicle (a new obstacle does not wait; a
+/// held vehicle's retries come sooner at high time scales, see [`hold_retry_after`]).
 const COOL_DOWN: Duration = Duration::from_secs(2);
 
 /// A report from the telemetry key.
@@ -243,7 +246,12 @@ pub(super) fn check(x: &mut Exec, now: f64) {
     for i in 0..x.fleet.vehicles.len() {
         let v = &x.fleet.vehicles[i];
         let active = !v.lost && v.arrived_s.is_none() && v.fault_s.is_none();
-        let cooled = x.last_reaction[i].is_none_or(|t| t.elapsed() >= COOL_DOWN);
+        let wait = if v.holding {
+            hold_retry_after(o.time_scale, x.last_attempt[i], COOL_DOWN)
+        } else {
+            COOL_DOWN
+        };
+        let cooled = x.last_reaction[i].is_none_or(|t| t.elapsed() >= wait);
         if !(active && cooled) {
             continue;
         }
@@ -369,6 +377,7 @@ pub(super) fn replan_vehicle(x: &mut Exec, i: usize, why: &str) -> bool {
         replan::replan(&request)
     };
     x.last_reaction[i] = Some(Instant::now());
+    x.last_attempt[i] = result.elapsed;
     let id = x.fleet.vehicles[i].id.clone();
     if result.safe {
         x.hold_retries[i] = 0;

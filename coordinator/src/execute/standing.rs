@@ -7,9 +7,13 @@
 //! than the horizon), and a path passing just over d_min from the standing vehicle was never
 //! seen as a conflict at all, though the tracking error of the passing crawler takes it under.
 //! So a crawler whose remaining path comes within d_min plus the separation buffer of a
-//! standing vehicle is repaired as soon as that vehicle stands, once per stand: the repair goes
-//! round it ([`super::repair`]: a standing vehicle is an obstacle to a coverage crawler's way
-//! round), at d_min plus the buffer where there is room.
+//! standing vehicle is repaired, once per stand: the repair goes round it ([`super::repair`]:
+//! a standing vehicle is an obstacle to a coverage crawler's way round), at d_min plus the
+//! buffer where there is room. It is repaired when that stretch of its path comes within the
+//! conflict horizon ([`conflict_horizon_s`]: `--horizon` past the update lead, so the update
+//! always takes effect in time), not as soon as the other stands: a held vehicle is retried
+//! every 30 mission seconds and usually goes on long before a pass hours ahead, and a way round
+//! is never undone, so rounding it at once left that ground uncovered for nothing.
 //!
 //! Only coverage missions: a tour's repair waits rather than skip inspection points (it would
 //! be held long before it needs to), and seed 004's replan is not a way round.
@@ -18,6 +22,7 @@ use shoal_common::geometry::{segment_point_distance, Vec3};
 use shoal_common::trajectory::Trajectory;
 
 use super::fleet::Tracked;
+use super::lead::conflict_horizon_s;
 use super::react::replan_vehicle;
 use super::Exec;
 
@@ -41,6 +46,12 @@ pub(super) fn rest_of(plan: &Trajectory, from: f64, p: Vec3) -> Vec<Vec3> {
 }
 
 /// Closest approach to `q` of the path from `p` along the rest of `plan` after plan time
+/// `from` up to plan time `from + window_s`, metres.
+fn closest_within(plan: &Trajectory, from: f64, p: Vec3, q: Vec3, window_s: f64) -> f64 {
+    closest_remaining(&plan.until(from + window_s), from, p, q)
+}
+
+/// Closest approach to `q` of the path from `p` along the rest of `plan` after plan time
 /// `from` ([`rest_of`]), metres.
 pub(super) fn closest_remaining(plan: &Trajectory, from: f64, p: Vec3, q: Vec3) -> f64 {
     let pts = rest_of(plan, from, p);
@@ -52,14 +63,16 @@ pub(super) fn closest_remaining(plan: &Trajectory, from: f64, p: Vec3, q: Vec3) 
         .fold(f64::INFINITY, f64::min)
 }
 
-/// Repairs every coverage crawler under way whose remaining path passes within d_min plus the
-/// separation buffer of a vehicle that stands still, once per stand (see the module doc). A
-/// crawler already that close is left to the conflict check, which lets it move away.
+/// Repairs every coverage crawler under way whose path within the conflict horizon passes
+/// within d_min plus the separation buffer of a vehicle that stands still, once per stand (see
+/// the module doc). A crawler already that close is left to the conflict check, which lets it
+/// move away.
 pub(super) fn check(x: &mut Exec, now: f64) {
     if x.scenario.coverage.is_none() {
         return;
     }
     let d = x.fleet.d_min + x.options.separation_buffer_m.max(0.0);
+    let horizon = conflict_horizon_s(x.options);
     let n = x.fleet.vehicles.len();
     // A stand is over once the vehicle moves again: the next one is a new stand.
     let fleet = &x.fleet;
@@ -80,7 +93,7 @@ pub(super) fn check(x: &mut Exec, now: f64) {
                 continue;
             }
             let from = v.progress.map_or(now, |pr| pr.plan_time_s);
-            let closest = closest_remaining(&v.plan, from, p, at);
+            let closest = closest_within(&v.plan, from, p, at, horizon);
             if closest >= d {
                 continue;
             }
@@ -121,6 +134,15 @@ mod tests {
         // Past the end: only the position.
         let d = closest_remaining(&plan, 250.0, p, Vec3::new(50.0, 3.0, 4.0));
         assert!((d - 5.0).abs() < 1e-9, "{d}");
+        // Within a window of plan time: 30 s ahead the path ends at (80, 0), 78.1 m from
+        // (130, 60); 100 s ahead at (100, 50), √(30² + 10²); 200 s ahead, the whole rest.
+        let q = Vec3::new(130.0, 60.0, 0.0);
+        let d = closest_within(&plan, 50.0, p, q, 30.0);
+        assert!((d - 50.0f64.hypot(60.0)).abs() < 1e-9, "{d}");
+        let d = closest_within(&plan, 50.0, p, q, 100.0);
+        assert!((d - 30.0f64.hypot(10.0)).abs() < 1e-9, "{d}");
+        let d = closest_within(&plan, 50.0, p, q, 200.0);
+        assert!((d - 30.0).abs() < 1e-9, "{d}");
     }
 
     #[test]
