@@ -145,7 +145,8 @@ fn repaired_path(r: &Request, scenario: &Scenario) -> Result<Repaired, String> {
         };
         // The run k..=j, rejoined at its end point.
         let way = if crawler {
-            if let (true, Some(o)) = (j + 2 == pts.len(), keep_out_at(scenario, &to)) {
+            let last = j + 2 == pts.len();
+            if let Some(o) = last.then(|| keep_out_at(scenario, &to)).flatten() {
                 if k == 0 {
                     return Err(format!(
                         "its finish ({:.0}, {:.0}) is inside {}'s keep-out, and it stands on the last stretch before it",

@@ -277,6 +277,33 @@ fn a_crawlers_blocked_run_is_widened_by_two_turning_radii() -> Result<(), Box<dy
     Ok(())
 }
 
+/// A crawler's scenario (coverage on) with a 5 m rock at `centre` with a margin of
+/// `inflation_m`.
+fn crawler_with_rock(
+    centre: [f64; 3],
+    inflation_m: f64,
+) -> Result<Scenario, Box<dyn std::error::Error>> {
+    let mut s = scenario()?;
+    s.coverage = Some(Default::default());
+    s.obstacles.push(Obstacle {
+        id: "rock".into(),
+        kind: ObstacleKind::Hard,
+        centre,
+        radius_m: 5.0,
+        inflation_m,
+    });
+    Ok(s)
+}
+
+/// East along the row y = 150 from x = 10 to 190 at 0.5 m/s.
+fn row_150() -> Trajectory {
+    let p = |x: f64| Vec3::new(x, 150.0, 0.0);
+    Trajectory {
+        times: vec![0.0, 360.0],
+        points: vec![p(10.0), p(190.0)],
+    }
+}
+
 /// A crawler's 198 m square of flat seabed with a 50 m pillar on cells 50..60 × 33..43 (x 100–
 /// 120 m, y 66–86 m): the crawler keeps 8 m from impassable ground and turns at 5 m.
 fn pillar_ground() -> Result<CrawlerGround, Box<dyn std::error::Error>> {
@@ -346,23 +373,12 @@ fn a_crawlers_rejoin_goes_round_ground_it_may_not_drive() -> Result<(), Box<dyn 
 #[test]
 fn a_crawlers_finish_inside_a_keep_out_ends_its_path_before_the_stretch_to_it(
 ) -> Result<(), Box<dyn std::error::Error>> {
-    let mut s = scenario()?;
-    s.coverage = Some(Default::default());
     // A rock of 5 m with a 20 m margin 10 m beyond the row's end (190, 150): the finish is
     // inside its keep-out.
-    s.obstacles.push(Obstacle {
-        id: "rock".into(),
-        kind: ObstacleKind::Hard,
-        centre: [200.0, 150.0, 0.0],
-        radius_m: 5.0,
-        inflation_m: 20.0,
-    });
+    let s = crawler_with_rock([200.0, 150.0, 0.0], 20.0)?;
     let ground = pillar_ground()?;
     let p = |x: f64, y: f64| Vec3::new(x, y, 0.0);
-    let plan = Trajectory {
-        times: vec![0.0, 360.0],
-        points: vec![p(10.0, 150.0), p(190.0, 150.0)],
-    };
+    let plan = row_150();
     let mut r = request(&s, &plan, &[]);
     r.t0 = 20.0;
     r.p0 = p(20.0, 150.0);
@@ -432,10 +448,7 @@ fn a_crawler_goes_round_a_vehicle_standing_near_its_path() -> Result<(), Box<dyn
     // East along y = 150 from x = 10 to 190 at 0.5 m/s (north of the pillar); the other
     // vehicle stands 40 m north of that row at x = 100 for the rest of the mission.
     let p = |x: f64, y: f64| Vec3::new(x, y, 0.0);
-    let plan = Trajectory {
-        times: vec![0.0, 360.0],
-        points: vec![p(10.0, 150.0), p(190.0, 150.0)],
-    };
+    let plan = row_150();
     let standing = Trajectory {
         times: vec![0.0, 1000.0],
         points: vec![p(100.0, 190.0), p(100.0, 190.0)],
@@ -479,22 +492,11 @@ fn a_crawler_goes_round_a_vehicle_standing_near_its_path() -> Result<(), Box<dyn
 #[test]
 fn a_crawler_inside_an_obstacles_margin_drives_out_of_it() -> Result<(), Box<dyn std::error::Error>>
 {
-    let mut s = scenario()?;
-    s.coverage = Some(Default::default());
     // A rock of 5 m with a 30 m margin 15 m north of the row y = 150, at x = 60.
-    s.obstacles.push(Obstacle {
-        id: "rock".into(),
-        kind: ObstacleKind::Hard,
-        centre: [60.0, 165.0, 0.0],
-        radius_m: 5.0,
-        inflation_m: 30.0,
-    });
+    let s = crawler_with_rock([60.0, 165.0, 0.0], 30.0)?;
     let ground = pillar_ground()?;
     let p = |x: f64, y: f64| Vec3::new(x, y, 0.0);
-    let plan = Trajectory {
-        times: vec![0.0, 360.0],
-        points: vec![p(10.0, 150.0), p(190.0, 150.0)],
-    };
+    let plan = row_150();
     // At x = 40 the crawler is 25 m from the rock's centre, 10 m inside its margin. The search
     // cannot start inside a keep-out: before, it held there until the rock was gone. Now the
     // margin is eased to 25 − 1 − 1 − 5 (its turn) − 5 = 13 m, and it goes round outside that.

@@ -77,7 +77,8 @@ pub struct Request<'a> {
 /// A replanned trajectory.
 #[derive(Debug, Clone)]
 pub struct Replanned {
-    /// Mission-timed, from `(t0, p0)` to the goal.
+    /// Mission-timed, from `(t0, p0)` to the goal (a coverage crawler's repair may end short of
+    /// its finish: see `note`).
     pub trajectory: Trajectory,
     /// No hard-obstacle intrusion and every other vehicle kept at d_min or more.
     pub safe: bool,
