@@ -424,16 +424,19 @@ pub(super) fn replan_vehicle(x: &mut Exec, i: usize, why: &str) -> bool {
     } else {
         if x.fleet.vehicles[i].holding {
             x.hold_retries[i] += 1;
-            x.event(
-                "still_holding",
-                vec![id.clone()],
-                format!(
-                    "{id} keeps holding: retry {} found no safe replan in {:.0} ms ({})",
-                    x.hold_retries[i],
-                    result.elapsed.as_secs_f64() * 1000.0,
-                    result.shortfall()
-                ),
-            );
+            let n = x.hold_retries[i];
+            if told_retry(n) {
+                x.event(
+                    "still_holding",
+                    vec![id.clone()],
+                    format!(
+                        "{id} keeps holding: retry {n} found no safe replan in {:.0} ms ({}); the next event on it comes at retry {}",
+                        result.elapsed.as_secs_f64() * 1000.0,
+                        result.shortfall(),
+                        2 * n
+                    ),
+                );
+            }
         } else {
             hold(
                 x,
@@ -448,6 +451,13 @@ pub(super) fn replan_vehicle(x: &mut Exec, i: usize, why: &str) -> bool {
         }
         false
     }
+}
+
+/// Whether a held vehicle's failed retry `n` (from 1) gets an event: 1, 2, 4, 8, …. A vehicle
+/// held for good is retried every 30 mission seconds or so ([`hold_retry_after`]): an event for
+/// each put 166 in one 10,000 s mission log at 500×.
+fn told_retry(n: u32) -> bool {
+    n.is_power_of_two()
 }
 
 /// Commands vehicle `i` to hold where it is (obeyed at once) and says why.
@@ -496,4 +506,17 @@ pub(super) fn progress_line(s: &FleetStatus, reports: u64) -> String {
         fmt(s.predicted.map(|c| c.min_distance_m)),
         vehicles.join(" | ")
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn failed_retries_1_2_4_8_and_so_on_are_told() {
+        let told: Vec<u32> = (1..=20).filter(|&n| told_retry(n)).collect();
+        assert_eq!(told, vec![1, 2, 4, 8, 16]);
+        // The 166 retries of a crawler held for good at 500× make 8 events.
+        assert_eq!((1..=166).filter(|&n| told_retry(n)).count(), 8);
+    }
 }
