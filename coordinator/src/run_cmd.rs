@@ -362,10 +362,11 @@ pub fn execution_summary(r: &ExecutionReport) -> String {
     ));
     s.push_str(&verdict::coverage_line(f));
     s.push_str(&format!(
-        "  telemetry: {} reports, latency median {} ms, p99 {} ms\n",
+        "  telemetry: {} reports, latency median {} ms, p99 {} ms; the loop's longest pause {:.0} ms\n",
         f.reports,
         crate::summary::opt(f.latency_median_ms, 2),
-        crate::summary::opt(f.latency_p99_ms, 2)
+        crate::summary::opt(f.latency_p99_ms, 2),
+        r.loop_longest_pause_ms
     ));
     if !r.obstacle_decision_ms.is_empty() || !r.update_delivery_ms.is_empty() {
         s.push_str(&format!(

@@ -106,6 +106,8 @@ pub(crate) struct Exec<'a> {
     /// Decision times of obstacle replans (obstacle received → update sent), ms.
     pub(crate) decisions_ms: Vec<f64>,
     dropped: u64,
+    /// Longest wall time between two passes of the loop (see [`ExecutionReport`]).
+    longest_pause: Duration,
     /// A coverage fleet's seabed map, for a crawler's way round a new obstacle; `None` for
     /// other missions, or when the map cannot be built (a crawler then holds instead).
     ground: Option<CrawlerGround>,
@@ -126,6 +128,9 @@ pub struct ExecutionReport {
     pub update_delivery_ms: Vec<f64>,
     /// Malformed or unusable open-interface messages dropped.
     pub dropped: u64,
+    /// Longest wall time between two passes of the execution loop, milliseconds: for that long
+    /// no report was read, no conflict looked for and no status published.
+    pub loop_longest_pause_ms: f64,
     /// Why it ended.
     pub ended: String,
 }
@@ -295,6 +300,7 @@ pub fn execute_trajectories(
         deliveries_ms: Vec::new(),
         decisions_ms: Vec::new(),
         dropped: 0,
+        longest_pause: Duration::ZERO,
         ground,
     };
     x.log.write(&Record::Start(Start {
@@ -330,6 +336,7 @@ pub fn execute_trajectories(
         obstacle_decision_ms: x.decisions_ms.clone(),
         update_delivery_ms: x.deliveries_ms.clone(),
         dropped: x.dropped,
+        loop_longest_pause_ms: x.longest_pause.as_secs_f64() * 1000.0,
         ended,
     };
     std::thread::sleep(Duration::from_millis(200)); // let the stops go out
@@ -354,7 +361,10 @@ fn run_loop(
     let mut injections: Vec<(f64, Obstacle)> = o.inject.clone();
     // Past the window, a mission that still has vehicles under way is given up.
     let give_up_s = x.common_arrival_s + o.arrival_window_s + 600.0;
+    let mut last_pass = Instant::now();
     loop {
+        x.longest_pause = x.longest_pause.max(last_pass.elapsed());
+        last_pass = Instant::now();
         if stop.load(Ordering::Relaxed) {
             return "interrupted".into();
         }
