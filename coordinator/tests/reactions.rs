@@ -14,7 +14,7 @@ use std::time::Duration;
 use common::{agent, finish, free_endpoint, TestResult};
 use serde_json::Value;
 use shoal_common::geometry::Vec3;
-use shoal_common::scenario::Scenario;
+use shoal_common::scenario::{Obstacle, ObstacleKind, Scenario};
 use shoal_common::trajectory::Trajectory;
 use shoal_coordinator::distributed::{AgentsMode, DistributedOptions};
 use shoal_coordinator::execute::{execute_trajectories, ExecOptions, ExecutionReport};
@@ -301,5 +301,58 @@ fn a_hairpin_the_vehicle_cannot_fly_is_a_deviation_and_is_replanned() -> TestRes
     let v = &report.figures.vehicles[0];
     assert!(v.revision >= 1 && v.arrived_s.is_some(), "{v:?}");
     assert_eq!(report.holds, 0);
+    Ok(())
+}
+
+#[test]
+fn the_loop_keeps_watching_while_a_held_vehicle_replans() -> TestResult {
+    // The crossing at 100× with a 1 s replan budget; at t = 300 s an obstacle covers auv2's
+    // goal, so no replan of auv2 is ever safe: it holds and is retried for the rest of the
+    // mission. Each retry thinks for half a second or more; run on the loop, each left the
+    // coordinator that long without reading a report (1253 ms with 1.2 s retries on amp-pso-3
+    // at 100×); off it, the loop goes on.
+    let dir = tempfile::tempdir()?;
+    let (mut s, plans) = crossing()?;
+    // With 8 waypoints the swarm reaches its iteration cap in 250–300 ms, whatever the
+    // budget; with 30 (seed 004's count) it takes 500–700 ms.
+    s.optimizer.waypoints = 30;
+    let (report, log) = execute_with(&s, &plans, 25.0, dir.path(), &|o| {
+        o.time_scale = 100.0;
+        o.replan_budget = Duration::from_secs(1);
+        o.inject = vec![(
+            300.0,
+            Obstacle {
+                id: "on-the-goal".into(),
+                kind: ObstacleKind::Hard,
+                centre: [1000.0, 1900.0, 200.0],
+                radius_m: 20.0,
+                inflation_m: 50.0,
+            },
+        )];
+    })?;
+    assert!(!events(&log, "hold", "auv2").is_empty(), "{log:?}");
+    // The attempts' wall times, from the hold and still_holding events ("… in 1004 ms …").
+    let attempts: Vec<f64> = ["hold", "still_holding"]
+        .iter()
+        .flat_map(|k| events(&log, k, "auv2"))
+        .filter_map(|e| {
+            let d = e["detail"].as_str()?;
+            let (_, after) = d.split_once(" in ")?;
+            after.split_once(" ms")?.0.parse().ok()
+        })
+        .collect();
+    let longest = attempts.iter().copied().fold(0.0, f64::max);
+    assert!(
+        attempts.len() >= 2 && longest >= 400.0,
+        "{attempts:?}: {log:?}"
+    );
+    let pause = report.loop_longest_pause_ms;
+    assert!(
+        pause < longest / 2.0,
+        "the loop paused {pause} ms; attempts took {attempts:?} ms"
+    );
+    // auv1 was watched to its goal meanwhile.
+    let auv1 = &report.figures.vehicles[0];
+    assert!(auv1.arrived_s.is_some() && auv1.in_window, "{auv1:?}");
     Ok(())
 }

@@ -35,10 +35,11 @@ pub(super) const HOLD_RETRY_S: f64 = 30.0;
 
 /// Wall time from a held vehicle's last attempt (or its hold) to its next retry:
 /// [`HOLD_RETRY_S`] of mission time, at most `cool_down` (at 1× a retry every 2 s, as every
-/// other reaction), but never less than twice the wall time the last attempt took, so the
-/// retries keep at most a third of the loop from the reports and the other vehicles' checks.
-/// A fixed wall-time cool-down made a hold cost 1000 mission seconds per retry at 500×. (The
-/// checks run every 100 ms of wall time, 50 mission seconds at 500×: no retry comes sooner.)
+/// other reaction), but never less than twice the wall time the last attempt took, so a vehicle
+/// held for good keeps at most a third of a core busy and the replans of the others their
+/// turn (one runs at a time, `replan_queue`). A fixed wall-time cool-down made a hold cost 1000
+/// mission seconds per retry at 500×. (The checks run every 100 ms of wall time, 50 mission
+/// seconds at 500×: no retry comes sooner.)
 pub(super) fn hold_retry_after(
     time_scale: f64,
     last_attempt: Duration,

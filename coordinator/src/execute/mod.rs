@@ -14,6 +14,7 @@ pub mod log;
 mod react;
 mod repair;
 pub mod replan;
+mod replan_queue;
 mod standing;
 mod track;
 mod tracked;
@@ -22,6 +23,7 @@ pub mod verdict;
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::{self, Receiver, RecvTimeoutError};
+use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use shoal_common::coverage::reroute::CrawlerGround;
@@ -97,6 +99,8 @@ pub(crate) struct Exec<'a> {
     hold_retries: Vec<u32>,
     /// Per vehicle: the wall time its last replan took (see [`lead::hold_retry_after`]).
     last_attempt: Vec<Duration>,
+    /// The replans waiting and the one under way (see [`replan_queue`]).
+    queue: replan_queue::ReplanQueue,
     /// (crawler, standing vehicle): repaired for this stand of it (see [`standing`]).
     rounded: Vec<(usize, usize)>,
     /// Per vehicle: the revision sent and when, to time its delivery.
@@ -110,7 +114,7 @@ pub(crate) struct Exec<'a> {
     longest_pause: Duration,
     /// A coverage fleet's seabed map, for a crawler's way round a new obstacle; `None` for
     /// other missions, or when the map cannot be built (a crawler then holds instead).
-    ground: Option<CrawlerGround>,
+    ground: Option<Arc<CrawlerGround>>,
 }
 
 /// What an execution leaves.
@@ -274,7 +278,7 @@ pub fn execute_trajectories(
         .wait()
         .map_err(|e| anyhow::anyhow!("cannot declare the queryable {status_key}: {e}"))?;
     // Built before the mission clock starts: a large map takes a moment.
-    let ground = crawler_ground(scenario);
+    let ground = crawler_ground(scenario).map(Arc::new);
     let log = LogWriter::create(&options.log)?;
     let epoch_unix_ms = unix_us() / 1000 + 1500;
     let mut x = Exec {
@@ -295,6 +299,7 @@ pub fn execute_trajectories(
         last_reaction: vec![None; ids.len()],
         hold_retries: vec![0; ids.len()],
         last_attempt: vec![Duration::ZERO; ids.len()],
+        queue: replan_queue::ReplanQueue::default(),
         rounded: Vec::new(),
         pending: vec![None; ids.len()],
         deliveries_ms: Vec::new(),
@@ -395,6 +400,7 @@ fn run_loop(
             Err(RecvTimeoutError::Timeout) => {}
             Err(RecvTimeoutError::Disconnected) => return "the network closed".into(),
         }
+        replan_queue::poll(x);
         while let Some(e) = x.session.net.next(Instant::now()) {
             if let Event::Gone(v) = e {
                 react::lose(x, &v, "its agent left the network (liveliness token gone)");

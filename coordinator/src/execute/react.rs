@@ -1,8 +1,9 @@
 //! What the coordinator does with reports and with what it sees (issue 8, item 3): a predicted
 //! loss of separation, a cross-track error beyond the tolerance, a vehicle silent too long or a
 //! new obstacle on a vehicle's remaining path makes it replan that vehicle (see
-//! [`super::replan`]); a replan that is not safe becomes a hold, retried until one is. Every
-//! decision is an event, logged and published.
+//! [`super::replan`]; the replan runs off the loop, [`super::replan_queue`]); a replan that is
+//! not safe becomes a hold, retried until one is. Every decision is an event, logged and
+//! published.
 //!
 //! Who gives way in a predicted conflict: a vehicle that can (not lost, holding or arrived);
 //! between two that can, the later one in scenario order — a fixed priority, so two
@@ -13,16 +14,11 @@ use std::time::{Duration, Instant};
 use shoal_common::geometry::{segment_hits_sphere, Vec3};
 use shoal_common::scenario::{Obstacle, ObstacleKind};
 use shoal_common::wire::codec;
-use shoal_common::wire::coordinator_to_agent::CoordinatorToAgent;
 use shoal_common::wire::open::{FleetStatus, Telemetry, OPEN_VERSION};
-use shoal_common::wire::WireTrajectory;
 
-use super::lead::{
-    conflict_horizon_s, course_conflict, course_enters_obstacle, hold_retry_after, update_lead_s,
-};
-use super::log::{Record, EVENT_FAULT, EVENT_HOLD, EVENT_LOST};
-use super::repair;
-use super::replan::{self, Request};
+use super::lead::{conflict_horizon_s, hold_retry_after};
+use super::log::{Record, EVENT_FAULT, EVENT_LOST};
+use super::replan_queue;
 use super::Exec;
 
 /// Shortest wall time between two reactions for one vehicle (a new obstacle does not wait; a
@@ -187,10 +183,7 @@ fn obstacle(x: &mut Exec, o: Obstacle, received: Instant) {
     x.scenario.obstacles.push(o.clone());
     x.fleet.obstacle_published();
     for i in blocked {
-        if replan_vehicle(x, i, "a new obstacle blocks its path") {
-            x.decisions_ms
-                .push(received.elapsed().as_secs_f64() * 1000.0);
-        }
+        replan_queue::request(x, i, "a new obstacle blocks its path", Some(received));
     }
 }
 
@@ -252,11 +245,11 @@ pub(super) fn check(x: &mut Exec, now: f64) {
             COOL_DOWN
         };
         let cooled = x.last_reaction[i].is_none_or(|t| t.elapsed() >= wait);
-        if !(active && cooled) {
+        if !(active && cooled) || x.queue.busy(i) {
             continue;
         }
         if v.holding {
-            replan_vehicle(x, i, "retrying after a hold");
+            replan_queue::request(x, i, "retrying after a hold", None);
             continue;
         }
         if let Some(p) = v.progress {
@@ -265,7 +258,7 @@ pub(super) fn check(x: &mut Exec, now: f64) {
                     "cross-track error {:.1} m is over the {:.1} m tolerance",
                     p.cross_track_m, o.deviation_m
                 );
-                replan_vehicle(x, i, &why);
+                replan_queue::request(x, i, &why, None);
             }
         }
     }
@@ -281,7 +274,7 @@ pub(super) fn check(x: &mut Exec, now: f64) {
         } else {
             continue;
         };
-        if x.last_reaction[who].is_some_and(|t| t.elapsed() < COOL_DOWN) {
+        if x.queue.busy(who) || x.last_reaction[who].is_some_and(|t| t.elapsed() < COOL_DOWN) {
             continue;
         }
         let why = format!(
@@ -299,187 +292,8 @@ pub(super) fn check(x: &mut Exec, now: f64) {
             ],
             why.clone(),
         );
-        replan_vehicle(x, who, &why);
+        replan_queue::request(x, who, &why, None);
     }
-}
-
-/// Replans vehicle `i` and sends the update, or commands a hold; true when an update went out.
-pub(super) fn replan_vehicle(x: &mut Exec, i: usize, why: &str) -> bool {
-    let o = x.options;
-    let now = x.clock();
-    // A holding vehicle is safe where it is, so each retry may think longer: the budget
-    // doubles per failed retry, up to 8 ×.
-    let budget = if x.fleet.vehicles[i].holding {
-        o.replan_budget * (1u32 << x.hold_retries[i].min(3))
-    } else {
-        o.replan_budget
-    };
-    let t0 = now + update_lead_s(budget, o.time_scale);
-    let remaining = (x.common_arrival_s + o.arrival_window_s - now).max(o.horizon_s);
-    // Long enough to cover the lead (near the end of a fast run it can be the longer).
-    let predictions = x.fleet.predictions_over(now, remaining.max(t0 - now));
-    // Until t0 the vehicle drives its predicted course: if that enters a hard obstacle or
-    // comes within d_min of another vehicle, no update can take effect in time. A hold is
-    // obeyed at once; the retries start from there.
-    if !x.fleet.vehicles[i].holding {
-        let course: Vec<_> = predictions.iter().map(|p| p.until(t0)).collect();
-        let detail = if course_enters_obstacle(&course[i], &x.scenario) {
-            Some("its course enters a hard obstacle".to_string())
-        } else {
-            course_conflict(&course, i, x.fleet.d_min).map(|c| {
-                let other = if c.a == i { c.b } else { c.a };
-                format!(
-                    "its course comes {:.1} m from {} at t = {:.0} s",
-                    c.min_distance_m, x.fleet.vehicles[other].id, c.at_s
-                )
-            })
-        };
-        if let Some(detail) = detail {
-            x.last_reaction[i] = Some(Instant::now());
-            let when = format!("before an update could take effect at t = {t0:.0} s");
-            hold(x, i, why, format!("{detail} {when}"));
-            return false;
-        }
-    }
-    let p0 = predictions[i].position_at(t0);
-    // The course there: where the prediction was heading over the last few seconds before.
-    let heading = Some(p0 - predictions[i].position_at((t0 - 5.0).max(now)))
-        .filter(|d| d.x.hypot(d.y) > 1e-3 && !x.fleet.vehicles[i].holding);
-    // A retry must not repeat the swarm that just failed.
-    let seed =
-        o.seed ^ (u64::from(x.revision) << 8) ^ (u64::from(x.hold_retries[i]) << 32) ^ i as u64;
-    let request = Request {
-        scenario: &x.scenario,
-        vehicle: i,
-        t0,
-        p0,
-        heading,
-        current: &x.fleet.vehicles[i].plan,
-        resume_s: x.fleet.vehicles[i].resume_s(),
-        others: &predictions,
-        arrival_s: x.fleet.vehicles[i].planned_arrival_s,
-        budget,
-        separation_buffer_m: o.separation_buffer_m,
-        seed,
-        ground: x.ground.as_ref(),
-    };
-    // A tour must still pass its remaining inspection points, an energy plan (seed 001)
-    // keeps the path its cost chose over the seabed, its turning radius and the current, and
-    // a coverage crawler (seed 002) must still drive its remaining rows, none of which seed
-    // 004's replan models: all three are repaired, not replanned.
-    let algorithm = x.scenario.optimizer.algorithm;
-    let result = if algorithm.is_tour_planner()
-        || algorithm.is_energy_planner()
-        || x.scenario.coverage.is_some()
-    {
-        repair::repair(&request)
-    } else {
-        replan::replan(&request)
-    };
-    x.last_reaction[i] = Some(Instant::now());
-    x.last_attempt[i] = result.elapsed;
-    let id = x.fleet.vehicles[i].id.clone();
-    if result.safe {
-        x.hold_retries[i] = 0;
-        x.revision += 1;
-        let v = &mut x.fleet.vehicles[i];
-        // Under way, the vehicle goes on as predicted (its old course, its lag included) until
-        // the new one starts at the predicted point; holding, it waits where it is for it. The
-        // plan before now stays, for the record.
-        let plan = if v.holding {
-            result.trajectory.clone()
-        } else {
-            v.plan
-                .followed_by(&predictions[i].followed_by(&result.trajectory))
-        };
-        v.plan = plan.clone();
-        v.revision = x.revision;
-        v.holding = false;
-        v.held_since_s = None;
-        x.send(
-            &id,
-            CoordinatorToAgent::Update {
-                mission: x.mission.clone(),
-                vehicle: id.clone(),
-                revision: x.revision,
-                trajectory: WireTrajectory::new(&id, &plan),
-            },
-        );
-        x.pending[i] = Some((x.revision, Instant::now()));
-        x.replans += 1;
-        x.publish_plan(vec![id.clone()]);
-        x.event(
-            "replanned",
-            vec![id.clone()],
-            format!(
-                "{id} replanned ({why}) in {:.0} ms: revision {}, from t = {t0:.0} s, arrival {:.0} s, closest vehicle {:.1} m{}",
-                result.elapsed.as_secs_f64() * 1000.0,
-                x.revision,
-                result.trajectory.arrival(),
-                result.min_separation_m,
-                result.note.as_ref().map_or(String::new(), |n| format!("; {n}"))
-            ),
-        );
-        true
-    } else {
-        if x.fleet.vehicles[i].holding {
-            x.hold_retries[i] += 1;
-            let n = x.hold_retries[i];
-            if told_retry(n) {
-                x.event(
-                    "still_holding",
-                    vec![id.clone()],
-                    format!(
-                        "{id} keeps holding: retry {n} found no safe replan in {:.0} ms ({}); the next event on it comes at retry {}",
-                        result.elapsed.as_secs_f64() * 1000.0,
-                        result.shortfall(),
-                        2 * n
-                    ),
-                );
-            }
-        } else {
-            hold(
-                x,
-                i,
-                why,
-                format!(
-                    "no safe replan in {:.0} ms ({})",
-                    result.elapsed.as_secs_f64() * 1000.0,
-                    result.shortfall()
-                ),
-            );
-        }
-        false
-    }
-}
-
-/// Whether a held vehicle's failed retry `n` (from 1) gets an event: 1, 2, 4, 8, …. A vehicle
-/// held for good is retried every 30 mission seconds or so ([`hold_retry_after`]): an event for
-/// each put 166 in one 10,000 s mission log at 500×.
-fn told_retry(n: u32) -> bool {
-    n.is_power_of_two()
-}
-
-/// Commands vehicle `i` to hold where it is (obeyed at once) and says why.
-fn hold(x: &mut Exec, i: usize, why: &str, detail: String) {
-    let id = x.fleet.vehicles[i].id.clone();
-    x.send(
-        &id,
-        CoordinatorToAgent::Hold {
-            mission: x.mission.clone(),
-            vehicle: id.clone(),
-            reason: why.to_string(),
-        },
-    );
-    let now = x.clock();
-    x.fleet.vehicles[i].holding = true;
-    x.fleet.vehicles[i].held_since_s = Some(now);
-    x.holds += 1;
-    x.event(
-        EVENT_HOLD,
-        vec![id.clone()],
-        format!("{id} told to hold ({why}): {detail}"),
-    );
 }
 
 /// The progress line on stderr.
@@ -506,17 +320,4 @@ pub(super) fn progress_line(s: &FleetStatus, reports: u64) -> String {
         fmt(s.predicted.map(|c| c.min_distance_m)),
         vehicles.join(" | ")
     )
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn failed_retries_1_2_4_8_and_so_on_are_told() {
-        let told: Vec<u32> = (1..=20).filter(|&n| told_retry(n)).collect();
-        assert_eq!(told, vec![1, 2, 4, 8, 16]);
-        // The 166 retries of a crawler held for good at 500× make 8 events.
-        assert_eq!((1..=166).filter(|&n| told_retry(n)).count(), 8);
-    }
 }

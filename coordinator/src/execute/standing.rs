@@ -23,7 +23,7 @@ use shoal_common::trajectory::Trajectory;
 
 use super::fleet::Tracked;
 use super::lead::conflict_horizon_s;
-use super::react::replan_vehicle;
+use super::replan_queue;
 use super::Exec;
 
 /// Whether `v` stands still for the others: held, lost or faulted (not arrived: the plans
@@ -85,7 +85,9 @@ pub(super) fn check(x: &mut Exec, now: f64) {
         for i in 0..n {
             let v = &x.fleet.vehicles[i];
             let under_way = !v.lost && !v.holding && v.arrived_s.is_none() && v.fault_s.is_none();
-            if i == j || !under_way || x.rounded.contains(&(i, j)) {
+            // One under replan now is looked at again once its update is in.
+            let busy = x.queue.busy(i);
+            if i == j || !under_way || busy || x.rounded.contains(&(i, j)) {
                 continue;
             }
             let p = v.position();
@@ -102,7 +104,7 @@ pub(super) fn check(x: &mut Exec, now: f64) {
                 "{} stands {closest:.1} m from its remaining path, under d_min plus the buffer ({d:.0} m)",
                 x.fleet.vehicles[j].id
             );
-            replan_vehicle(x, i, &why);
+            replan_queue::request(x, i, &why, None);
         }
     }
 }

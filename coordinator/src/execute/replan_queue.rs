@@ -1,0 +1,558 @@
+//! Replans off the loop. A replan thinks for up to its wall-time budget (a held vehicle's retry
+//! up to 8 × that: 2.4 s at the default 0.3 s); run on the loop, it left the coordinator blind
+//! for that long — no report read, no conflict looked for, no status published — which is 1200
+//! mission seconds at 500×. So the loop only decides: a replan is queued, run on its own thread
+//! one at a time, and its result applied on the loop when it comes ([`poll`]).
+//!
+//! One at a time, as before: each replan plans against the others' plans as they are when it
+//! starts, so two replans at once could each plan into the other's old path. What the loop
+//! learns while one thinks is checked when its result comes: a vehicle lost, arrived or told
+//! to hold meanwhile drops it; a result that enters an obstacle published meanwhile is planned
+//! again at once. And a vehicle that must wait its turn is held at once when its course until
+//! an update could reach it is not safe (the same test a replan starts with, see
+//! [`super::lead`]).
+
+use std::collections::VecDeque;
+use std::sync::mpsc::{self, Receiver, TryRecvError};
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+use shoal_common::coverage::reroute::CrawlerGround;
+use shoal_common::geometry::{segment_hits_sphere, Vec3};
+use shoal_common::scenario::Scenario;
+use shoal_common::trajectory::Trajectory;
+use shoal_common::wire::coordinator_to_agent::CoordinatorToAgent;
+use shoal_common::wire::WireTrajectory;
+
+use super::lead::{course_conflict, course_enters_obstacle, update_lead_s};
+use super::log::EVENT_HOLD;
+use super::replan::{self, Replanned, Request};
+use super::{repair, Exec};
+
+/// The replans waiting and the one under way.
+#[derive(Default)]
+pub(super) struct ReplanQueue {
+    waiting: VecDeque<Waiting>,
+    under_way: Option<UnderWay>,
+}
+
+/// A replan waiting for its turn.
+struct Waiting {
+    vehicle: usize,
+    why: String,
+    /// When the obstacle that asked for it came (for the decision time).
+    obstacle_received: Option<Instant>,
+    budget: Duration,
+}
+
+/// The replan under way on its thread.
+struct UnderWay {
+    vehicle: usize,
+    why: String,
+    obstacle_received: Option<Instant>,
+    /// Mission time its update takes effect; the vehicle drives `course` until then.
+    t0: f64,
+    course: Trajectory,
+    /// Whether the vehicle was holding when it started.
+    was_holding: bool,
+    /// Obstacles the scenario had when it started: any published since are checked against
+    /// its result.
+    obstacles: usize,
+    started: Instant,
+    budget: Duration,
+    result: Receiver<Replanned>,
+}
+
+impl ReplanQueue {
+    /// Whether vehicle `i` has a replan waiting or under way.
+    pub(super) fn busy(&self, i: usize) -> bool {
+        self.under_way.as_ref().is_some_and(|u| u.vehicle == i)
+            || self.waiting.iter().any(|w| w.vehicle == i)
+    }
+
+    /// Wall time until a replan queued behind the first `ahead` waiting ones starts: the rest of
+    /// the budget of the one under way plus the budgets of those.
+    fn wait_for(&self, ahead: usize) -> Duration {
+        let rest = self.under_way.as_ref().map_or(Duration::ZERO, |u| {
+            u.budget.saturating_sub(u.started.elapsed())
+        });
+        rest + self.waiting.iter().take(ahead).map(|w| w.budget).sum()
+    }
+}
+
+/// Everything a replan needs, owned, for its thread.
+struct Job {
+    scenario: Scenario,
+    vehicle: usize,
+    t0: f64,
+    p0: Vec3,
+    heading: Option<Vec3>,
+    current: Trajectory,
+    resume_s: Option<f64>,
+    others: Vec<Trajectory>,
+    arrival_s: f64,
+    budget: Duration,
+    separation_buffer_m: f64,
+    seed: u64,
+    ground: Option<Arc<CrawlerGround>>,
+}
+
+impl Job {
+    fn run(&self) -> Replanned {
+        let request = Request {
+            scenario: &self.scenario,
+            vehicle: self.vehicle,
+            t0: self.t0,
+            p0: self.p0,
+            heading: self.heading,
+            current: &self.current,
+            resume_s: self.resume_s,
+            others: &self.others,
+            arrival_s: self.arrival_s,
+            budget: self.budget,
+            separation_buffer_m: self.separation_buffer_m,
+            seed: self.seed,
+            ground: self.ground.as_deref(),
+        };
+        // A tour must still pass its remaining inspection points, an energy plan (seed 001)
+        // keeps the path its cost chose over the seabed, its turning radius and the current,
+        // and a coverage crawler (seed 002) must still drive its remaining rows, none of which
+        // seed 004's replan models: all three are repaired, not replanned.
+        let algorithm = self.scenario.optimizer.algorithm;
+        if algorithm.is_tour_planner()
+            || algorithm.is_energy_planner()
+            || self.scenario.coverage.is_some()
+        {
+            repair::repair(&request)
+        } else {
+            replan::replan(&request)
+        }
+    }
+}
+
+/// The budget of vehicle `i`'s next replan: a holding vehicle is safe where it is, so each
+/// retry may think longer: the budget doubles per failed retry, up to 8 ×.
+fn budget(x: &Exec, i: usize) -> Duration {
+    if x.fleet.vehicles[i].holding {
+        x.options.replan_budget * (1u32 << x.hold_retries[i].min(3))
+    } else {
+        x.options.replan_budget
+    }
+}
+
+/// Why vehicle `i`'s predicted course from now until mission time `until` is not safe (it
+/// enters a hard obstacle or comes within d_min of another vehicle), or `None`.
+fn course_blocked(x: &Exec, i: usize, until: f64) -> Option<String> {
+    let now = x.clock();
+    let course: Vec<Trajectory> = x
+        .fleet
+        .predictions_over(now, (until - now).max(0.0))
+        .iter()
+        .map(|p| p.until(until))
+        .collect();
+    if course_enters_obstacle(&course[i], &x.scenario) {
+        return Some("its course enters a hard obstacle".to_string());
+    }
+    course_conflict(&course, i, x.fleet.d_min).map(|c| {
+        let other = if c.a == i { c.b } else { c.a };
+        format!(
+            "its course comes {:.1} m from {} at t = {:.0} s",
+            c.min_distance_m, x.fleet.vehicles[other].id, c.at_s
+        )
+    })
+}
+
+/// Asks for a replan of vehicle `i`: started at once when none is under way, else queued. A
+/// vehicle under way whose course until its update could take effect is not safe is told to
+/// hold instead (obeyed at once; its retries start from there).
+pub(super) fn request(x: &mut Exec, i: usize, why: &str, obstacle_received: Option<Instant>) {
+    let o = x.options;
+    let waiting_at = x.queue.waiting.iter().position(|w| w.vehicle == i);
+    // When its update could take effect at the earliest (when it starts at once, `start`
+    // looks).
+    let effect = match (&x.queue.under_way, waiting_at) {
+        (None, _) => None,
+        (Some(u), _) if u.vehicle == i => Some(u.t0),
+        (Some(_), Some(k)) => Some(
+            x.clock()
+                + x.queue.wait_for(k).as_secs_f64() * o.time_scale
+                + update_lead_s(x.queue.waiting[k].budget, o.time_scale),
+        ),
+        (Some(_), None) => Some(
+            x.clock()
+                + x.queue.wait_for(x.queue.waiting.len()).as_secs_f64() * o.time_scale
+                + update_lead_s(budget(x, i), o.time_scale),
+        ),
+    };
+    if let Some(effect) = effect.filter(|_| !x.fleet.vehicles[i].holding) {
+        if let Some(detail) = course_blocked(x, i, effect) {
+            x.queue.waiting.retain(|w| w.vehicle != i);
+            x.last_reaction[i] = Some(Instant::now());
+            let when = format!("before an update could take effect at t = {effect:.0} s");
+            hold(x, i, why, format!("{detail} {when}"));
+            return;
+        }
+    }
+    if x.queue.busy(i) {
+        return;
+    }
+    x.last_reaction[i] = Some(Instant::now());
+    let w = Waiting {
+        vehicle: i,
+        why: why.to_string(),
+        obstacle_received,
+        budget: budget(x, i),
+    };
+    x.queue.waiting.push_back(w);
+    poll(x);
+}
+
+/// Applies the result of the replan under way when it has come, and starts the next one.
+pub(super) fn poll(x: &mut Exec) {
+    if let Some(u) = &x.queue.under_way {
+        let result = match u.result.try_recv() {
+            Ok(r) => r,
+            Err(TryRecvError::Empty) => return,
+            Err(TryRecvError::Disconnected) => {
+                tracing::error!("the replan thread of {} ended without a result", u.vehicle);
+                failed(u.started, "the replan failed (see the log)".into())
+            }
+        };
+        if let Some(u) = x.queue.under_way.take() {
+            apply(x, u, result);
+        }
+    }
+    while x.queue.under_way.is_none() {
+        let Some(w) = x.queue.waiting.pop_front() else {
+            break;
+        };
+        start(x, w);
+    }
+}
+
+/// A result that found nothing, with `why`.
+fn failed(started: Instant, why: String) -> Replanned {
+    Replanned {
+        trajectory: Trajectory {
+            times: Vec::new(),
+            points: Vec::new(),
+        },
+        safe: false,
+        hard_hits: 0,
+        min_separation_m: f64::INFINITY,
+        elapsed: started.elapsed(),
+        no_way: Some(why),
+        note: None,
+    }
+}
+
+/// Starts the replan `w` on its own thread, or holds the vehicle when its course until the
+/// update could take effect is not safe; nothing for a vehicle that no longer drives.
+fn start(x: &mut Exec, w: Waiting) {
+    let i = w.vehicle;
+    let o = x.options;
+    let v = &x.fleet.vehicles[i];
+    if v.lost || v.arrived_s.is_some() || v.fault_s.is_some() {
+        return;
+    }
+    let holding = v.holding;
+    let now = x.clock();
+    let budget = budget(x, i);
+    let t0 = now + update_lead_s(budget, o.time_scale);
+    if !holding {
+        if let Some(detail) = course_blocked(x, i, t0) {
+            x.last_reaction[i] = Some(Instant::now());
+            let when = format!("before an update could take effect at t = {t0:.0} s");
+            hold(x, i, &w.why, format!("{detail} {when}"));
+            return;
+        }
+    }
+    let remaining = (x.common_arrival_s + o.arrival_window_s - now).max(o.horizon_s);
+    // Long enough to cover the lead (near the end of a fast run it can be the longer).
+    let predictions = x.fleet.predictions_over(now, remaining.max(t0 - now));
+    let p0 = predictions[i].position_at(t0);
+    // The course there: where the prediction was heading over the last few seconds before.
+    let heading = Some(p0 - predictions[i].position_at((t0 - 5.0).max(now)))
+        .filter(|d| d.x.hypot(d.y) > 1e-3 && !holding);
+    // A retry must not repeat the swarm that just failed.
+    let seed =
+        o.seed ^ (u64::from(x.revision) << 8) ^ (u64::from(x.hold_retries[i]) << 32) ^ i as u64;
+    let job = Job {
+        scenario: x.scenario.clone(),
+        vehicle: i,
+        t0,
+        p0,
+        heading,
+        current: x.fleet.vehicles[i].plan.clone(),
+        resume_s: x.fleet.vehicles[i].resume_s(),
+        arrival_s: x.fleet.vehicles[i].planned_arrival_s,
+        budget,
+        separation_buffer_m: o.separation_buffer_m,
+        seed,
+        ground: x.ground.clone(),
+        others: predictions.clone(),
+    };
+    let (tx, rx) = mpsc::channel();
+    let u = UnderWay {
+        vehicle: i,
+        why: w.why,
+        obstacle_received: w.obstacle_received,
+        t0,
+        course: predictions[i].clone(),
+        was_holding: holding,
+        obstacles: x.scenario.obstacles.len(),
+        started: Instant::now(),
+        budget,
+        result: rx,
+    };
+    let name = format!("replan-{}", x.fleet.vehicles[i].id);
+    let spawned = std::thread::Builder::new().name(name).spawn(move || {
+        // The loop may have ended and dropped the receiver: nothing to tell then.
+        let _ = tx.send(job.run());
+    });
+    match spawned {
+        Ok(_) => x.queue.under_way = Some(u),
+        Err(e) => {
+            let result = failed(u.started, format!("cannot start a replan thread: {e}"));
+            apply(x, u, result);
+        }
+    }
+}
+
+/// Whether `t` enters the inflated sphere of a hard obstacle of `scenario` from the
+/// `from`-th on.
+fn enters_new_obstacle(t: &Trajectory, scenario: &Scenario, from: usize) -> bool {
+    scenario.obstacles.iter().skip(from).any(|o| {
+        o.kind == shoal_common::scenario::ObstacleKind::Hard
+            && t.points
+                .windows(2)
+                .any(|w| segment_hits_sphere(&w[0], &w[1], &o.centre(), o.inflated_radius()))
+    })
+}
+
+/// Applies the result of `u`: sends the update, or commands a hold (or, for a vehicle held
+/// already, counts a failed retry). Dropped when the loop learnt meanwhile that the vehicle no
+/// longer drives or was told to hold; planned again at once when it enters an obstacle
+/// published meanwhile.
+fn apply(x: &mut Exec, u: UnderWay, result: Replanned) {
+    let i = u.vehicle;
+    x.last_reaction[i] = Some(Instant::now());
+    x.last_attempt[i] = result.elapsed;
+    let v = &x.fleet.vehicles[i];
+    let id = v.id.clone();
+    if v.lost || v.arrived_s.is_some() || v.fault_s.is_some() || v.holding != u.was_holding {
+        tracing::info!(
+            "{id}'s replan ({}) is dropped: the vehicle's state changed while it ran",
+            u.why
+        );
+        return;
+    }
+    if result.safe && enters_new_obstacle(&result.trajectory, &x.scenario, u.obstacles) {
+        x.queue.waiting.push_front(Waiting {
+            vehicle: i,
+            why: "a new obstacle blocks its path".to_string(),
+            obstacle_received: u.obstacle_received,
+            budget: budget(x, i),
+        });
+        return;
+    }
+    let why = u.why;
+    let t0 = u.t0;
+    if result.safe {
+        x.hold_retries[i] = 0;
+        x.revision += 1;
+        let v = &mut x.fleet.vehicles[i];
+        // Under way, the vehicle goes on as predicted (its old course, its lag included) until
+        // the new one starts at the predicted point; holding, it waits where it is for it. The
+        // plan before now stays, for the record.
+        let plan = if v.holding {
+            result.trajectory.clone()
+        } else {
+            v.plan
+                .followed_by(&u.course.followed_by(&result.trajectory))
+        };
+        v.plan = plan.clone();
+        v.revision = x.revision;
+        v.holding = false;
+        v.held_since_s = None;
+        x.send(
+            &id,
+            CoordinatorToAgent::Update {
+                mission: x.mission.clone(),
+                vehicle: id.clone(),
+                revision: x.revision,
+                trajectory: WireTrajectory::new(&id, &plan),
+            },
+        );
+        x.pending[i] = Some((x.revision, Instant::now()));
+        x.replans += 1;
+        if let Some(received) = u.obstacle_received {
+            x.decisions_ms
+                .push(received.elapsed().as_secs_f64() * 1000.0);
+        }
+        x.publish_plan(vec![id.clone()]);
+        x.event(
+            "replanned",
+            vec![id.clone()],
+            format!(
+                "{id} replanned ({why}) in {:.0} ms: revision {}, from t = {t0:.0} s, arrival {:.0} s, closest vehicle {:.1} m{}",
+                result.elapsed.as_secs_f64() * 1000.0,
+                x.revision,
+                result.trajectory.arrival(),
+                result.min_separation_m,
+                result.note.as_ref().map_or(String::new(), |n| format!("; {n}"))
+            ),
+        );
+    } else if x.fleet.vehicles[i].holding {
+        x.hold_retries[i] += 1;
+        let n = x.hold_retries[i];
+        if told_retry(n) {
+            x.event(
+                "still_holding",
+                vec![id.clone()],
+                format!(
+                    "{id} keeps holding: retry {n} found no safe replan in {:.0} ms ({}); the next event on it comes at retry {}",
+                    result.elapsed.as_secs_f64() * 1000.0,
+                    result.shortfall(),
+                    2 * n
+                ),
+            );
+        }
+    } else {
+        hold(
+            x,
+            i,
+            &why,
+            format!(
+                "no safe replan in {:.0} ms ({})",
+                result.elapsed.as_secs_f64() * 1000.0,
+                result.shortfall()
+            ),
+        );
+    }
+}
+
+/// Whether a held vehicle's failed retry `n` (from 1) gets an event: 1, 2, 4, 8, …. A vehicle
+/// held for good is retried every 30 mission seconds or so ([`super::lead::hold_retry_after`]):
+/// an event for each put 166 in one 10,000 s mission log at 500×.
+fn told_retry(n: u32) -> bool {
+    n.is_power_of_two()
+}
+
+/// Commands vehicle `i` to hold where it is (obeyed at once) and says why.
+fn hold(x: &mut Exec, i: usize, why: &str, detail: String) {
+    let id = x.fleet.vehicles[i].id.clone();
+    x.send(
+        &id,
+        CoordinatorToAgent::Hold {
+            mission: x.mission.clone(),
+            vehicle: id.clone(),
+            reason: why.to_string(),
+        },
+    );
+    let now = x.clock();
+    x.fleet.vehicles[i].holding = true;
+    x.fleet.vehicles[i].held_since_s = Some(now);
+    x.holds += 1;
+    x.event(
+        EVENT_HOLD,
+        vec![id.clone()],
+        format!("{id} told to hold ({why}): {detail}"),
+    );
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use shoal_common::scenario::{Obstacle, ObstacleKind};
+
+    fn waiting(vehicle: usize, ms: u64) -> Waiting {
+        Waiting {
+            vehicle,
+            why: String::new(),
+            obstacle_received: None,
+            budget: Duration::from_millis(ms),
+        }
+    }
+
+    #[test]
+    fn a_replan_waits_for_the_rest_of_the_one_under_way_and_the_budgets_ahead_of_it() {
+        let mut q = ReplanQueue::default();
+        assert_eq!(q.wait_for(0), Duration::ZERO);
+        assert!(!q.busy(0));
+        q.waiting.push_back(waiting(2, 300));
+        q.waiting.push_back(waiting(3, 600));
+        // Nothing under way: the budgets of the two ahead, 300 + 600 ms.
+        assert_eq!(q.wait_for(2), Duration::from_millis(900));
+        assert_eq!(q.wait_for(1), Duration::from_millis(300));
+        let (_tx, rx) = mpsc::channel();
+        q.under_way = Some(UnderWay {
+            vehicle: 1,
+            why: String::new(),
+            obstacle_received: None,
+            t0: 0.0,
+            course: Trajectory {
+                times: Vec::new(),
+                points: Vec::new(),
+            },
+            was_holding: false,
+            obstacles: 0,
+            // Started 1.2 s ago with a 1 s budget: overdue, nothing left of it.
+            started: Instant::now() - Duration::from_millis(1200),
+            budget: Duration::from_secs(1),
+            result: rx,
+        });
+        assert_eq!(q.wait_for(1), Duration::from_millis(300));
+        // Started 400 ms ago with a 2.4 s budget: 2 s or a little less left.
+        if let Some(u) = q.under_way.as_mut() {
+            u.started = Instant::now() - Duration::from_millis(400);
+            u.budget = Duration::from_millis(2400);
+        }
+        let w = q.wait_for(0);
+        assert!(
+            w <= Duration::from_millis(2000) && w > Duration::from_millis(1900),
+            "{w:?}"
+        );
+        assert!(q.busy(1) && q.busy(2) && q.busy(3) && !q.busy(0));
+    }
+
+    #[test]
+    fn only_obstacles_published_since_the_start_are_checked_against_a_result(
+    ) -> Result<(), Box<dyn std::error::Error>> {
+        let file = concat!(env!("CARGO_MANIFEST_DIR"), "/../scenarios/amp-pso-1.toml");
+        let mut s = Scenario::load(std::path::Path::new(file))?;
+        let rock = |id: &str, x: f64, kind: ObstacleKind| Obstacle {
+            id: id.into(),
+            kind,
+            centre: [x, 3.0, 0.0],
+            radius_m: 4.0,
+            inflation_m: 1.0,
+        };
+        s.obstacles = vec![rock("old", 50.0, ObstacleKind::Hard)];
+        // Along the x axis from 0 to 100 m: 3 m from each centre, inside 4 + 1 m.
+        let t = Trajectory {
+            times: vec![0.0, 100.0],
+            points: vec![Vec3::new(0.0, 0.0, 0.0), Vec3::new(100.0, 0.0, 0.0)],
+        };
+        // The one known at the start is the replan's own business.
+        assert!(!enters_new_obstacle(&t, &s, 1));
+        assert!(enters_new_obstacle(&t, &s, 0));
+        s.obstacles.push(rock("soft", 30.0, ObstacleKind::Soft));
+        assert!(!enters_new_obstacle(&t, &s, 1));
+        s.obstacles.push(rock("beyond", 130.0, ObstacleKind::Hard));
+        // (130, 3) is 30.1 m from the end (100, 0).
+        assert!(!enters_new_obstacle(&t, &s, 1));
+        s.obstacles.push(rock("on it", 70.0, ObstacleKind::Hard));
+        assert!(enters_new_obstacle(&t, &s, 1));
+        assert!(!enters_new_obstacle(&t, &s, 4));
+        Ok(())
+    }
+
+    #[test]
+    fn failed_retries_1_2_4_8_and_so_on_are_told() {
+        let told: Vec<u32> = (1..=20).filter(|&n| told_retry(n)).collect();
+        assert_eq!(told, vec![1, 2, 4, 8, 16]);
+        // The 166 retries of a crawler held for good at 500× make 8 events.
+        assert_eq!((1..=166).filter(|&n| told_retry(n)).count(), 8);
+    }
+}
