@@ -9,6 +9,7 @@
 mod detour;
 pub mod fleet;
 mod ground;
+mod keep_out;
 mod lead;
 pub mod log;
 mod react;

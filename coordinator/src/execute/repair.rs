@@ -25,8 +25,9 @@
 //! rejoin is searched there too when the straight line back would cross ground it may not
 //! drive. A vehicle standing still near its path is gone round like an obstacle, and an
 //! obstacle's margin the crawler is already inside is eased to let it out
-//! ([`crawler_scenario`]). A crawler whose finish a keep-out covers ends its path before the
-//! stretch that leads there (its finish is only where its last row ends). A crawler with no
+//! ([`super::keep_out`]). A crawler whose finish a keep-out covers ends its path before the
+//! stretch that leads there (its finish is only where its last row ends), or, already on that
+//! stretch, at the keep-out's edge ([`super::keep_out::drive_to_keep_out`]). A crawler with no
 //! way (none within the search budget, or no map) holds, and the retries start from where it
 //! stopped; the hold says why in words ([`Replanned::shortfall`]).
 //!
@@ -43,6 +44,10 @@ use shoal_common::scenario::{Obstacle, ObstacleKind, Scenario};
 use shoal_common::separation::{motion_separation, Motion};
 use shoal_common::trajectory::Trajectory;
 
+use super::keep_out::{
+    crawler_scenario, drive_to_keep_out, keep_out_at, near_obstacle, MIN_DRIVE_M,
+    WAY_ROUND_MARGIN_M,
+};
 use super::replan::{rebase, Replanned, Request};
 
 /// Whether the leg `a`–`b` enters the inflated sphere of a hard obstacle of `obstacles`.
@@ -68,7 +73,8 @@ struct Repaired {
 /// A coverage crawler's finish is only where its last row ends, so when a keep-out covers it
 /// the crawler ends its path before the blocked stretch that leads there (the same widened
 /// run a way round would replace), rather than hold where it is with the rest of its rows
-/// undone; a tour's or an energy plan's goal is the mission's, and it holds.
+/// undone; already on that stretch, it drives on to the keep-out's edge. A tour's or an energy
+/// plan's goal is the mission's, and it holds.
 fn repaired_path(r: &Request, scenario: &Scenario) -> Result<Repaired, String> {
     let started = Instant::now();
     let crawler = scenario.coverage.is_some();
@@ -148,10 +154,35 @@ fn repaired_path(r: &Request, scenario: &Scenario) -> Result<Repaired, String> {
             let last = j + 2 == pts.len();
             if let Some(o) = last.then(|| keep_out_at(scenario, &to)).flatten() {
                 if k == 0 {
-                    return Err(format!(
-                        "its finish ({:.0}, {:.0}) is inside {}'s keep-out, and it stands on the last stretch before it",
-                        to.x, to.y, o.id
+                    // Already on that stretch: it drives on along it to the keep-out's edge,
+                    // the full margins' (one eased to let the crawler out is not a way in).
+                    let own = r.scenario.obstacles.len();
+                    let edges: Vec<Obstacle> = r
+                        .scenario
+                        .obstacles
+                        .iter()
+                        .chain(&scenario.obstacles[own..])
+                        .cloned()
+                        .collect();
+                    let (driven, short) = drive_to_keep_out(
+                        &edges,
+                        &pts[..=j + 1],
+                        &speeds,
+                        &mut out,
+                        &mut out_speeds,
+                    );
+                    if driven < MIN_DRIVE_M {
+                        return Err(format!(
+                            "its finish ({:.0}, {:.0}) is inside {}'s keep-out, and it stands at the keep-out's edge on the last stretch before it",
+                            to.x, to.y, o.id
+                        ));
+                    }
+                    let end = out[out.len() - 1];
+                    note = Some(format!(
+                        "its finish ({:.0}, {:.0}) is inside {}'s keep-out: it is on the last stretch there, and its path now ends at ({:.0}, {:.0}), at the keep-out's edge, the last {short:.0} m undriven",
+                        to.x, to.y, o.id, end.x, end.y
                     ));
+                    break;
                 }
                 let short: f64 = (k..=j).map(|i| (pts[i + 1] - pts[i]).norm()).sum();
                 note = Some(format!(
@@ -247,87 +278,6 @@ fn blocked_runs(scenario: &Scenario, r: &Request, pts: &[Vec3]) -> Vec<(usize, u
     runs
 }
 
-/// Every other vehicle that stands still over the rest of its prediction (held, lost or
-/// faulted; arrived, once its prediction has settled on its end point), as a hard sphere of
-/// d_min plus the separation buffer round where it stands (a crawler's repair goes round it,
-/// see [`crawler_scenario`]). A re-timing cannot pass a vehicle that stands on the path (the
-/// repair would be unsafe at every timing, and the crawler would wait behind it as long as it
-/// stands): the repair goes round it as round an obstacle, leaving the ground near it
-/// uncovered. A crawler that will already be inside such a sphere at `t0` (a conflict is seen
-/// only `--horizon` ahead) gets a smaller one, down to d_min, that leaves it room to turn away
-/// (and its finish outside, when that keeps d_min); one already within d_min of the standing
-/// vehicle is left to the separation check, which lets it move away. A tour still waits: the
-/// way round would skip the inspection points near the standing vehicle.
-fn stopped_vehicles(r: &Request) -> Vec<Obstacle> {
-    let d_min = r.scenario.fleet.d_min_m;
-    let d = d_min + r.separation_buffer_m.max(0.0);
-    let turn = r.ground.map_or(0.0, |g| g.min_turn_radius_m);
-    let finish = r.current.points.last().copied().unwrap_or(r.p0);
-    if d_min <= 0.0 {
-        return Vec::new();
-    }
-    r.others
-        .iter()
-        .enumerate()
-        .filter(|(j, _)| *j != r.vehicle)
-        .filter_map(|(j, o)| {
-            let at = o.position_at(r.t0);
-            let rest = o.since(r.t0);
-            let still = rest.points.iter().all(|p| (p - at).norm() < STILL_M);
-            // Room left outside the sphere for the crawler's start, which the search needs
-            // free, and for a turn away from it; and for its finish.
-            let dist = (r.p0 - at).norm();
-            let to_finish = (finish - at).norm();
-            let radius = (dist - WAY_ROUND_MARGIN_M - STILL_M - turn)
-                .min(to_finish - WAY_ROUND_MARGIN_M - STILL_M)
-                .clamp(d_min, d);
-            let room = dist >= d_min + WAY_ROUND_MARGIN_M + STILL_M;
-            (still && room).then(|| Obstacle {
-                id: format!("{} (standing still)", r.scenario.vehicles[j].id),
-                kind: ObstacleKind::Hard,
-                centre: at.into(),
-                radius_m: radius,
-                inflation_m: 0.0,
-            })
-        })
-        .collect()
-}
-
-/// The scenario a coverage crawler's repair plans in (`None`: `r.scenario` as it is).
-///
-/// - Every vehicle standing still near its path is an obstacle ([`stopped_vehicles`]).
-/// - A hard obstacle whose margin (its inflation) the crawler is already inside at `t0` (it
-///   appeared there, or the crawler stopped short of it inside) has its margin eased, down to
-///   none, to leave the crawler room to turn away at its turning radius: the way round then
-///   takes it out of the margin, where it would otherwise hold (a search cannot start in a
-///   keep-out) until the obstacle is gone. Its physical sphere is never eased, nor is the
-///   margin of an obstacle the crawler is outside.
-fn crawler_scenario(r: &Request) -> Option<Scenario> {
-    r.scenario.coverage.as_ref()?;
-    let turn = r.ground.map_or(0.0, |g| g.min_turn_radius_m);
-    let mut s = r.scenario.clone();
-    let mut changed = false;
-    for o in s
-        .obstacles
-        .iter_mut()
-        .filter(|o| o.kind == ObstacleKind::Hard)
-    {
-        let dist = (r.p0 - o.centre()).norm();
-        let room = dist - WAY_ROUND_MARGIN_M - STILL_M - turn - o.radius_m;
-        if dist < o.inflated_radius() + WAY_ROUND_MARGIN_M && room < o.inflation_m {
-            o.inflation_m = room.max(0.0);
-            changed = true;
-        }
-    }
-    let stopped = stopped_vehicles(r);
-    changed |= !stopped.is_empty();
-    s.obstacles.extend(stopped);
-    changed.then_some(s)
-}
-
-/// A vehicle whose prediction stays within this of where it is at `t0` stands still, metres.
-const STILL_M: f64 = 1.0;
-
 /// Legs of a crawler's path are cut to at most this long before its blocked runs are found, so
 /// a way round replaces only the stretch near the obstacle, not a whole row.
 const CRAWLER_LEG_M: f64 = 10.0;
@@ -345,23 +295,6 @@ fn split_legs(pts: &[Vec3], speeds: &[f64], max_m: f64) -> (Vec<Vec3>, Vec<f64>)
         }
     }
     (out, out_speeds)
-}
-
-/// Margin a crawler's way round keeps outside the inflated spheres, metres: its points are
-/// checked every half metre on the map and thinned by 5 cm, and a leg that grazed a sphere would
-/// make the repair unsafe.
-const WAY_ROUND_MARGIN_M: f64 = 1.0;
-
-/// Whether `p` is within [`WAY_ROUND_MARGIN_M`] of a hard obstacle's inflated sphere.
-fn near_obstacle(scenario: &Scenario, p: &Vec3) -> bool {
-    keep_out_at(scenario, p).is_some()
-}
-
-/// The first hard obstacle within [`WAY_ROUND_MARGIN_M`] of whose inflated sphere `p` is.
-fn keep_out_at<'s>(scenario: &'s Scenario, p: &Vec3) -> Option<&'s Obstacle> {
-    scenario
-        .hard_obstacles()
-        .find(|o| (p - o.centre()).norm() < o.inflated_radius() + WAY_ROUND_MARGIN_M)
 }
 
 /// A crawler's way round the legs `k..=j` of `pts` ([`WaysRound::between`]), from `pts[k]` on

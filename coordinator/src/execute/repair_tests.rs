@@ -359,7 +359,7 @@ fn a_crawlers_rejoin_goes_round_ground_it_may_not_drive() -> Result<(), Box<dyn 
     // 3 m from the pillar's foot, facing it, the crawler has no way it may drive: it holds.
     r.p0 = p(96.0, 76.0);
     let held = repair(&r);
-    assert!(!held.safe);
+    assert!(!held.safe, "{held:?}");
     assert_eq!(held.trajectory.points, plan.points);
     // The hold says why in words, not as an obstacle intrusion it never had.
     assert_eq!(held.hard_hits, 0);
@@ -401,14 +401,30 @@ fn a_crawlers_finish_inside_a_keep_out_ends_its_path_before_the_stretch_to_it(
     // 0.5 m/s: it finishes at 20 + 140 / 0.5 = 300 s.
     assert!((repaired.trajectory.arrival() - 300.0).abs() < 1e-9);
 
-    // Already on that last stretch, at x = 165, it has nowhere to go: it holds, and says why.
+    // Already on that last stretch, at x = 165: it drives on to 26 m from the rock's centre
+    // (its 25 m keep-out and the 1 m margin of a way round), x = 174, 16 m short of the
+    // finish, which 9 m at 0.5 m/s reach at 310 + 18 = 328 s. Its 25 m to the finish are cut
+    // into three legs of 8.33 m: the first (to x = 173.33) is clear, the second is cut.
     r.t0 = 310.0;
     r.p0 = p(165.0, 150.0);
+    let on_it = repair(&r);
+    assert!(on_it.safe, "{on_it:?}");
+    let pts = &on_it.trajectory.points;
+    assert_eq!(pts.len(), 3, "{pts:?}");
+    assert!((pts[1] - p(165.0 + 25.0 / 3.0, 150.0)).norm() < 1e-9);
+    assert!((pts[2] - p(174.0, 150.0)).norm() < 1e-9, "{pts:?}");
+    assert!((on_it.trajectory.arrival() - 328.0).abs() < 1e-9);
+    assert_eq!(
+        on_it.note.as_deref(),
+        Some("its finish (190, 150) is inside rock's keep-out: it is on the last stretch there, and its path now ends at (174, 150), at the keep-out's edge, the last 16 m undriven")
+    );
+    // At 174.2 m it stands at the edge already: nowhere to go, it holds, and says why.
+    r.p0 = p(174.2, 150.0);
     let held = repair(&r);
     assert!(!held.safe);
     assert_eq!(
         held.shortfall(),
-        "its finish (190, 150) is inside rock's keep-out, and it stands on the last stretch before it"
+        "its finish (190, 150) is inside rock's keep-out, and it stands at the keep-out's edge on the last stretch before it"
     );
     Ok(())
 }
