@@ -194,6 +194,14 @@ pub(super) fn request(x: &mut Exec, i: usize, why: &str, obstacle_received: Opti
         }
     }
     if x.queue.busy(i) {
+        // Its replan plans with the obstacle (waiting) or is checked against it (under way):
+        // the update it sends is the decision on it.
+        if let Some(u) = x.queue.under_way.as_mut().filter(|u| u.vehicle == i) {
+            u.obstacle_received = u.obstacle_received.or(obstacle_received);
+        }
+        if let Some(w) = x.queue.waiting.iter_mut().find(|w| w.vehicle == i) {
+            w.obstacle_received = w.obstacle_received.or(obstacle_received);
+        }
         return;
     }
     x.last_reaction[i] = Some(Instant::now());
