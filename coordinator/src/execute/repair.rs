@@ -417,17 +417,7 @@ pub fn repair(r: &Request) -> Replanned {
         note,
     } = match repaired_path(r, scenario) {
         Ok(p) => p,
-        Err(why) => {
-            return Replanned {
-                trajectory: r.current.clone(),
-                safe: false,
-                hard_hits: 0,
-                min_separation_m: f64::INFINITY,
-                elapsed: started.elapsed(),
-                no_way: Some(why),
-                note: None,
-            }
-        }
+        Err(why) => return Replanned::not_found(r.current.clone(), started, why),
     };
     // The path, hence its obstacle intrusions, is the same at every timing. They are counted
     // on the scenario's own obstacles (a margin the crawler was inside eased as it planned);

@@ -95,6 +95,20 @@ pub struct Replanned {
 }
 
 impl Replanned {
+    /// No path at all, for `why` (in plain words), after the time since `started`; its
+    /// trajectory `trajectory` (the one the vehicle follows, or none) is not to be flown.
+    pub fn not_found(trajectory: Trajectory, started: Instant, why: String) -> Replanned {
+        Replanned {
+            trajectory,
+            safe: false,
+            hard_hits: 0,
+            min_separation_m: f64::INFINITY,
+            elapsed: started.elapsed(),
+            no_way: Some(why),
+            note: None,
+        }
+    }
+
     /// Why the result is not safe, in plain words, for the hold events.
     pub fn shortfall(&self) -> String {
         self.no_way.clone().unwrap_or_else(|| {

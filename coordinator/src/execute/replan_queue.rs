@@ -222,8 +222,13 @@ pub(super) fn poll(x: &mut Exec) {
             Ok(r) => r,
             Err(TryRecvError::Empty) => return,
             Err(TryRecvError::Disconnected) => {
-                tracing::error!("the replan thread of {} ended without a result", u.vehicle);
-                failed(u.started, "the replan failed (see the log)".into())
+                let id = &x.fleet.vehicles[u.vehicle].id;
+                tracing::error!("the replan thread of {id} ended without a result");
+                Replanned::not_found(
+                    no_path(),
+                    u.started,
+                    "the replan failed (see the log)".into(),
+                )
             }
         };
         if let Some(u) = x.queue.under_way.take() {
@@ -238,19 +243,11 @@ pub(super) fn poll(x: &mut Exec) {
     }
 }
 
-/// A result that found nothing, with `why`.
-fn failed(started: Instant, why: String) -> Replanned {
-    Replanned {
-        trajectory: Trajectory {
-            times: Vec::new(),
-            points: Vec::new(),
-        },
-        safe: false,
-        hard_hits: 0,
-        min_separation_m: f64::INFINITY,
-        elapsed: started.elapsed(),
-        no_way: Some(why),
-        note: None,
+/// The trajectory of a replan that never ran.
+fn no_path() -> Trajectory {
+    Trajectory {
+        times: Vec::new(),
+        points: Vec::new(),
     }
 }
 
@@ -321,7 +318,11 @@ fn start(x: &mut Exec, w: Waiting) {
     match spawned {
         Ok(_) => x.queue.under_way = Some(u),
         Err(e) => {
-            let result = failed(u.started, format!("cannot start a replan thread: {e}"));
+            let result = Replanned::not_found(
+                no_path(),
+                u.started,
+                format!("cannot start a replan thread: {e}"),
+            );
             apply(x, u, result);
         }
     }
