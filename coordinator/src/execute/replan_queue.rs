@@ -282,6 +282,7 @@ fn start(x: &mut Exec, w: Waiting) {
     // A retry must not repeat the swarm that just failed.
     let seed =
         o.seed ^ (u64::from(x.revision) << 8) ^ (u64::from(x.hold_retries[i]) << 32) ^ i as u64;
+    let course = predictions[i].clone();
     let job = Job {
         scenario: x.scenario.clone(),
         vehicle: i,
@@ -295,7 +296,7 @@ fn start(x: &mut Exec, w: Waiting) {
         separation_buffer_m: o.separation_buffer_m,
         seed,
         ground: x.ground.clone(),
-        others: predictions.clone(),
+        others: predictions,
     };
     let (tx, rx) = mpsc::channel();
     let u = UnderWay {
@@ -303,7 +304,7 @@ fn start(x: &mut Exec, w: Waiting) {
         why: w.why,
         obstacle_received: w.obstacle_received,
         t0,
-        course: predictions[i].clone(),
+        course,
         was_holding: holding,
         obstacles: x.scenario.obstacles.len(),
         started: Instant::now(),
