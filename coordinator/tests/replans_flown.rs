@@ -72,6 +72,7 @@ fn every_replanned_crossing_is_flown_to_an_arrival_on_time() -> TestResult {
             separation_buffer_m: 10.0,
             seed,
             ground: None,
+            stop: None,
         });
         let plan = plans[1].followed_by(&out.trajectory);
         let model = SimModel::Auv {

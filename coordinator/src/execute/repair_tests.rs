@@ -49,6 +49,7 @@ fn request<'a>(s: &'a Scenario, current: &'a Trajectory, others: &'a [Trajectory
         separation_buffer_m: 0.0,
         seed: 1,
         ground: None,
+        stop: None,
     }
 }
 

@@ -15,7 +15,8 @@
 //! vehicle is on to the first leg, is held to the same limit as every other turn
 //! ([`VehicleProblem::entering_along`]).
 
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use rand::rngs::StdRng;
@@ -72,6 +73,10 @@ pub struct Request<'a> {
     /// A coverage crawler's seabed, for its way round a new obstacle (`None`: there is none,
     /// and a blocked crawler holds).
     pub ground: Option<&'a CrawlerGround>,
+    /// Raised: the swarm stops at its next iteration and the best so far is the answer (a held
+    /// vehicle's retry yields to a vehicle under way, `replan_queue`). A repair ignores it: it
+    /// is a search of tens of milliseconds, bounded by the budget.
+    pub stop: Option<Arc<AtomicBool>>,
 }
 
 /// A replanned trajectory.
@@ -374,6 +379,7 @@ pub fn replan(r: &Request) -> Replanned {
         max_iterations: 10_000,
         // The warm starts (the A* way round) came out of the same budget.
         time_limit: Some(r.budget.saturating_sub(started.elapsed())),
+        stop: r.stop.clone(),
         ..Executor::default()
     };
     let mut solver = Pso::adaptive(PARTICLES, r.seed);
@@ -427,6 +433,52 @@ mod tests {
         }
         // 1 m/s, inside the range.
         assert!(g[9..].iter().all(|v| (v - 1.0).abs() < 1e-9), "{g:?}");
+    }
+
+    #[test]
+    fn a_raised_stop_flag_ends_the_swarm_long_before_its_budget(
+    ) -> Result<(), Box<dyn std::error::Error>> {
+        let file = concat!(env!("CARGO_MANIFEST_DIR"), "/../scenarios/amp-pso-1.toml");
+        let s = Scenario::load(std::path::Path::new(file))?;
+        let plans: Vec<Trajectory> = s
+            .vehicles
+            .iter()
+            .map(|v| Trajectory {
+                times: vec![0.0, 2100.0],
+                points: vec![v.start(), v.goal()],
+            })
+            .collect();
+        let stop = Arc::new(AtomicBool::new(true));
+        let r = Request {
+            scenario: &s,
+            vehicle: 0,
+            t0: 100.0,
+            p0: plans[0].position_at(100.0),
+            heading: None,
+            current: &plans[0],
+            resume_s: None,
+            others: &plans,
+            arrival_s: 2100.0,
+            budget: Duration::from_secs(5),
+            separation_buffer_m: 10.0,
+            seed: 1,
+            ground: None,
+            stop: Some(Arc::clone(&stop)),
+        };
+        let out = replan(&r);
+        // It still answers: the warm start, the rest of the straight plan.
+        assert_eq!(out.trajectory.points.len(), s.optimizer.waypoints + 2);
+        // Not raised, the swarm runs to its budget or its iteration cap: 813 ms against 266 ms
+        // stopped (most of that the coarse way round, which the flag does not stop).
+        stop.store(false, Ordering::Relaxed);
+        let full = replan(&r);
+        assert!(
+            out.elapsed * 2 < full.elapsed,
+            "stopped {:?}, not stopped {:?}",
+            out.elapsed,
+            full.elapsed
+        );
+        Ok(())
     }
 
     #[test]

@@ -5,7 +5,10 @@
 //! one at a time, and its result applied on the loop when it comes ([`poll`]).
 //!
 //! One at a time, as before: each replan plans against the others' plans as they are when it
-//! starts, so two replans at once could each plan into the other's old path. What the loop
+//! starts, so two replans at once could each plan into the other's old path. A vehicle under
+//! way goes first: its replan is queued before every held vehicle's retry, and a retry under
+//! way yields to it (its swarm stops at the next iteration with its best so far; cut short and
+//! not safe, it is not counted as a failed retry). A held vehicle is safe where it is. What the loop
 //! learns while one thinks is checked when its result comes: a vehicle lost, arrived or told
 //! to hold meanwhile drops it; a result that enters an obstacle published meanwhile is planned
 //! again at once. And a vehicle that must wait its turn is held at once when its course until
@@ -13,6 +16,7 @@
 //! [`super::lead`]).
 
 use std::collections::VecDeque;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::{self, Receiver, TryRecvError};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -61,6 +65,15 @@ struct UnderWay {
     started: Instant,
     budget: Duration,
     result: Receiver<Replanned>,
+    /// Raised when a held vehicle's retry yields to a vehicle under way.
+    stop: Arc<AtomicBool>,
+}
+
+impl UnderWay {
+    /// Whether it is a held vehicle's retry told to yield.
+    fn yielded(&self) -> bool {
+        self.stop.load(Ordering::Relaxed)
+    }
 }
 
 impl ReplanQueue {
@@ -71,12 +84,34 @@ impl ReplanQueue {
     }
 
     /// Wall time until a replan queued behind the first `ahead` waiting ones starts: the rest of
-    /// the budget of the one under way plus the budgets of those.
+    /// the budget of the one under way (none once it yields) plus the budgets of those.
     fn wait_for(&self, ahead: usize) -> Duration {
-        let rest = self.under_way.as_ref().map_or(Duration::ZERO, |u| {
-            u.budget.saturating_sub(u.started.elapsed())
-        });
+        let rest = self
+            .under_way
+            .as_ref()
+            .filter(|u| !u.yielded())
+            .map_or(Duration::ZERO, |u| {
+                u.budget.saturating_sub(u.started.elapsed())
+            });
         rest + self.waiting.iter().take(ahead).map(|w| w.budget).sum()
+    }
+
+    /// Where a replan of a vehicle under way is queued: before every held vehicle's retry
+    /// (`holding` tells which vehicles hold). A held vehicle is safe where it is; one under way
+    /// drives on into what it must avoid while it waits.
+    fn slot(&self, holding: impl Fn(usize) -> bool) -> usize {
+        self.waiting
+            .iter()
+            .position(|w| holding(w.vehicle))
+            .unwrap_or(self.waiting.len())
+    }
+
+    /// A held vehicle's retry under way stops at its next iteration and gives its best so far
+    /// (for a vehicle under way that needs the thread, see [`Self::slot`]).
+    fn yield_retry(&self) {
+        if let Some(u) = self.under_way.as_ref().filter(|u| u.was_holding) {
+            u.stop.store(true, Ordering::Relaxed);
+        }
     }
 }
 
@@ -95,6 +130,7 @@ struct Job {
     separation_buffer_m: f64,
     seed: u64,
     ground: Option<Arc<CrawlerGround>>,
+    stop: Arc<AtomicBool>,
 }
 
 impl Job {
@@ -113,6 +149,7 @@ impl Job {
             separation_buffer_m: self.separation_buffer_m,
             seed: self.seed,
             ground: self.ground.as_deref(),
+            stop: Some(Arc::clone(&self.stop)),
         };
         // A tour must still pass its remaining inspection points, an energy plan (seed 001)
         // keeps the path its cost chose over the seabed, its turning radius and the current,
@@ -167,7 +204,13 @@ fn course_blocked(x: &Exec, i: usize, until: f64) -> Option<String> {
 /// hold instead (obeyed at once; its retries start from there).
 pub(super) fn request(x: &mut Exec, i: usize, why: &str, obstacle_received: Option<Instant>) {
     let o = x.options;
+    let holding = x.fleet.vehicles[i].holding;
+    if !holding && !x.queue.busy(i) {
+        x.queue.yield_retry();
+    }
     let waiting_at = x.queue.waiting.iter().position(|w| w.vehicle == i);
+    let fleet = &x.fleet;
+    let slot = x.queue.slot(|j| fleet.vehicles[j].holding);
     // When its update could take effect at the earliest (when it starts at once, `start`
     // looks).
     let effect = match (&x.queue.under_way, waiting_at) {
@@ -180,11 +223,11 @@ pub(super) fn request(x: &mut Exec, i: usize, why: &str, obstacle_received: Opti
         ),
         (Some(_), None) => Some(
             x.clock()
-                + x.queue.wait_for(x.queue.waiting.len()).as_secs_f64() * o.time_scale
+                + x.queue.wait_for(slot).as_secs_f64() * o.time_scale
                 + update_lead_s(budget(x, i), o.time_scale),
         ),
     };
-    if let Some(effect) = effect.filter(|_| !x.fleet.vehicles[i].holding) {
+    if let Some(effect) = effect.filter(|_| !holding) {
         if let Some(detail) = course_blocked(x, i, effect) {
             x.queue.waiting.retain(|w| w.vehicle != i);
             x.last_reaction[i] = Some(Instant::now());
@@ -211,7 +254,11 @@ pub(super) fn request(x: &mut Exec, i: usize, why: &str, obstacle_received: Opti
         obstacle_received,
         budget: budget(x, i),
     };
-    x.queue.waiting.push_back(w);
+    if holding {
+        x.queue.waiting.push_back(w);
+    } else {
+        x.queue.waiting.insert(slot, w);
+    }
     poll(x);
 }
 
@@ -283,6 +330,7 @@ fn start(x: &mut Exec, w: Waiting) {
     let seed =
         o.seed ^ (u64::from(x.revision) << 8) ^ (u64::from(x.hold_retries[i]) << 32) ^ i as u64;
     let course = predictions[i].clone();
+    let stop = Arc::new(AtomicBool::new(false));
     let job = Job {
         scenario: x.scenario.clone(),
         vehicle: i,
@@ -297,6 +345,7 @@ fn start(x: &mut Exec, w: Waiting) {
         seed,
         ground: x.ground.clone(),
         others: predictions,
+        stop: Arc::clone(&stop),
     };
     let (tx, rx) = mpsc::channel();
     let u = UnderWay {
@@ -310,6 +359,7 @@ fn start(x: &mut Exec, w: Waiting) {
         started: Instant::now(),
         budget,
         result: rx,
+        stop,
     };
     let name = format!("replan-{}", x.fleet.vehicles[i].id);
     let spawned = std::thread::Builder::new().name(name).spawn(move || {
@@ -364,6 +414,10 @@ fn apply(x: &mut Exec, u: UnderWay, result: Replanned) {
             obstacle_received: u.obstacle_received,
             budget: budget(x, i),
         });
+        return;
+    }
+    if u.yielded() && !result.safe {
+        // Cut short for a vehicle under way: not a failed retry (its budget does not double).
         return;
     }
     let why = u.why;
@@ -472,97 +526,5 @@ fn hold(x: &mut Exec, i: usize, why: &str, detail: String) {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use shoal_common::scenario::{Obstacle, ObstacleKind};
-
-    fn waiting(vehicle: usize, ms: u64) -> Waiting {
-        Waiting {
-            vehicle,
-            why: String::new(),
-            obstacle_received: None,
-            budget: Duration::from_millis(ms),
-        }
-    }
-
-    #[test]
-    fn a_replan_waits_for_the_rest_of_the_one_under_way_and_the_budgets_ahead_of_it() {
-        let mut q = ReplanQueue::default();
-        assert_eq!(q.wait_for(0), Duration::ZERO);
-        assert!(!q.busy(0));
-        q.waiting.push_back(waiting(2, 300));
-        q.waiting.push_back(waiting(3, 600));
-        // Nothing under way: the budgets of the two ahead, 300 + 600 ms.
-        assert_eq!(q.wait_for(2), Duration::from_millis(900));
-        assert_eq!(q.wait_for(1), Duration::from_millis(300));
-        let (_tx, rx) = mpsc::channel();
-        q.under_way = Some(UnderWay {
-            vehicle: 1,
-            why: String::new(),
-            obstacle_received: None,
-            t0: 0.0,
-            course: Trajectory {
-                times: Vec::new(),
-                points: Vec::new(),
-            },
-            was_holding: false,
-            obstacles: 0,
-            // Started 1.2 s ago with a 1 s budget: overdue, nothing left of it.
-            started: Instant::now() - Duration::from_millis(1200),
-            budget: Duration::from_secs(1),
-            result: rx,
-        });
-        assert_eq!(q.wait_for(1), Duration::from_millis(300));
-        // Started 400 ms ago with a 2.4 s budget: 2 s or a little less left.
-        if let Some(u) = q.under_way.as_mut() {
-            u.started = Instant::now() - Duration::from_millis(400);
-            u.budget = Duration::from_millis(2400);
-        }
-        let w = q.wait_for(0);
-        assert!(
-            w <= Duration::from_millis(2000) && w > Duration::from_millis(1900),
-            "{w:?}"
-        );
-        assert!(q.busy(1) && q.busy(2) && q.busy(3) && !q.busy(0));
-    }
-
-    #[test]
-    fn only_obstacles_published_since_the_start_are_checked_against_a_result(
-    ) -> Result<(), Box<dyn std::error::Error>> {
-        let file = concat!(env!("CARGO_MANIFEST_DIR"), "/../scenarios/amp-pso-1.toml");
-        let mut s = Scenario::load(std::path::Path::new(file))?;
-        let rock = |id: &str, x: f64, kind: ObstacleKind| Obstacle {
-            id: id.into(),
-            kind,
-            centre: [x, 3.0, 0.0],
-            radius_m: 4.0,
-            inflation_m: 1.0,
-        };
-        s.obstacles = vec![rock("old", 50.0, ObstacleKind::Hard)];
-        // Along the x axis from 0 to 100 m: 3 m from each centre, inside 4 + 1 m.
-        let t = Trajectory {
-            times: vec![0.0, 100.0],
-            points: vec![Vec3::new(0.0, 0.0, 0.0), Vec3::new(100.0, 0.0, 0.0)],
-        };
-        // The one known at the start is the replan's own business.
-        assert!(!enters_new_obstacle(&t, &s, 1));
-        assert!(enters_new_obstacle(&t, &s, 0));
-        s.obstacles.push(rock("soft", 30.0, ObstacleKind::Soft));
-        assert!(!enters_new_obstacle(&t, &s, 1));
-        s.obstacles.push(rock("beyond", 130.0, ObstacleKind::Hard));
-        // (130, 3) is 30.1 m from the end (100, 0).
-        assert!(!enters_new_obstacle(&t, &s, 1));
-        s.obstacles.push(rock("on it", 70.0, ObstacleKind::Hard));
-        assert!(enters_new_obstacle(&t, &s, 1));
-        assert!(!enters_new_obstacle(&t, &s, 4));
-        Ok(())
-    }
-
-    #[test]
-    fn failed_retries_1_2_4_8_and_so_on_are_told() {
-        let told: Vec<u32> = (1..=20).filter(|&n| told_retry(n)).collect();
-        assert_eq!(told, vec![1, 2, 4, 8, 16]);
-        // The 166 retries of a crawler held for good at 500× make 8 events.
-        assert_eq!((1..=166).filter(|&n| told_retry(n)).count(), 8);
-    }
-}
+#[path = "replan_queue_tests.rs"]
+mod tests;

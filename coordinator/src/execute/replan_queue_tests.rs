@@ -1,0 +1,121 @@
+//! Unit tests of `execute::replan_queue`.
+
+use super::*;
+use shoal_common::scenario::{Obstacle, ObstacleKind};
+
+fn waiting(vehicle: usize, ms: u64) -> Waiting {
+    Waiting {
+        vehicle,
+        why: String::new(),
+        obstacle_received: None,
+        budget: Duration::from_millis(ms),
+    }
+}
+
+#[test]
+fn a_replan_waits_for_the_rest_of_the_one_under_way_and_the_budgets_ahead_of_it() {
+    let mut q = ReplanQueue::default();
+    assert_eq!(q.wait_for(0), Duration::ZERO);
+    assert!(!q.busy(0));
+    q.waiting.push_back(waiting(2, 300));
+    q.waiting.push_back(waiting(3, 600));
+    // Nothing under way: the budgets of the two ahead, 300 + 600 ms.
+    assert_eq!(q.wait_for(2), Duration::from_millis(900));
+    assert_eq!(q.wait_for(1), Duration::from_millis(300));
+    let (_tx, rx) = mpsc::channel();
+    q.under_way = Some(UnderWay {
+        vehicle: 1,
+        why: String::new(),
+        obstacle_received: None,
+        t0: 0.0,
+        course: Trajectory {
+            times: Vec::new(),
+            points: Vec::new(),
+        },
+        was_holding: false,
+        obstacles: 0,
+        // Started 1.2 s ago with a 1 s budget: overdue, nothing left of it.
+        started: Instant::now() - Duration::from_millis(1200),
+        budget: Duration::from_secs(1),
+        result: rx,
+        stop: Arc::new(AtomicBool::new(false)),
+    });
+    assert_eq!(q.wait_for(1), Duration::from_millis(300));
+    // Started 400 ms ago with a 2.4 s budget: 2 s or a little less left.
+    if let Some(u) = q.under_way.as_mut() {
+        u.started = Instant::now() - Duration::from_millis(400);
+        u.budget = Duration::from_millis(2400);
+    }
+    let w = q.wait_for(0);
+    assert!(
+        w <= Duration::from_millis(2000) && w > Duration::from_millis(1900),
+        "{w:?}"
+    );
+    assert!(q.busy(1) && q.busy(2) && q.busy(3) && !q.busy(0));
+    // It is no held vehicle's retry: it does not yield.
+    q.yield_retry();
+    assert!(q.wait_for(0) > Duration::from_millis(1900));
+    // A held vehicle's retry yields: nothing left of it to wait for.
+    if let Some(u) = q.under_way.as_mut() {
+        u.was_holding = true;
+    }
+    q.yield_retry();
+    assert!(q.under_way.as_ref().is_some_and(|u| u.yielded()));
+    assert_eq!(q.wait_for(0), Duration::ZERO);
+    assert_eq!(q.wait_for(2), Duration::from_millis(900));
+}
+
+#[test]
+fn a_vehicle_under_way_is_queued_before_every_held_vehicles_retry() {
+    let mut q = ReplanQueue::default();
+    assert_eq!(q.slot(|_| false), 0);
+    // Vehicles 2 and 5 are under way, 3 and 4 hold.
+    let holding = |j: usize| j == 3 || j == 4;
+    for v in [2, 3, 5, 4] {
+        q.waiting.push_back(waiting(v, 300));
+    }
+    // Before 3, the first held one.
+    assert_eq!(q.slot(holding), 1);
+    assert_eq!(q.slot(|_| false), 4);
+    assert_eq!(q.slot(|_| true), 0);
+}
+
+#[test]
+fn only_obstacles_published_since_the_start_are_checked_against_a_result(
+) -> Result<(), Box<dyn std::error::Error>> {
+    let file = concat!(env!("CARGO_MANIFEST_DIR"), "/../scenarios/amp-pso-1.toml");
+    let mut s = Scenario::load(std::path::Path::new(file))?;
+    let rock = |id: &str, x: f64, kind: ObstacleKind| Obstacle {
+        id: id.into(),
+        kind,
+        centre: [x, 3.0, 0.0],
+        radius_m: 4.0,
+        inflation_m: 1.0,
+    };
+    s.obstacles = vec![rock("old", 50.0, ObstacleKind::Hard)];
+    // Along the x axis from 0 to 100 m: 3 m from each centre, inside 4 + 1 m.
+    let t = Trajectory {
+        times: vec![0.0, 100.0],
+        points: vec![Vec3::new(0.0, 0.0, 0.0), Vec3::new(100.0, 0.0, 0.0)],
+    };
+    // The one known at the start is the replan's own business.
+    assert!(!enters_new_obstacle(&t, &s, 1));
+    assert!(enters_new_obstacle(&t, &s, 0));
+    s.obstacles.push(rock("soft", 30.0, ObstacleKind::Soft));
+    assert!(!enters_new_obstacle(&t, &s, 1));
+    s.obstacles.push(rock("beyond", 130.0, ObstacleKind::Hard));
+    // (130, 3) is 30.1 m from the end (100, 0).
+    assert!(!enters_new_obstacle(&t, &s, 1));
+    s.obstacles.push(rock("on it", 70.0, ObstacleKind::Hard));
+    assert!(enters_new_obstacle(&t, &s, 1));
+    assert!(!enters_new_obstacle(&t, &s, 4));
+    Ok(())
+}
+
+#[test]
+fn failed_retries_1_2_4_8_and_so_on_are_told() {
+    let told: Vec<u32> = (1..=20).filter(|&n| told_retry(n)).collect();
+    assert_eq!(told, vec![1, 2, 4, 8, 16]);
+    // The 166 retries of a crawler held for good at 500× make 8 events.
+    assert_eq!((1..=166).filter(|&n| told_retry(n)).count(), 8);
+}
