@@ -20,6 +20,7 @@
 //! limit; a shortcut is taken only when it is no steeper either.
 
 use std::collections::BinaryHeap;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 use shoal_common::cost::SEABED_STEP_M;
 use shoal_common::geometry::{segment_hits_sphere, Vec3};
@@ -53,6 +54,8 @@ const SHORTCUT_GROW: f64 = 1.08;
 const SEABED_MARGIN_M: f64 = 1.0;
 /// Cells along the longer horizontal side of the bounds.
 const CELLS: f64 = 40.0;
+/// Nodes the search expands between two looks at its stop flag.
+const STOP_EVERY: usize = 1024;
 /// Layers are this fraction of the height a one-cell move may climb.
 const LAYER_FRACTION: f64 = 0.95;
 
@@ -127,8 +130,9 @@ impl Grid {
     }
 
     /// A* from `from` to `to` over free nodes (the two end nodes are allowed even if blocked:
-    /// the vehicle is where it is), as node centres.
-    fn search(&self, from: usize, to: usize) -> Option<Vec<usize>> {
+    /// the vehicle is where it is), as node centres; `None` also once `stop` is raised (looked
+    /// at every [`STOP_EVERY`] nodes).
+    fn search(&self, from: usize, to: usize, stop: Option<&AtomicBool>) -> Option<Vec<usize>> {
         let total = self.blocked.len();
         let mut best = vec![f64::INFINITY; total];
         let mut came = vec![usize::MAX; total];
@@ -136,7 +140,13 @@ impl Grid {
         let goal = self.centre(to);
         best[from] = 0.0;
         open.push(Cheapest(Grid::cost(self.centre(from), goal), from));
+        let mut popped = 0usize;
         while let Some(Cheapest(_, k)) = open.pop() {
+            if popped.is_multiple_of(STOP_EVERY) && stop.is_some_and(|s| s.load(Ordering::Relaxed))
+            {
+                return None;
+            }
+            popped += 1;
             if k == to {
                 let mut path = vec![to];
                 let mut at = to;
@@ -204,20 +214,23 @@ fn flyable(scenario: &Scenario, a: &Vec3, b: &Vec3, max_pitch: f64, seabed: Keep
 
 /// A way from `from` to `to` round the scenario's hard obstacles (and over the seabed a
 /// swimmer keeps off, [`keep_off`]), no steeper than `max_pitch_deg` (see the module doc): the
-/// corners of the shortened grid path, from `from` to `to`. `None` when the grid has no way.
+/// corners of the shortened grid path, from `from` to `to`. `None` when the grid has no way, or
+/// once `stop` is raised (a held vehicle's retry yielding, `replan_queue`: the search takes a
+/// few hundred milliseconds on seed 004's scenarios).
 pub fn detour(
     scenario: &Scenario,
     from: Vec3,
     to: Vec3,
     max_pitch_deg: f64,
     seabed: KeepOff,
+    stop: Option<&AtomicBool>,
 ) -> Option<Vec<Vec3>> {
     let max_pitch = max_pitch_deg.to_radians();
     if flyable(scenario, &from, &to, max_pitch, seabed) {
         return Some(vec![from, to]);
     }
     let grid = Grid::new(scenario, max_pitch, seabed);
-    let cells = grid.search(grid.nearest(from), grid.nearest(to))?;
+    let cells = grid.search(grid.nearest(from), grid.nearest(to), stop)?;
     let mut raw = vec![from];
     // The end nodes stand for `from` and `to` themselves.
     raw.extend(
@@ -294,7 +307,7 @@ mod tests {
             Vec3::new(100.0, 500.0, 200.0),
             Vec3::new(1900.0, 500.0, 200.0),
         );
-        assert_eq!(detour(&s, a, b, 20.0, None), Some(vec![a, b]));
+        assert_eq!(detour(&s, a, b, 20.0, None, None), Some(vec![a, b]));
         Ok(())
     }
 
@@ -306,7 +319,7 @@ mod tests {
         // spheres' centres, the inflated wall ends at y = 1250 + √(200² − 100²) ≈ 1423.
         let s = scenario(&wall(6, 250.0))?;
         let (a, b) = across();
-        let path = detour(&s, a, b, 20.0, None).ok_or("no detour")?;
+        let path = detour(&s, a, b, 20.0, None, None).ok_or("no detour")?;
         assert_eq!(path.first(), Some(&a));
         assert_eq!(path.last(), Some(&b));
         for w in path.windows(2) {
@@ -314,6 +327,11 @@ mod tests {
         }
         let north = path.iter().map(|p| p.y).fold(f64::MIN, f64::max);
         assert!(north > 1423.0, "{path:?}");
+        // A raised stop flag ends the search (a straight line, above, needs none).
+        assert_eq!(
+            detour(&s, a, b, 20.0, None, Some(&AtomicBool::new(true))),
+            None
+        );
         // Round the end: at least 2 × √(800² + 923²) ≈ 2443 m (two straight lines to the
         // wall's end); the grid and the shortcuts' margin add a little, never much.
         let l = length(&path);
@@ -326,7 +344,7 @@ mod tests {
         // Spheres every 200 m along x = 1000, at both heights, over the whole width.
         let s = scenario(&wall(11, 200.0))?;
         let (a, b) = across();
-        assert_eq!(detour(&s, a, b, 20.0, None), None);
+        assert_eq!(detour(&s, a, b, 20.0, None, None), None);
         Ok(())
     }
 
@@ -340,7 +358,7 @@ mod tests {
             Vec3::new(100.0, 1000.0, 0.0),
             Vec3::new(300.0, 1000.0, 400.0),
         );
-        let path = detour(&s, a, b, 20.0, None).ok_or("no way up")?;
+        let path = detour(&s, a, b, 20.0, None, None).ok_or("no way up")?;
         assert_eq!((path.first(), path.last()), (Some(&a), Some(&b)));
         let legs = path.len() - 1;
         for (k, w) in path.windows(2).enumerate() {
@@ -373,7 +391,7 @@ mod tests {
             Vec3::new(2000.0, 1000.0, 100.0),
         );
         assert!(hill.lowest_height_along(&a, &b, 1.0).0 < -100.0);
-        let way = detour(&s, a, b, 20.0, Some((&hill, 2.0))).ok_or("no way over the hill")?;
+        let way = detour(&s, a, b, 20.0, Some((&hill, 2.0)), None).ok_or("no way over the hill")?;
         assert!(way.len() > 2, "{way:?}");
         assert_eq!((way[0], way[way.len() - 1]), (a, b));
         for w in way.windows(2) {
@@ -385,7 +403,7 @@ mod tests {
                 "{way:?}"
             );
         }
-        assert_eq!(detour(&s, a, b, 20.0, None), Some(vec![a, b]));
+        assert_eq!(detour(&s, a, b, 20.0, None, None), Some(vec![a, b]));
         Ok(())
     }
 }

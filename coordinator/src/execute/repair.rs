@@ -210,6 +210,7 @@ fn repaired_path(r: &Request, scenario: &Scenario) -> Result<Repaired, String> {
                 to,
                 scenario.vehicles[r.vehicle].max_pitch_deg,
                 super::detour::keep_off(scenario, r.vehicle),
+                r.stop.as_deref(),
             )
             .ok_or_else(stretch)?
         };

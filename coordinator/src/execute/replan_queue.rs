@@ -418,6 +418,8 @@ fn apply(x: &mut Exec, u: UnderWay, result: Replanned) {
     }
     if u.yielded() && !result.safe {
         // Cut short for a vehicle under way: not a failed retry (its budget does not double).
+        let ms = result.elapsed.as_secs_f64() * 1000.0;
+        tracing::info!("{id}'s retry yielded to a vehicle under way after {ms:.0} ms");
         return;
     }
     let why = u.why;
