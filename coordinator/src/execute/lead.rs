@@ -8,7 +8,7 @@ use std::time::Duration;
 
 use shoal_common::execution::picture::{self, Conflict};
 use shoal_common::geometry::segment_hits_sphere;
-use shoal_common::scenario::Scenario;
+use shoal_common::scenario::{Obstacle, ObstacleKind, Scenario};
 use shoal_common::trajectory::Trajectory;
 
 /// How far ahead of now a replan's update takes effect, mission seconds: it must reach the
@@ -52,10 +52,16 @@ pub(super) fn hold_retry_after(
 /// Whether `course` (a vehicle's, from now until the update lead is over) enters a hard
 /// obstacle's inflated sphere.
 pub(super) fn course_enters_obstacle(course: &Trajectory, scenario: &Scenario) -> bool {
+    enters_any(course, &scenario.obstacles)
+}
+
+/// Whether `course` enters the inflated sphere of a hard obstacle of `obstacles`.
+pub(super) fn enters_any(course: &Trajectory, obstacles: &[Obstacle]) -> bool {
     course.points.windows(2).any(|w| {
-        scenario
-            .hard_obstacles()
-            .any(|o| segment_hits_sphere(&w[0], &w[1], &o.centre(), o.inflated_radius()))
+        obstacles.iter().any(|o| {
+            o.kind == ObstacleKind::Hard
+                && segment_hits_sphere(&w[0], &w[1], &o.centre(), o.inflated_radius())
+        })
     })
 }
 

@@ -22,13 +22,13 @@ use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use shoal_common::coverage::reroute::CrawlerGround;
-use shoal_common::geometry::{segment_hits_sphere, Vec3};
+use shoal_common::geometry::Vec3;
 use shoal_common::scenario::Scenario;
 use shoal_common::trajectory::Trajectory;
 use shoal_common::wire::coordinator_to_agent::CoordinatorToAgent;
 use shoal_common::wire::WireTrajectory;
 
-use super::lead::{course_conflict, course_enters_obstacle, update_lead_s};
+use super::lead::{course_conflict, course_enters_obstacle, enters_any, update_lead_s};
 use super::log::EVENT_HOLD;
 use super::replan::{self, Replanned, Request};
 use super::{repair, Exec};
@@ -382,12 +382,7 @@ fn start(x: &mut Exec, w: Waiting) {
 /// Whether `t` enters the inflated sphere of a hard obstacle of `scenario` from the
 /// `from`-th on.
 fn enters_new_obstacle(t: &Trajectory, scenario: &Scenario, from: usize) -> bool {
-    scenario.obstacles.iter().skip(from).any(|o| {
-        o.kind == shoal_common::scenario::ObstacleKind::Hard
-            && t.points
-                .windows(2)
-                .any(|w| segment_hits_sphere(&w[0], &w[1], &o.centre(), o.inflated_radius()))
-    })
+    enters_any(t, scenario.obstacles.get(from..).unwrap_or(&[]))
 }
 
 /// Applies the result of `u`: sends the update, or commands a hold (or, for a vehicle held
