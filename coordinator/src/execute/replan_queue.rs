@@ -51,9 +51,8 @@ struct Waiting {
 
 /// The replan under way on its thread.
 struct UnderWay {
-    vehicle: usize,
-    why: String,
-    obstacle_received: Option<Instant>,
+    /// What was asked for (its budget the one it runs with).
+    asked: Waiting,
     /// Mission time its update takes effect; the vehicle drives `course` until then.
     t0: f64,
     course: Trajectory,
@@ -63,7 +62,6 @@ struct UnderWay {
     /// its result.
     obstacles: usize,
     started: Instant,
-    budget: Duration,
     result: Receiver<Replanned>,
     /// Raised when a held vehicle's retry yields to a vehicle under way.
     stop: Arc<AtomicBool>,
@@ -79,7 +77,9 @@ impl UnderWay {
 impl ReplanQueue {
     /// Whether vehicle `i` has a replan waiting or under way.
     pub(super) fn busy(&self, i: usize) -> bool {
-        self.under_way.as_ref().is_some_and(|u| u.vehicle == i)
+        self.under_way
+            .as_ref()
+            .is_some_and(|u| u.asked.vehicle == i)
             || self.waiting.iter().any(|w| w.vehicle == i)
     }
 
@@ -91,7 +91,7 @@ impl ReplanQueue {
             .as_ref()
             .filter(|u| !u.yielded())
             .map_or(Duration::ZERO, |u| {
-                u.budget.saturating_sub(u.started.elapsed())
+                u.asked.budget.saturating_sub(u.started.elapsed())
             });
         rest + self.waiting.iter().take(ahead).map(|w| w.budget).sum()
     }
@@ -213,19 +213,21 @@ pub(super) fn request(x: &mut Exec, i: usize, why: &str, obstacle_received: Opti
     let slot = x.queue.slot(|j| fleet.vehicles[j].holding);
     // When its update could take effect at the earliest (when it starts at once, `start`
     // looks).
-    let effect = match (&x.queue.under_way, waiting_at) {
-        (None, _) => None,
-        (Some(u), _) if u.vehicle == i => Some(u.t0),
-        (Some(_), Some(k)) => Some(
-            x.clock()
-                + x.queue.wait_for(k).as_secs_f64() * o.time_scale
-                + update_lead_s(x.queue.waiting[k].budget, o.time_scale),
-        ),
-        (Some(_), None) => Some(
-            x.clock()
-                + x.queue.wait_for(slot).as_secs_f64() * o.time_scale
-                + update_lead_s(budget(x, i), o.time_scale),
-        ),
+    let effect = match &x.queue.under_way {
+        None => None,
+        Some(u) if u.asked.vehicle == i => Some(u.t0),
+        Some(_) => {
+            // Its place in the queue (already waiting, or where it would go) and its budget.
+            let (ahead, own) = match waiting_at {
+                Some(k) => (k, x.queue.waiting[k].budget),
+                None => (slot, budget(x, i)),
+            };
+            Some(
+                x.clock()
+                    + x.queue.wait_for(ahead).as_secs_f64() * o.time_scale
+                    + update_lead_s(own, o.time_scale),
+            )
+        }
     };
     if let Some(effect) = effect.filter(|_| !holding) {
         if let Some(detail) = course_blocked(x, i, effect) {
@@ -239,8 +241,8 @@ pub(super) fn request(x: &mut Exec, i: usize, why: &str, obstacle_received: Opti
     if x.queue.busy(i) {
         // Its replan plans with the obstacle (waiting) or is checked against it (under way):
         // the update it sends is the decision on it.
-        if let Some(u) = x.queue.under_way.as_mut().filter(|u| u.vehicle == i) {
-            u.obstacle_received = u.obstacle_received.or(obstacle_received);
+        if let Some(u) = x.queue.under_way.as_mut().filter(|u| u.asked.vehicle == i) {
+            u.asked.obstacle_received = u.asked.obstacle_received.or(obstacle_received);
         }
         if let Some(w) = x.queue.waiting.iter_mut().find(|w| w.vehicle == i) {
             w.obstacle_received = w.obstacle_received.or(obstacle_received);
@@ -269,7 +271,7 @@ pub(super) fn poll(x: &mut Exec) {
             Ok(r) => r,
             Err(TryRecvError::Empty) => return,
             Err(TryRecvError::Disconnected) => {
-                let id = &x.fleet.vehicles[u.vehicle].id;
+                let id = &x.fleet.vehicles[u.asked.vehicle].id;
                 tracing::error!("the replan thread of {id} ended without a result");
                 Replanned::not_found(
                     no_path(),
@@ -349,15 +351,12 @@ fn start(x: &mut Exec, w: Waiting) {
     };
     let (tx, rx) = mpsc::channel();
     let u = UnderWay {
-        vehicle: i,
-        why: w.why,
-        obstacle_received: w.obstacle_received,
+        asked: Waiting { budget, ..w },
         t0,
         course,
         was_holding: holding,
         obstacles: x.scenario.obstacles.len(),
         started: Instant::now(),
-        budget,
         result: rx,
         stop,
     };
@@ -390,7 +389,7 @@ fn enters_new_obstacle(t: &Trajectory, scenario: &Scenario, from: usize) -> bool
 /// longer drives or was told to hold; planned again at once when it enters an obstacle
 /// published meanwhile.
 fn apply(x: &mut Exec, u: UnderWay, result: Replanned) {
-    let i = u.vehicle;
+    let i = u.asked.vehicle;
     x.last_reaction[i] = Some(Instant::now());
     x.last_attempt[i] = result.elapsed;
     let v = &x.fleet.vehicles[i];
@@ -398,7 +397,7 @@ fn apply(x: &mut Exec, u: UnderWay, result: Replanned) {
     if v.lost || v.arrived_s.is_some() || v.fault_s.is_some() || v.holding != u.was_holding {
         tracing::info!(
             "{id}'s replan ({}) is dropped: the vehicle's state changed while it ran",
-            u.why
+            u.asked.why
         );
         return;
     }
@@ -406,7 +405,7 @@ fn apply(x: &mut Exec, u: UnderWay, result: Replanned) {
         x.queue.waiting.push_front(Waiting {
             vehicle: i,
             why: "a new obstacle blocks its path".to_string(),
-            obstacle_received: u.obstacle_received,
+            obstacle_received: u.asked.obstacle_received,
             budget: budget(x, i),
         });
         return;
@@ -417,7 +416,7 @@ fn apply(x: &mut Exec, u: UnderWay, result: Replanned) {
         tracing::info!("{id}'s retry yielded to a vehicle under way after {ms:.0} ms");
         return;
     }
-    let why = u.why;
+    let why = u.asked.why;
     let t0 = u.t0;
     if result.safe {
         x.hold_retries[i] = 0;
@@ -447,7 +446,7 @@ fn apply(x: &mut Exec, u: UnderWay, result: Replanned) {
         );
         x.pending[i] = Some((x.revision, Instant::now()));
         x.replans += 1;
-        if let Some(received) = u.obstacle_received {
+        if let Some(received) = u.asked.obstacle_received {
             x.decisions_ms
                 .push(received.elapsed().as_secs_f64() * 1000.0);
         }

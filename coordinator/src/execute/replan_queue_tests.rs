@@ -23,10 +23,9 @@ fn a_replan_waits_for_the_rest_of_the_one_under_way_and_the_budgets_ahead_of_it(
     assert_eq!(q.wait_for(2), Duration::from_millis(900));
     assert_eq!(q.wait_for(1), Duration::from_millis(300));
     let (_tx, rx) = mpsc::channel();
+    // Started 1.2 s ago with a 1 s budget: overdue, nothing left of it.
     q.under_way = Some(UnderWay {
-        vehicle: 1,
-        why: String::new(),
-        obstacle_received: None,
+        asked: waiting(1, 1000),
         t0: 0.0,
         course: Trajectory {
             times: Vec::new(),
@@ -34,9 +33,7 @@ fn a_replan_waits_for_the_rest_of_the_one_under_way_and_the_budgets_ahead_of_it(
         },
         was_holding: false,
         obstacles: 0,
-        // Started 1.2 s ago with a 1 s budget: overdue, nothing left of it.
         started: Instant::now() - Duration::from_millis(1200),
-        budget: Duration::from_secs(1),
         result: rx,
         stop: Arc::new(AtomicBool::new(false)),
     });
@@ -44,7 +41,7 @@ fn a_replan_waits_for_the_rest_of_the_one_under_way_and_the_budgets_ahead_of_it(
     // Started 400 ms ago with a 2.4 s budget: 2 s or a little less left.
     if let Some(u) = q.under_way.as_mut() {
         u.started = Instant::now() - Duration::from_millis(400);
-        u.budget = Duration::from_millis(2400);
+        u.asked.budget = Duration::from_millis(2400);
     }
     let w = q.wait_for(0);
     assert!(
