@@ -185,9 +185,13 @@ pub struct CompareArgs {
     /// Scenario files.
     #[arg(required = true, env = "SHOAL_SCENARIOS", value_delimiter = ',')]
     pub scenarios: Vec<PathBuf>,
-    /// Seeds 1..=N.
+    /// How many seeds: `--first-seed` … `--first-seed` + N − 1 (1..=N by default).
     #[arg(long, default_value_t = 10, env = "SHOAL_SEEDS", value_parser = clap::value_parser!(u64).range(1..))]
     pub seeds: u64,
+    /// First seed, so a comparison can be repeated on seeds no setting was chosen on (e.g.
+    /// `--first-seed 11 --seeds 20` runs seeds 11–30).
+    #[arg(long, default_value_t = 1, env = "SHOAL_FIRST_SEED")]
+    pub first_seed: u64,
     /// Algorithms to compare.
     #[arg(
         long,
@@ -209,6 +213,36 @@ pub struct CompareArgs {
     /// Crawler scenarios: grid spacing of the reference shortest admissible path, metres.
     #[arg(long, default_value_t = 0.5, env = "SHOAL_REFERENCE_CELL")]
     pub reference_cell: f64,
+}
+
+impl CompareArgs {
+    /// The seeds to run, `first_seed .. first_seed + seeds`; an error names both flags when the
+    /// last seed would not fit in a u64.
+    pub fn seed_range(&self) -> anyhow::Result<std::ops::Range<u64>> {
+        match self.first_seed.checked_add(self.seeds) {
+            Some(end) => Ok(self.first_seed..end),
+            None => anyhow::bail!(
+                "--first-seed {} with --seeds {}: the last seed would be past {}",
+                self.first_seed,
+                self.seeds,
+                u64::MAX
+            ),
+        }
+    }
+}
+
+/// One line naming the seeds a table was made on, e.g. "Seeds 11–30 (20 per cell)."
+pub fn seeds_line(seeds: &std::ops::Range<u64>) -> String {
+    let n = seeds.end.saturating_sub(seeds.start);
+    match n {
+        0 => "No seeds.\n\n".to_string(),
+        1 => format!("Seed {}.\n\n", seeds.start),
+        _ => format!(
+            "Seeds {}–{} ({n} per cell).\n\n",
+            seeds.start,
+            seeds.end - 1
+        ),
+    }
 }
 
 #[cfg(test)]
@@ -285,5 +319,51 @@ mod tests {
         )
         .unwrap_or_else(|e| panic!("compare failed: {e}"));
         assert!(cells.is_empty());
+    }
+
+    #[derive(clap::Parser)]
+    struct Cli {
+        #[command(flatten)]
+        compare: CompareArgs,
+    }
+
+    fn parsed(args: &[&str]) -> CompareArgs {
+        use clap::Parser;
+        match Cli::try_parse_from(std::iter::once("compare").chain(args.iter().copied())) {
+            Ok(c) => c.compare,
+            Err(e) => panic!("{args:?} did not parse: {e}"),
+        }
+    }
+
+    #[test]
+    fn seeds_start_at_one_unless_a_first_seed_is_given() {
+        let range = |args: &[&str]| {
+            parsed(args)
+                .seed_range()
+                .unwrap_or_else(|e| panic!("{args:?}: {e}"))
+        };
+        assert_eq!(range(&["a.toml"]), 1..11);
+        assert_eq!(range(&["a.toml", "--seeds", "3"]), 1..4);
+        assert_eq!(
+            range(&["a.toml", "--first-seed", "11", "--seeds", "20"]),
+            11..31
+        );
+        let past = parsed(&[
+            "a.toml",
+            "--first-seed",
+            &u64::MAX.to_string(),
+            "--seeds",
+            "2",
+        ]);
+        let e = match past.seed_range() {
+            Ok(r) => panic!("a range past u64::MAX was accepted: {r:?}"),
+            Err(e) => e.to_string(),
+        };
+        assert!(
+            e.contains("--first-seed 18446744073709551615") && e.contains("--seeds 2"),
+            "{e}"
+        );
+        assert_eq!(seeds_line(&(11..31)), "Seeds 11–30 (20 per cell).\n\n");
+        assert_eq!(seeds_line(&(4..5)), "Seed 4.\n\n");
     }
 }

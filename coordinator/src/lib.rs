@@ -90,6 +90,7 @@ pub fn run(command: Command, shutdown: Arc<AtomicBool>) -> anyhow::Result<i32> {
 }
 
 fn compare_command(args: &compare::CompareArgs, stop: &Arc<AtomicBool>) -> anyhow::Result<i32> {
+    let seeds = args.seed_range()?;
     let scenarios = args
         .scenarios
         .iter()
@@ -131,7 +132,7 @@ fn compare_command(args: &compare::CompareArgs, stop: &Arc<AtomicBool>) -> anyho
     let cells = compare::compare(
         &scenarios,
         &args.algorithms,
-        1..args.seeds + 1,
+        seeds.clone(),
         distributed.as_ref(),
         stop,
         &mut |p| {
@@ -151,7 +152,8 @@ fn compare_command(args: &compare::CompareArgs, stop: &Arc<AtomicBool>) -> anyho
     if stop.load(std::sync::atomic::Ordering::Relaxed) {
         eprintln!("interrupted: the table has only the cells completed before Ctrl-C");
     }
-    let mut table = compare::markdown(&cells);
+    let mut table = compare::seeds_line(&seeds);
+    table.push_str(&compare::markdown(&cells));
     table.push_str(&significance::markdown(&significance::significance(&cells)));
     if cells.iter().any(|c| c.crawler.is_some()) {
         eprintln!(
