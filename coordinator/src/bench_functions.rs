@@ -90,6 +90,26 @@ pub struct RunResult {
     pub best: f64,
     /// Cost evaluations spent.
     pub evaluations: u64,
+    /// The best still improved over the last tenth of the iterations ([`still_improving`]).
+    pub still_improving: bool,
+}
+
+/// Share of the iterations at the end of a run [`still_improving`] looks at.
+pub const LATE_SHARE: f64 = 0.1;
+
+/// True when a run's best improved over the last [`LATE_SHARE`] of its iterations by more than
+/// 1e-9 of max(1, |best|): the budget, not the optimizer, ended it, and more iterations would
+/// likely give a better best (Kowalik at Table 4's budget is the case in point). The floor of 1
+/// keeps a run crawling from 1e-80 to 1e-82 on the Sphere from counting. `convergence` is the
+/// best after each iteration.
+pub fn still_improving(convergence: &[f64]) -> bool {
+    let n = convergence.len();
+    if n < 2 {
+        return false;
+    }
+    let window = ((n as f64 * LATE_SHARE).ceil() as usize).clamp(1, n - 1);
+    let (before, end) = (convergence[n - 1 - window], convergence[n - 1]);
+    before - end > 1e-9 * end.abs().max(1.0)
 }
 
 /// An optimizer the suite can run.
@@ -206,6 +226,7 @@ fn run<'a, S: Solver<&'a dyn Benchmark> + VelocityCapped>(
     RunResult {
         best: out.state.best_cost(),
         evaluations: out.state.evaluations(),
+        still_improving: still_improving(&out.convergence),
     }
 }
 
@@ -244,6 +265,8 @@ pub struct Cell {
     pub values: Vec<f64>,
     /// Evaluations of each run.
     pub evaluations: Vec<u64>,
+    /// Whether each run was still improving when its budget ended ([`still_improving`]).
+    pub still_improving: Vec<bool>,
 }
 
 /// A function of the suite as the report shows it.
@@ -388,6 +411,7 @@ pub fn bench_functions(
         let cell = &mut cells[k / (na * nr)][(k / nr) % na];
         cell.values.push(r.best);
         cell.evaluations.push(r.evaluations);
+        cell.still_improving.push(r.still_improving);
     }
     Ok(Report {
         runs: nr,
@@ -498,4 +522,38 @@ pub fn command(args: &BenchFunctionsArgs, stop: &AtomicBool) -> anyhow::Result<i
     }
     eprintln!("{note}");
     Ok(crate::EXIT_FEASIBLE)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::still_improving;
+
+    #[test]
+    fn a_run_still_improves_when_its_last_tenth_lowered_the_best_beyond_the_tolerance() {
+        // 20 iterations: the window is the last 2, from index 17 to 19.
+        let mut c = vec![5.0; 20];
+        c[18] = 4.0;
+        c[19] = 4.0;
+        assert!(still_improving(&c), "5 → 4 within the last 2 iterations");
+        // The fall came at index 17, before the window started: no longer improving.
+        c[17] = 4.0;
+        assert!(!still_improving(&c));
+        // Kowalik's scale: a fall of 1e-7 near 3.1e-4 counts (tolerance 1e-9 of max(1, 3.1e-4)).
+        let mut k = vec![3.1017e-4; 10];
+        k[9] = 3.1016e-4;
+        assert!(still_improving(&k));
+        // The Sphere crawling from 1e-80 to 1e-82 does not (below the floor of 1e-9).
+        let mut z = vec![1e-80; 10];
+        z[9] = 1e-82;
+        assert!(!still_improving(&z));
+        // A big cost falling by less than 1e-9 of itself does not either: 1e6 → 1e6 − 1e-4.
+        let mut b = vec![1e6; 10];
+        b[9] = 1e6 - 1e-4;
+        assert!(!still_improving(&b));
+        b[9] = 1e6 - 1e-2;
+        assert!(still_improving(&b));
+        // Too short to tell.
+        assert!(!still_improving(&[1.0]));
+        assert!(still_improving(&[2.0, 1.0]));
+    }
 }

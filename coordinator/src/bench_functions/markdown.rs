@@ -1,12 +1,12 @@
 //! The suite's report as markdown: seed 000 Table 5 (best / mean / std, plus the worst run), the
-//! runs that found f*, Table 6 (Wilcoxon rank-sum p-values of IPSO against each other
-//! algorithm), evaluations per run and a legend.
+//! runs that found f*, the runs the budget cut short, Table 6 (Wilcoxon rank-sum p-values of IPSO
+//! against each other algorithm), evaluations per run and a legend.
 
 use std::fmt::Write as _;
 
 use shoal_common::stats;
 
-use super::{Report, MULTI_POPULATIONS};
+use super::{Report, LATE_SHARE, MULTI_POPULATIONS};
 
 /// A number for the tables: six significant digits between 10⁻³ and 10⁵ (so Branin's 0.397887
 /// and Six-Hump Camel's −1.03163 read as in the paper), scientific otherwise.
@@ -137,6 +137,27 @@ fn write_markdown(s: &mut String, r: &Report) -> std::fmt::Result {
             })
             .collect();
         writeln!(s, "| {} {} | {} |", f.label, f.name, hits.join(" | "))?;
+    }
+
+    writeln!(
+        s,
+        "\n## Runs still improving over the last {:.0} % of the iterations\n\n\
+         A run counts when its best fell by more than 1e-9 of max(1, |best|) over its last \
+         {:.0} % of iterations: the budget, not the optimizer, ended it. Many here mean the \
+         row's figures are limited by t_max.\n",
+        LATE_SHARE * 100.0,
+        LATE_SHARE * 100.0
+    )?;
+    header(s, "function", &r.algorithms)?;
+    for (fi, f) in r.functions.iter().enumerate() {
+        let late: Vec<String> = r.cells[fi]
+            .iter()
+            .map(|c| {
+                let n = c.still_improving.iter().filter(|l| **l).count();
+                format!("{n}/{}", c.still_improving.len())
+            })
+            .collect();
+        writeln!(s, "| {} {} | {} |", f.label, f.name, late.join(" | "))?;
     }
 
     write_wilcoxon(s, r)?;
@@ -303,10 +324,12 @@ mod tests {
             cells: vec![vec![
                 Cell {
                     evaluations: vec![9030; a.len()],
+                    still_improving: (0..a.len()).map(|i| i == 0).collect(),
                     values: a,
                 },
                 Cell {
                     evaluations: vec![9030; b.len()],
+                    still_improving: vec![false; b.len()],
                     values: b,
                 },
             ]],
@@ -326,6 +349,8 @@ mod tests {
             "|  | std | 1.000e-5 | 1.00000 |",
             "|  | worst | 2.000e-5 | 3.00000 |",
             "| f1 Sphere | 3/3 | 0/3 |",
+            "## Runs still improving over the last 10 % of the iterations",
+            "| f1 Sphere | 1/3 | 0/3 |",
             "| function | IPSO vs spso |\n|---|---|\n",
             "| f1 Sphere | 0.081 (+) |",
             "| best values of f1–f8 (1 vs 1, as Table 6) | 1.000 (+) |",
