@@ -6,7 +6,7 @@ use std::fmt::Write as _;
 
 use shoal_common::stats;
 
-use super::{Report, LATE_SHARE, MULTI_POPULATIONS};
+use super::{Cell, FunctionInfo, Report, LATE_SHARE, MULTI_POPULATIONS};
 
 /// A number for the tables: six significant digits between 10⁻³ and 10⁵ (so Branin's 0.397887
 /// and Six-Hump Camel's −1.03163 read as in the paper), scientific otherwise.
@@ -45,12 +45,14 @@ pub fn markdown(r: &Report) -> String {
     s
 }
 
+/// A table's header row and its rule: `first` (which may hold several columns) then `names`.
+fn header(s: &mut String, first: &str, names: &[&str]) -> std::fmt::Result {
+    writeln!(s, "| {first} | {} |", names.join(" | "))?;
+    let columns = 1 + first.matches('|').count() + names.len();
+    writeln!(s, "{}|", "|---".repeat(columns))
+}
+
 fn write_markdown(s: &mut String, r: &Report) -> std::fmt::Result {
-    let header = |s: &mut String, first: &str, names: &[&str]| -> std::fmt::Result {
-        writeln!(s, "| {first} | {} |", names.join(" | "))?;
-        let columns = 1 + first.matches('|').count() + names.len();
-        writeln!(s, "{}|", "|---".repeat(columns))
-    };
     let scalable_dim = r.functions.iter().find(|f| f.scalable).map(|f| f.dim);
     writeln!(
         s,
@@ -123,21 +125,14 @@ fn write_markdown(s: &mut String, r: &Report) -> std::fmt::Result {
         "\n## Runs whose best is within {HIT_TOLERANCE:e} of f* (seed 003 Table 2's \
          convergence rate)\n"
     )?;
-    header(s, "function", &r.algorithms)?;
-    for (fi, f) in r.functions.iter().enumerate() {
-        let hits: Vec<String> = r.cells[fi]
+    counts(s, r, |c, f| {
+        let n = c
+            .values
             .iter()
-            .map(|c| {
-                let n = c
-                    .values
-                    .iter()
-                    .filter(|v| (**v - f.optimum).abs() <= HIT_TOLERANCE)
-                    .count();
-                format!("{n}/{}", c.values.len())
-            })
-            .collect();
-        writeln!(s, "| {} {} | {} |", f.label, f.name, hits.join(" | "))?;
-    }
+            .filter(|v| (**v - f.optimum).abs() <= HIT_TOLERANCE)
+            .count();
+        (n, c.values.len())
+    })?;
 
     writeln!(
         s,
@@ -148,17 +143,10 @@ fn write_markdown(s: &mut String, r: &Report) -> std::fmt::Result {
         LATE_SHARE * 100.0,
         LATE_SHARE * 100.0
     )?;
-    header(s, "function", &r.algorithms)?;
-    for (fi, f) in r.functions.iter().enumerate() {
-        let late: Vec<String> = r.cells[fi]
-            .iter()
-            .map(|c| {
-                let n = c.still_improving.iter().filter(|l| **l).count();
-                format!("{n}/{}", c.still_improving.len())
-            })
-            .collect();
-        writeln!(s, "| {} {} | {} |", f.label, f.name, late.join(" | "))?;
-    }
+    counts(s, r, |c, _| {
+        let n = c.still_improving.iter().filter(|l| **l).count();
+        (n, c.still_improving.len())
+    })?;
 
     write_wilcoxon(s, r)?;
 
@@ -185,6 +173,26 @@ fn write_markdown(s: &mut String, r: &Report) -> std::fmt::Result {
          leader with the rest (M = 30: 5 × 5 + 5), instead of Table 5's 20 × 50 + 20, so the \
          budget is comparable."
     )
+}
+
+/// A table of "k/n" per function and algorithm, `count` giving (k, n) for a cell.
+fn counts(
+    s: &mut String,
+    r: &Report,
+    count: impl Fn(&Cell, &FunctionInfo) -> (usize, usize),
+) -> std::fmt::Result {
+    header(s, "function", &r.algorithms)?;
+    for (fi, f) in r.functions.iter().enumerate() {
+        let row: Vec<String> = r.cells[fi]
+            .iter()
+            .map(|c| {
+                let (k, n) = count(c, f);
+                format!("{k}/{n}")
+            })
+            .collect();
+        writeln!(s, "| {} {} | {} |", f.label, f.name, row.join(" | "))?;
+    }
+    Ok(())
 }
 
 fn write_wilcoxon(s: &mut String, r: &Report) -> std::fmt::Result {
@@ -289,7 +297,6 @@ fn write_wilcoxon(s: &mut String, r: &Report) -> std::fmt::Result {
 
 #[cfg(test)]
 mod tests {
-    use super::super::{Cell, FunctionInfo};
     use super::*;
 
     #[test]
