@@ -24,6 +24,7 @@ pub mod separation;
 pub mod stats;
 pub mod swarm;
 pub mod terrain;
+pub mod touch_up;
 pub mod tour;
 pub mod trajectory;
 pub mod vehicle_problem;

@@ -90,6 +90,11 @@ pub struct PlanArgs {
     /// No progress output on stderr.
     #[arg(long, short, env = "SHOAL_QUIET")]
     pub quiet: bool,
+    /// Fleet plans: keep the swarm's own best even when it breaks a limit, instead of
+    /// re-planning each vehicle in a violation against the others' paths afterwards (the
+    /// scenario's `optimizer.touch_up`).
+    #[arg(long, env = "SHOAL_NO_TOUCH_UP")]
+    pub no_touch_up: bool,
     /// Distributed mode: start one agent per vehicle here (embedded) or wait for agents started
     /// elsewhere to connect (external).
     #[arg(long, env = "SHOAL_AGENTS", value_enum, default_value_t = AgentsMode::Embedded)]

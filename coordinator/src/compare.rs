@@ -129,6 +129,8 @@ pub fn compare(
                     let mut s = s.clone();
                     s.optimizer.algorithm = a;
                     s.optimizer.seed = seed;
+                    // The algorithms as their papers give them: no touch-up afterwards.
+                    s.optimizer.touch_up = false;
                     let started = Instant::now();
                     let p = match distributed {
                         Some(o) if remote => {

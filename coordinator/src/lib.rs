@@ -200,6 +200,9 @@ pub fn load_scenario(args: &PlanArgs) -> anyhow::Result<Scenario> {
         o.threads = v;
         given.push(format!("--threads {v}"));
     }
+    if args.no_touch_up {
+        o.touch_up = false;
+    }
     // Overrides are user input too: check them with the same rules, naming the field, and
     // saying that the command line set it.
     match s.validate(&args.scenario) {

@@ -16,6 +16,7 @@ use shoal_common::swarm::pso::Pso;
 use shoal_common::swarm::{
     Executor, IterationReport, Problem, Solver, SolverState, Termination, VelocityCapped,
 };
+use shoal_common::touch_up::{touch_up, TouchUp, TouchUpSettings};
 
 /// What an optimizer run leaves behind, whatever the algorithm and the mode.
 pub struct RunResult {
@@ -122,12 +123,30 @@ pub fn plan_in_process(
     to_plan(scenario, &model, run, "in-process")
 }
 
-/// The validated plan of a run: the fleet figures are recomputed from the trajectories.
+/// The validated plan of a run: the fleet figures are recomputed from the trajectories. When
+/// the swarm's best breaks a limit and the settings allow it, the plan is first touched up
+/// ([`shoal_common::touch_up`]) and says so.
 pub fn to_plan(scenario: &Scenario, model: &FleetModel, run: RunResult, mode: &str) -> Plan {
     let o = &scenario.optimizer;
-    let eval = model.evaluate(&run.best_x);
+    let started = std::time::Instant::now();
+    let touched = o
+        .touch_up
+        .then(|| {
+            let settings = TouchUpSettings::new(o.seed, o.velocity_cap(SEED004_VELOCITY_CAP));
+            touch_up(model, &run.best_x, settings)
+        })
+        .flatten();
+    let touch_up_s = started.elapsed().as_secs_f64();
+    let eval = model.evaluate(touched.as_ref().map_or(&run.best_x, |t| &t.x));
     let assessment = assess(scenario, &eval.trajectories);
     let mut notices = notices(scenario, &eval.trajectories, eval.common_arrival);
+    if let Some(t) = &touched {
+        notices.push(touch_up_notice(
+            scenario,
+            t,
+            assessment.violations.is_empty(),
+        ));
+    }
     if run.termination == Termination::Interrupted {
         notices.push(format!(
             "planning was interrupted after {} of {} iterations: this is the best plan found so far",
@@ -140,7 +159,7 @@ pub fn to_plan(scenario: &Scenario, model: &FleetModel, run: RunResult, mode: &s
         algorithm: o.algorithm.as_str().to_string(),
         mode: mode.to_string(),
         seed: o.seed,
-        runtime_s: run.runtime_s,
+        runtime_s: run.runtime_s + if touched.is_some() { touch_up_s } else { 0.0 },
         fitness: eval.total,
         objective: eval.objective,
         penalty: eval.penalty,
@@ -151,13 +170,47 @@ pub fn to_plan(scenario: &Scenario, model: &FleetModel, run: RunResult, mode: &s
         common_arrival_s: eval.common_arrival,
         d_min_m: scenario.fleet.d_min_m,
         iterations: run.convergence.len(),
-        evaluations: run.evaluations,
+        evaluations: run.evaluations + touched.as_ref().map_or(0, |t| t.evaluations),
         termination: format!("{:?}", run.termination),
         vehicles: assessment.vehicles,
         fleet: assessment.fleet,
         convergence: run.convergence,
         distributed: None,
     }
+}
+
+/// What the touch-up did, in words, for the plan's notices.
+fn touch_up_notice(scenario: &Scenario, t: &TouchUp, cleared: bool) -> String {
+    let mut ids: Vec<&str> = Vec::new();
+    for v in &t.changed {
+        if let Some(id) = scenario.vehicles.get(*v).map(|v| v.id.as_str()) {
+            if !ids.contains(&id) {
+                ids.push(id);
+            }
+        }
+    }
+    let what = if ids.is_empty() {
+        "no vehicle's path could be improved".to_string()
+    } else {
+        format!(
+            "{} re-planned against the others' paths (penalty {:.3} -> {:.3}, fitness {:.4} -> {:.4})",
+            ids.join(", "),
+            t.penalty.0,
+            t.penalty.1,
+            t.total.0,
+            t.total.1
+        )
+    };
+    format!(
+        "touch-up: the swarm's best plan broke a limit; {what} in {} evaluations{} \
+         (--no-touch-up gives the swarm's own plan)",
+        t.evaluations,
+        if cleared {
+            ", which cleared every violation"
+        } else {
+            "; the violations listed remain"
+        }
+    )
 }
 
 #[cfg(test)]
@@ -210,5 +263,38 @@ mod tests {
             assert_eq!(own, with(Some(0.2)), "{algorithm:?}");
             assert_ne!(own, with(Some(0.02)), "{algorithm:?}");
         }
+    }
+
+    /// Scenario 3, seed 50, in process: the swarm's best has auv5 pitching 20.9° on one leg
+    /// (limit 20°); re-planning auv5 against the others clears it (measured 2026-11-26).
+    #[test]
+    fn a_plan_the_swarm_left_over_a_limit_is_touched_up_and_says_so() {
+        let mut s = small("amp-pso-3", None);
+        s.optimizer.iterations = 200;
+        s.optimizer.particles = 50;
+        s.optimizer.seed = 50;
+        s.optimizer.touch_up = false;
+        let own = plan_in_process(&s, None, &mut |_| {});
+        assert!(!own.feasible, "the swarm's own plan: {:?}", own.violations);
+        assert!(own.violations.iter().any(|v| v.contains("auv5 pitches")));
+        assert!(!own.notices.iter().any(|n| n.starts_with("touch-up")));
+        s.optimizer.touch_up = true;
+        let touched = plan_in_process(&s, None, &mut |_| {});
+        assert!(touched.feasible, "{:?}", touched.violations);
+        assert!(touched.fitness < own.fitness);
+        assert!(touched.evaluations > own.evaluations);
+        assert_eq!(
+            touched.convergence, own.convergence,
+            "the swarm ran the same"
+        );
+        let note = touched
+            .notices
+            .iter()
+            .find(|n| n.starts_with("touch-up"))
+            .unwrap_or_else(|| panic!("no touch-up notice: {:?}", touched.notices));
+        assert!(
+            note.contains("auv5 re-planned") && note.contains("cleared every violation"),
+            "{note}"
+        );
     }
 }

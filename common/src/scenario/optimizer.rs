@@ -153,6 +153,10 @@ pub struct OptimizerSettings {
     pub threads: usize,
     /// How the multi-population algorithms split over vehicle agents (distributed mode only).
     pub distributed: DistributedSettings,
+    /// After the swarm, re-plan each vehicle still in a violation against the others' paths
+    /// (`crate::touch_up`, not part of any seed's algorithm). `plan` does it by default
+    /// (`--no-touch-up` or `touch_up = false` to see the swarm's own result); `compare` never.
+    pub touch_up: bool,
 }
 
 /// Distributed AMP-PSO (`plan` without `--in-process`): each vehicle's agent runs follower
@@ -206,6 +210,7 @@ impl Default for OptimizerSettings {
             max_velocity_fraction: None,
             threads: 2,
             distributed: DistributedSettings::default(),
+            touch_up: true,
         }
     }
 }

@@ -1,0 +1,316 @@
+//! A last pass over a fleet plan the swarm left with a violation: each vehicle that takes part in
+//! one is re-planned on its own, against the others' timed trajectories as the plan has them
+//! ([`VehicleProblem`], the problem a vehicle agent solves in distributed AMP-PSO), starting
+//! from its own chromosome, and its new chromosome is kept only if the whole fleet's fitness
+//! (seed 004 eq. (12) plus the penalties) gets lower.
+//!
+//! Not part of any seed's algorithm: the paper's swarm ends where it ends. It exists because a
+//! plan the swarm left a few metres inside an obstacle's margin, or half a degree over a pitch
+//! limit, cannot be flown, and the vehicle-by-vehicle search that the distributed planner runs
+//! anyway usually clears it in a few thousand evaluations of one vehicle. `compare` and the
+//! benchmarks measure the algorithms without it; `plan` runs it unless told not to, and the plan
+//! says what it changed.
+
+use rand::rngs::StdRng;
+use rand::{Rng, SeedableRng};
+
+use crate::cost::FleetModel;
+use crate::geometry::Vec3;
+use crate::swarm::multi::stream_seed;
+use crate::swarm::population::{Limits, Particle, Population, Schedule};
+use crate::swarm::{Executor, Problem, Progress, Solver, SolverState};
+use crate::vehicle_problem::VehicleProblem;
+
+/// How hard the touch-up tries.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TouchUpSettings {
+    /// Passes over the vehicles (each pass re-plans every vehicle still in a violation).
+    pub rounds: usize,
+    /// Particles of each vehicle's swarm.
+    pub particles: usize,
+    /// Iterations of each vehicle's swarm.
+    pub iterations: usize,
+    /// Velocity cap, a fraction of each gene's range.
+    pub max_velocity_fraction: f64,
+    /// The run's seed (each vehicle and round draws its own stream from it).
+    pub seed: u64,
+}
+
+impl TouchUpSettings {
+    /// Two passes of 50 particles × 100 iterations per vehicle, Table 5's fixed coefficients
+    /// (ω = 0.15, c1 = c2 = 1.5: a swarm that stays near its best, which starts as the plan's own
+    /// chromosome) and seed 004's velocity cap.
+    pub fn new(seed: u64, max_velocity_fraction: f64) -> TouchUpSettings {
+        TouchUpSettings {
+            rounds: 2,
+            particles: 50,
+            iterations: 100,
+            max_velocity_fraction,
+            seed,
+        }
+    }
+}
+
+/// What a touch-up did.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TouchUp {
+    /// The fleet position after it (the input when nothing was kept).
+    pub x: Vec<f64>,
+    /// Vehicles (scenario order) whose new chromosome was kept, in the order they were kept.
+    pub changed: Vec<usize>,
+    /// Penalty sum P of the plan before and after.
+    pub penalty: (f64, f64),
+    /// Fitness (objective + W · P) before and after.
+    pub total: (f64, f64),
+    /// Cost evaluations spent (of one vehicle or of the fleet).
+    pub evaluations: u64,
+}
+
+/// Touches up fleet position `x`; `None` when its plan has no violation to clear.
+pub fn touch_up(model: &FleetModel, x: &[f64], settings: TouchUpSettings) -> Option<TouchUp> {
+    let mut eval = model.evaluate(x);
+    if eval.penalty <= 0.0 {
+        return None;
+    }
+    let before = (eval.penalty, eval.total);
+    let mut x = x.to_vec();
+    let mut changed = Vec::new();
+    let mut evaluations = 1;
+    'rounds: for round in 0..settings.rounds {
+        for v in 0..model.layout.vehicles {
+            if eval.penalty <= 0.0 {
+                break 'rounds;
+            }
+            let range = model.layout.chromosome(v);
+            let problem = VehicleProblem::new(model, v, &eval.trajectories, eval.common_arrival);
+            if !in_violation(&problem, &x[range.clone()]) {
+                continue;
+            }
+            let vehicle = &model.scenario.vehicles[v];
+            let mut solver = Started {
+                start: x[range.clone()].to_vec(),
+                ends: (vehicle.start(), vehicle.goal()),
+                particles: settings.particles,
+                max_velocity_fraction: settings.max_velocity_fraction,
+                seed: stream_seed(settings.seed, 7_000_001 + (round * 1000 + v) as u64),
+            };
+            let out = Executor::new(settings.iterations).run(&problem, &mut solver, |_| {});
+            evaluations += out.state.evaluations();
+            let mut candidate = x.clone();
+            candidate[range].copy_from_slice(out.state.best_position());
+            let e = model.evaluate(&candidate);
+            evaluations += 1;
+            if e.total < eval.total {
+                x = candidate;
+                eval = e;
+                changed.push(v);
+            }
+        }
+    }
+    Some(TouchUp {
+        x,
+        changed,
+        penalty: (before.0, eval.penalty),
+        total: (before.1, eval.total),
+        evaluations,
+    })
+}
+
+/// True when the vehicle has a penalty (hard obstacle, turn, pitch, separation) in the context.
+fn in_violation(problem: &VehicleProblem<'_>, genes: &[f64]) -> bool {
+    let t = problem.evaluate(genes).terms;
+    t.hard + t.motion + t.separation > 0.0
+}
+
+/// `genes` (M waypoints as x, y, z, then M speeds) with each waypoint moved `strength` of the
+/// way to the midpoint of its neighbours, `passes` times; the path's start and goal (`ends`)
+/// stay. A corner's turn and a leg's pitch shrink; the speeds are kept.
+pub fn smoothed(genes: &[f64], ends: (Vec3, Vec3), strength: f64, passes: usize) -> Vec<f64> {
+    let m = genes.len() / crate::trajectory::GENES_PER_WAYPOINT;
+    let mut points: Vec<Vec3> = std::iter::once(ends.0)
+        .chain(
+            genes[..3 * m]
+                .chunks_exact(3)
+                .map(|g| Vec3::new(g[0], g[1], g[2])),
+        )
+        .chain(std::iter::once(ends.1))
+        .collect();
+    for _ in 0..passes {
+        let before = points.clone();
+        for k in 1..points.len() - 1 {
+            let mid = (before[k - 1] + before[k + 1]) / 2.0;
+            points[k] = before[k] + (mid - before[k]) * strength;
+        }
+    }
+    let mut out: Vec<f64> = points[1..points.len() - 1]
+        .iter()
+        .flat_map(|p| [p.x, p.y, p.z])
+        .collect();
+    out.extend_from_slice(&genes[3 * m..]);
+    out
+}
+
+/// Largest share of a deformation added to the start to seed the other particles.
+const MAX_BEND: f64 = 0.3;
+
+/// One population with Table 5's fixed coefficients whose first particle is `start` and whose
+/// others are `start` bent a little.
+struct Started {
+    start: Vec<f64>,
+    /// The vehicle's start and goal, which the chromosome leaves out.
+    ends: (Vec3, Vec3),
+    particles: usize,
+    max_velocity_fraction: f64,
+    seed: u64,
+}
+
+/// The state of a [`Started`] swarm.
+struct StartedState {
+    population: Population,
+    limits: Limits,
+    evaluations: u64,
+}
+
+impl SolverState for StartedState {
+    fn best_cost(&self) -> f64 {
+        self.population.elite_cost
+    }
+    fn best_position(&self) -> &[f64] {
+        &self.population.elite_x
+    }
+    fn evaluations(&self) -> u64 {
+        self.evaluations
+    }
+}
+
+impl<P: Problem> Solver<P> for Started {
+    type State = StartedState;
+
+    fn name(&self) -> &'static str {
+        "touch-up"
+    }
+
+    fn init(&mut self, problem: &P) -> StartedState {
+        let mut rng = StdRng::seed_from_u64(self.seed);
+        let mut particles = vec![Particle::new(problem, self.start.clone())];
+        let (lower, upper) = (problem.lower(), problem.upper());
+        while particles.len() < self.particles.max(1) {
+            let x = if particles.len() % 2 == 1 {
+                // The start with its corners eased: what takes a turn or a pitch back under
+                // its limit.
+                let strength = rng.random_range(0.05..0.5);
+                let passes = rng.random_range(1..=3);
+                smoothed(&self.start, self.ends, strength, passes)
+            } else {
+                // The start bent a little: the difference of two samples is a smooth
+                // deformation (each is a straight line bent by a few harmonics), so a small
+                // share of it moves the path off an obstacle or another vehicle without kinks.
+                let (a, b) = (problem.sample(&mut rng), problem.sample(&mut rng));
+                let share: f64 = rng.random_range(0.0..MAX_BEND);
+                (0..self.start.len())
+                    .map(|d| self.start[d] + share * (a[d] - b[d]))
+                    .collect()
+            };
+            let x = x
+                .iter()
+                .enumerate()
+                .map(|(d, g)| g.clamp(lower[d], upper[d]))
+                .collect();
+            particles.push(Particle::new(problem, x));
+        }
+        let population = Population::from_particles(problem, particles, rng);
+        StartedState {
+            evaluations: population.evaluations,
+            population,
+            limits: Limits::of(problem, self.max_velocity_fraction),
+        }
+    }
+
+    fn step(&mut self, problem: &P, mut state: StartedState, progress: Progress) -> StartedState {
+        let c = Schedule::TABLE5_FIXED.at(progress);
+        state.evaluations += state.population.step(problem, c, None, &state.limits);
+        state
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fixtures;
+    use approx::assert_abs_diff_eq;
+
+    #[test]
+    fn smoothing_moves_a_corner_towards_its_neighbours_midpoint_and_keeps_the_speeds() {
+        // One waypoint at (10, 10, 0) between (0, 0, 0) and (20, 0, 0), speed gene 1.2: the
+        // neighbours' midpoint is (10, 0, 0); half the way there is (10, 5, 0).
+        let ends = (Vec3::zeros(), Vec3::new(20.0, 0.0, 0.0));
+        let once = smoothed(&[10.0, 10.0, 0.0, 1.2], ends, 0.5, 1);
+        assert_eq!(once.len(), 4);
+        assert_abs_diff_eq!(once[1], 5.0);
+        assert_abs_diff_eq!(once[0], 10.0);
+        assert_abs_diff_eq!(once[3], 1.2);
+        // Two passes: 10 → 5 → 2.5.
+        assert_abs_diff_eq!(smoothed(&[10.0, 10.0, 0.0, 1.2], ends, 0.5, 2)[1], 2.5);
+        // Two waypoints, one pass of strength 1 from the old positions (Jacobi, not in place):
+        // (5, 10, 0) → mid of (0, 0, 0) and (15, 10, 0) = (7.5, 5, 0);
+        // (15, 10, 0) → mid of (5, 10, 0) and (20, 0, 0) = (12.5, 5, 0).
+        let two = smoothed(&[5.0, 10.0, 0.0, 15.0, 10.0, 0.0, 1.0, 1.0], ends, 1.0, 1);
+        for (got, want) in two.iter().zip([7.5, 5.0, 0.0, 12.5, 5.0, 0.0, 1.0, 1.0]) {
+            assert_abs_diff_eq!(*got, want);
+        }
+        // A straight line stays where it is.
+        let line = smoothed(&[10.0, 0.0, 0.0, 1.0], ends, 0.4, 3);
+        assert_abs_diff_eq!(line[1], 0.0);
+    }
+
+    /// Two AUVs on straight lines that meet head-on at the centre of the box at t = 400 s.
+    fn crossing() -> FleetModel {
+        let s = fixtures::scenario(
+            800.0,
+            "",
+            &[
+                fixtures::vehicle_toml("a", [100.0, 500.0, 250.0], [900.0, 500.0, 250.0]),
+                fixtures::vehicle_toml("b", [500.0, 100.0, 250.0], [500.0, 900.0, 250.0]),
+            ],
+        )
+        .unwrap_or_else(|e| panic!("{e}"));
+        FleetModel::new(&s)
+    }
+
+    #[test]
+    fn a_plan_with_a_violation_is_cleared_vehicle_by_vehicle_and_a_clean_one_is_left_alone() {
+        let model = crossing();
+        let x = fixtures::straight_particle(&model);
+        let before = model.evaluate(&x);
+        assert!(before.penalty > 0.0, "the straight lines collide");
+        let settings = TouchUpSettings::new(3, 0.1);
+        let t = touch_up(&model, &x, settings).unwrap_or_else(|| panic!("nothing to clear?"));
+        assert_eq!(t.penalty.0, before.penalty);
+        assert_eq!(t.total.0, before.total);
+        assert_eq!(t.penalty.1, 0.0, "the crossing is cleared: {t:?}");
+        assert!(t.total.1 < t.total.0);
+        assert!(!t.changed.is_empty());
+        // What it reports is what its position gives.
+        let after = model.evaluate(&t.x);
+        assert_eq!(after.total, t.total.1);
+        let sep = crate::separation::pair_separation(
+            &after.trajectories[0],
+            &after.trajectories[1],
+            50.0,
+        );
+        assert!(sep.min_distance >= 50.0, "{}", sep.min_distance);
+        // Only the vehicles it kept a change for moved.
+        for v in 0..2 {
+            let r = model.layout.chromosome(v);
+            assert_eq!(
+                t.x[r.clone()] != x[r],
+                t.changed.contains(&v),
+                "vehicle {v}"
+            );
+        }
+        // The same seed, the same touch-up.
+        assert_eq!(touch_up(&model, &x, settings), Some(t.clone()));
+        // A plan with nothing to clear is left alone.
+        assert_eq!(touch_up(&model, &t.x, settings), None);
+    }
+}
