@@ -488,4 +488,15 @@ mod tests {
         assert_eq!(s.optimizer.iterations, 7);
         Ok(())
     }
+
+    #[test]
+    fn plans_are_touched_up_unless_the_command_line_says_not() -> anyhow::Result<()> {
+        assert!(load_scenario(&plan_args(&[])?)?.optimizer.touch_up);
+        assert!(
+            !load_scenario(&plan_args(&["--no-touch-up"])?)?
+                .optimizer
+                .touch_up
+        );
+        Ok(())
+    }
 }

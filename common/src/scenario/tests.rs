@@ -177,6 +177,19 @@ fn the_velocity_cap_is_the_algorithms_own_unless_the_file_sets_one() -> Result<(
 }
 
 #[test]
+fn plans_are_touched_up_unless_the_file_says_not() -> Result<(), ScenarioError> {
+    assert!(parse(GOOD)?.optimizer.touch_up);
+    let off = parse(&(GOOD.to_string() + "[optimizer]\ntouch_up = false\n"))?;
+    assert!(!off.optimizer.touch_up);
+    let msg = parse(&(GOOD.to_string() + "[optimizer]\ntouch_up = \"no\"\n"))
+        .err()
+        .map(|e| e.to_string())
+        .unwrap_or_default();
+    assert!(msg.contains("touch_up"), "{msg}");
+    Ok(())
+}
+
+#[test]
 fn a_vehicle_executes_with_its_own_turn_radius_else_the_radius_its_plan_was_made_for(
 ) -> Result<(), ScenarioError> {
     // A fleet scenario with no turn radius leaves the simulator's default.
