@@ -17,7 +17,8 @@ use rand::{Rng, SeedableRng};
 use crate::cost::FleetModel;
 use crate::geometry::Vec3;
 use crate::swarm::multi::stream_seed;
-use crate::swarm::population::{Limits, Particle, Population, Schedule};
+use crate::swarm::population::{Particle, Population, Schedule};
+use crate::swarm::pso::PsoState;
 use crate::swarm::{Executor, Problem, Progress, Solver, SolverState};
 use crate::vehicle_problem::VehicleProblem;
 
@@ -164,33 +165,14 @@ struct Started {
     seed: u64,
 }
 
-/// The state of a [`Started`] swarm.
-struct StartedState {
-    population: Population,
-    limits: Limits,
-    evaluations: u64,
-}
-
-impl SolverState for StartedState {
-    fn best_cost(&self) -> f64 {
-        self.population.elite_cost
-    }
-    fn best_position(&self) -> &[f64] {
-        &self.population.elite_x
-    }
-    fn evaluations(&self) -> u64 {
-        self.evaluations
-    }
-}
-
 impl<P: Problem> Solver<P> for Started {
-    type State = StartedState;
+    type State = PsoState;
 
     fn name(&self) -> &'static str {
         "touch-up"
     }
 
-    fn init(&mut self, problem: &P) -> StartedState {
+    fn init(&mut self, problem: &P) -> PsoState {
         let mut rng = StdRng::seed_from_u64(self.seed);
         let mut particles = vec![Particle::new(problem, self.start.clone())];
         let (lower, upper) = (problem.lower(), problem.upper());
@@ -219,14 +201,10 @@ impl<P: Problem> Solver<P> for Started {
             particles.push(Particle::new(problem, x));
         }
         let population = Population::from_particles(problem, particles, rng);
-        StartedState {
-            evaluations: population.evaluations,
-            population,
-            limits: Limits::of(problem, self.max_velocity_fraction),
-        }
+        PsoState::of(problem, population, self.max_velocity_fraction)
     }
 
-    fn step(&mut self, problem: &P, mut state: StartedState, progress: Progress) -> StartedState {
+    fn step(&mut self, problem: &P, mut state: PsoState, progress: Progress) -> PsoState {
         let c = Schedule::TABLE5_FIXED.at(progress);
         state.evaluations += state.population.step(problem, c, None, &state.limits);
         state

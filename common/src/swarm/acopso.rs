@@ -27,7 +27,7 @@
 use rand::rngs::StdRng;
 use rand::Rng;
 
-use super::population::{Coefficients, Limits, Population};
+use super::population::{Coefficients, Population};
 use super::pso::PsoState;
 use super::{Problem, Progress, Solver, SolverState};
 
@@ -214,11 +214,7 @@ impl<P: Problem> Solver<P> for AcoPso {
         let points = population.particles.iter().map(|p| (p.x.clone(), p.cost));
         merge(&mut archive, points, self.archive);
         AcoPsoState {
-            swarm: PsoState {
-                evaluations: population.evaluations,
-                population,
-                limits: Limits::of(problem, self.max_velocity_fraction),
-            },
+            swarm: PsoState::of(problem, population, self.max_velocity_fraction),
             archive,
         }
     }

@@ -6,7 +6,7 @@
 use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
 
-use super::population::{Coefficients, Limits, Particle, Population};
+use super::population::{Coefficients, Particle, Population};
 use super::pso::PsoState;
 use super::{Problem, Progress, Solver};
 
@@ -81,11 +81,7 @@ impl<P: Problem> Solver<P> for Cbpso {
             })
             .collect();
         let population = Population::from_particles(problem, particles, rng);
-        PsoState {
-            evaluations: population.evaluations,
-            population,
-            limits: Limits::of(problem, self.max_velocity_fraction),
-        }
+        PsoState::of(problem, population, self.max_velocity_fraction)
     }
 
     fn step(&mut self, problem: &P, mut state: PsoState, progress: Progress) -> PsoState {

@@ -72,7 +72,20 @@ impl PsoState {
         seed: u64,
         max_velocity_fraction: f64,
     ) -> PsoState {
-        let population = Population::sample(problem, particles.max(1), seed);
+        PsoState::of(
+            problem,
+            Population::sample(problem, particles.max(1), seed),
+            max_velocity_fraction,
+        )
+    }
+
+    /// The state of an evaluated `population` (a chaotic start, a run's own start), with
+    /// velocities capped at `max_velocity_fraction` of each range.
+    pub fn of<P: Problem>(
+        problem: &P,
+        population: Population,
+        max_velocity_fraction: f64,
+    ) -> PsoState {
         PsoState {
             evaluations: population.evaluations,
             population,
