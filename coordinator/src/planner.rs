@@ -275,15 +275,21 @@ mod tests {
         }
     }
 
+    /// Scenario 3 at Table 5's default budget with seed `seed`, touch-up off.
+    fn scenario3_untouched(seed: u64) -> Scenario {
+        let mut s = small("amp-pso-3", None);
+        s.optimizer.iterations = 200;
+        s.optimizer.particles = 50;
+        s.optimizer.seed = seed;
+        s.optimizer.touch_up = false;
+        s
+    }
+
     /// Scenario 3, seed 50, in process: the swarm's best has auv5 pitching 20.9° on one leg
     /// (limit 20°); re-planning auv5 against the others clears it (measured 2026-11-26).
     #[test]
     fn a_plan_the_swarm_left_over_a_limit_is_touched_up_and_says_so() {
-        let mut s = small("amp-pso-3", None);
-        s.optimizer.iterations = 200;
-        s.optimizer.particles = 50;
-        s.optimizer.seed = 50;
-        s.optimizer.touch_up = false;
+        let mut s = scenario3_untouched(50);
         let own = plan_in_process(&s, None, &mut |_| {});
         assert!(!own.feasible, "the swarm's own plan: {:?}", own.violations);
         assert!(own.violations.iter().any(|v| v.contains("auv5 pitches")));
@@ -313,11 +319,7 @@ mod tests {
     /// the fleet arrives hundreds of seconds earlier (measured 2026-11-26: fitness 12.99 -> 1.73).
     #[test]
     fn a_detour_no_small_change_can_ease_is_cleared_by_a_fresh_search() {
-        let mut s = small("amp-pso-3", None);
-        s.optimizer.iterations = 200;
-        s.optimizer.particles = 50;
-        s.optimizer.seed = 6;
-        s.optimizer.touch_up = false;
+        let mut s = scenario3_untouched(6);
         let own = plan_in_process(&s, None, &mut |_| {});
         assert!(
             own.violations.iter().any(|v| v.contains("auv3 turns")),
