@@ -181,19 +181,17 @@ pub fn to_plan(scenario: &Scenario, model: &FleetModel, run: RunResult, mode: &s
 
 /// What the touch-up did, in words, for the plan's notices.
 fn touch_up_notice(scenario: &Scenario, t: &TouchUp, cleared: bool) -> String {
-    let mut ids: Vec<&str> = Vec::new();
-    for v in &t.changed {
-        if let Some(id) = scenario.vehicles.get(*v).map(|v| v.id.as_str()) {
-            if !ids.contains(&id) {
-                ids.push(id);
+    // Vehicle ids of scenario indices, each once, in first-seen order.
+    let names = |vs: &[usize]| {
+        let mut ids: Vec<&str> = Vec::new();
+        for vehicle in vs.iter().filter_map(|v| scenario.vehicles.get(*v)) {
+            if !ids.contains(&vehicle.id.as_str()) {
+                ids.push(vehicle.id.as_str());
             }
         }
-    }
-    let fresh: Vec<&str> = t
-        .fresh
-        .iter()
-        .filter_map(|v| scenario.vehicles.get(*v).map(|v| v.id.as_str()))
-        .collect();
+        ids
+    };
+    let (ids, fresh) = (names(&t.changed), names(&t.fresh));
     let what = if ids.is_empty() {
         "no vehicle's path could be improved".to_string()
     } else {
