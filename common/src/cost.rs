@@ -14,9 +14,10 @@
 //!
 //! The penalty `P` (weight `W = optimizer.penalty_weight`) counts what makes a plan infeasible:
 //! hard-obstacle intrusions, an AUV's legs closer to the seabed than its clearance
-//! ([`seabed_penalty`]), turns beyond the limit, pitch beyond the limit and separation breaches,
-//! each as `count + depth of the breach relative to its limit`, so the swarm feels both how many
-//! and how bad.
+//! ([`seabed_penalty`]), turns beyond the limit, pitch beyond the limit, a path too short to
+//! arrive with the others even at the vehicle's slowest ([`early_arrival_penalty`]) and
+//! separation breaches, each as `count + depth of the breach relative to its limit`, so the
+//! swarm feels both how many and how bad.
 
 use crate::crawler::{CrawlerModel, CrawlerTerms};
 use crate::geometry::{chord_inside_sphere, pitch, Vec3, CONTACT_GUARD_M, MIN_HEADING_EXTENT};
@@ -147,6 +148,25 @@ pub fn time_term(length: f64, vehicle: &Vehicle, mission_time: f64) -> f64 {
         0.0
     };
     miss / mission_time
+}
+
+/// How far apart arrivals may be before the plan calls them unsynchronised, seconds.
+pub const ARRIVAL_SPREAD_TOLERANCE_S: f64 = 1.0;
+
+/// Penalty for a vehicle whose path is too short to arrive at the common arrival `target` even
+/// at its minimum speed: it arrives at `L / v_min`, early, and the fleet's arrivals are not
+/// synchronised (seed 004 §2.2.2's temporal coupling; eq. (10) only measures the window against
+/// the mission time, not against the time the fleet is timed for). `1 + (target − L / v_min) /
+/// target` when it would arrive early at all, else 0: penalising from zero, not from
+/// [`ARRIVAL_SPREAD_TOLERANCE_S`], keeps the swarm's plans clear of the assessment's threshold
+/// instead of on it. The cure is a longer path, which the swarm can find.
+pub fn early_arrival_penalty(length: f64, vehicle: &Vehicle, target: f64) -> f64 {
+    let early = target - length / vehicle.speed_min_mps;
+    if early > 1e-6 {
+        1.0 + early / target
+    } else {
+        0.0
+    }
 }
 
 /// F_i(S) of eq. (11) on timed trajectories: eq. (11) is 1 at every instant a pair is closer than
@@ -288,7 +308,8 @@ pub struct VehicleTerms {
     /// Hard-obstacle penalty (see [`hard_penalty`]), plus a swimmer's [`seabed_penalty`]
     /// (a crawler's: its hazard penalty).
     pub hard: f64,
-    /// Turn plus pitch penalty.
+    /// Turn, pitch (a crawler's slope) and early-arrival penalties: what the vehicle's
+    /// kinematic limits forbid.
     pub motion: f64,
     /// This vehicle's half of the separation penalty of every pair it belongs to.
     pub separation: f64,
@@ -483,7 +504,11 @@ impl FleetModel {
         let mut vehicles: Vec<VehicleTerms> = paths
             .iter()
             .enumerate()
-            .map(|(i, p)| self.vehicle_terms(i, p, lengths[i]))
+            .map(|(i, p)| {
+                let mut t = self.vehicle_terms(i, p, lengths[i]);
+                t.motion += early_arrival_penalty(lengths[i], &s.vehicles[i], arrival);
+                t
+            })
             .collect();
         let trajectories: Vec<Trajectory> = paths
             .into_iter()

@@ -440,6 +440,56 @@ mod tests {
         assert_abs_diff_eq!(p[50].z, 10.5, epsilon = 1e-6);
     }
 
+    /// Ground rising `rise` metres per metre along x (nodes at x = 0, 50, 100).
+    fn tilted(rise: f64) -> Terrain {
+        let row = [0.0, 50.0 * rise, 100.0 * rise];
+        match HeightGrid::new([0.0, -50.0], 50.0, 3, 3, row.repeat(3)) {
+            Ok(g) => Terrain::Grid(g),
+            Err(e) => panic!("{e}"),
+        }
+    }
+
+    #[test]
+    fn undulation_slope_and_their_scales_on_a_tilted_plane_by_hand() {
+        // Rising 0.1 m per metre: the straight path climbs 10 m over 100 m.
+        let m = model(tilted(0.1), vec![]);
+        let r = m.reference();
+        let length = (100.0f64 * 100.0 + 10.0 * 10.0).sqrt();
+        assert_abs_diff_eq!(r.length_m, length, epsilon = 1e-9);
+        assert_abs_diff_eq!(r.undulation_m, 10.0, epsilon = 1e-9);
+        assert_abs_diff_eq!(r.max_slope_deg, 0.1f64.atan().to_degrees(), epsilon = 1e-9);
+        assert_eq!(r.penalty(), 0.0);
+        // Undulation is scaled by the reference *length*: 0.5·1 + 0.2·10/100.499 + 0 + 0.1·1.
+        assert_abs_diff_eq!(m.cost_of(&r, &r), 0.6 + 0.2 * 10.0 / length, epsilon = 1e-9);
+        // Rising 0.5 m per metre (26.57°) against a 15° limit: each of the 100 sample legs pays
+        // 1 + (26.57 − 15) / 15.
+        let steep = model(tilted(0.5), vec![]).reference();
+        let slope = 0.5f64.atan().to_degrees();
+        assert_abs_diff_eq!(steep.max_slope_deg, slope, epsilon = 1e-9);
+        assert_abs_diff_eq!(
+            steep.slope_penalty,
+            100.0 * (1.0 + (slope - 15.0) / 15.0),
+            epsilon = 1e-6
+        );
+    }
+
+    #[test]
+    fn the_path_is_the_smoothed_curve_not_the_control_polygon() {
+        // Start (0, 0), control points (25, 20), (50, 40), (75, 20), goal (100, 0): knots
+        // 0 0 0 0 ½ 1 1 1 1. At u = ½ the bases are (0, ¼, ½, ¼, 0): the curve passes (50, 30),
+        // 10 m inside the polygon's corner at (50, 40); at u = ¼ they are (1/8, 19/32, 1/4,
+        // 1/32, 0): (29.6875, 22.5).
+        let m = model(flat(), vec![]);
+        let p = m.path(&[25.0, 20.0, 50.0, 40.0, 75.0, 20.0]);
+        assert_eq!(p.len(), 101);
+        assert_abs_diff_eq!(p[50], Vec3::new(50.0, 30.0, 0.5), epsilon = 1e-9);
+        assert_abs_diff_eq!(p[25], Vec3::new(29.6875, 22.5, 0.5), epsilon = 1e-9);
+        // The reported length is the curve's, shorter than the polygon's 4 · √(25² + 20²).
+        let t = m.terms(&p);
+        assert_abs_diff_eq!(t.length_m, bspline::polyline_length(&p), epsilon = 1e-12);
+        assert!(t.length_m < 4.0 * (25.0f64 * 25.0 + 20.0 * 20.0).sqrt() - 5.0);
+    }
+
     #[test]
     fn ipso_steers_around_a_hazard_on_the_straight_line() {
         let m = model(flat(), vec![hazard(50.0, 0.0, 8.0)]);

@@ -273,7 +273,7 @@ pub fn assess(scenario: &Scenario, trajectories: &[Trajectory]) -> Assessment {
     } else {
         last - first
     };
-    if fleet.arrival_spread_s > 1.0 {
+    if fleet.arrival_spread_s > crate::cost::ARRIVAL_SPREAD_TOLERANCE_S {
         violations.push(format!(
             "arrivals are not synchronised: first at {first:.0} s, last at {last:.0} s"
         ));
@@ -302,10 +302,13 @@ pub fn notices(
         let straight = (v.goal() - v.start()).norm();
         if shortest / v.speed_max_mps > mission + TOL {
             // No path at all gets this vehicle there in time.
-            let dz = (v.goal()[2] - v.start()[2]).abs();
+            let dz = v.goal()[2] - v.start()[2];
+            // z is up: a goal below the start is a descent.
+            let change = if dz < 0.0 { "descending" } else { "climbing" };
             let why = if shortest > straight + TOL {
                 format!(
-                    "climbing {dz:.0} m within its {:.0}° pitch limit takes at least {shortest:.0} m of path (the straight line is {straight:.0} m)",
+                    "{change} {:.0} m within its {:.0}° pitch limit takes at least {shortest:.0} m of path (the straight line is {straight:.0} m)",
+                    dz.abs(),
                     v.max_pitch_deg
                 )
             } else {

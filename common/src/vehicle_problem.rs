@@ -14,7 +14,10 @@
 
 use rand::rngs::StdRng;
 
-use crate::cost::{entry_turn_penalty, separation_penalty, space_term, FleetModel, VehicleTerms};
+use crate::cost::{
+    early_arrival_penalty, entry_turn_penalty, separation_penalty, space_term, FleetModel,
+    VehicleTerms,
+};
 use crate::geometry::Vec3;
 use crate::separation::{motion_separation, Motion};
 use crate::swarm::Problem;
@@ -38,6 +41,9 @@ pub struct VehicleProblem<'a> {
     /// The course the vehicle is on at its start, when it starts under way (a replan): the
     /// turn onto the first leg is then limited like every other turn.
     heading_in: Option<Vec3>,
+    /// Whether a path too short to arrive with the others pays [`early_arrival_penalty`]:
+    /// planning wants every vehicle to arrive together; a replan under way may arrive early.
+    synchronised: bool,
 }
 
 /// Everything one evaluation found.
@@ -76,7 +82,14 @@ impl<'a> VehicleProblem<'a> {
             lower: model.lower[range.clone()].to_vec(),
             upper: model.upper[range].to_vec(),
             heading_in: None,
+            synchronised: true,
         }
+    }
+
+    /// An early arrival is not penalised (a replan under way: the vehicle may wait at its goal).
+    pub fn early_arrival_allowed(mut self) -> Self {
+        self.synchronised = false;
+        self
     }
 
     /// The vehicle starts under way along `heading` (see [`entry_turn_penalty`]).
@@ -97,6 +110,9 @@ impl<'a> VehicleProblem<'a> {
             terms.motion += entry_turn_penalty(h, &path.points, v.max_turn_deg.to_radians());
         }
         let target = self.arrival.max(length / v.speed_max_mps);
+        if self.synchronised {
+            terms.motion += early_arrival_penalty(length, v, target);
+        }
         let trajectory = retime_legs(path, &legs, v, target);
         let mine = Motion::new(&trajectory);
         let mut min_separation = f64::INFINITY;
@@ -240,6 +256,27 @@ mod tests {
             e.total,
             fleet.total
         );
+        Ok(())
+    }
+
+    #[test]
+    fn a_path_too_short_for_the_common_arrival_pays_unless_early_is_allowed(
+    ) -> Result<(), Box<dyn std::error::Error>> {
+        let mut s = scenario()?;
+        s.vehicles.truncate(1);
+        let model = FleetModel::new(&s);
+        let x = &straight_particle(&model)[..24];
+        // a's straight 800 m take at least 1600 s at 0.5 m/s: timed for 2000 s it is 400 s
+        // early, 1 + 400 / 2000 in the motion penalty; timed for 1600 s, on time.
+        let late = VehicleProblem::new(&model, 0, &[], 2000.0);
+        let e = late.evaluate(x);
+        assert!((e.terms.motion - 1.2).abs() < 1e-9, "{:?}", e.terms);
+        assert!((e.trajectory.arrival() - 1600.0).abs() < 1e-6);
+        let allowed = late.early_arrival_allowed().evaluate(x);
+        assert_eq!(allowed.terms.motion, 0.0);
+        assert!((e.total - allowed.total - 10.0 * 1.2).abs() < 1e-9);
+        let on_time = VehicleProblem::new(&model, 0, &[], 1600.0).evaluate(x);
+        assert_eq!(on_time.terms.motion, 0.0);
         Ok(())
     }
 

@@ -90,3 +90,30 @@ fn mp_pso_plan_is_consistent() -> TestResult {
 fn a_pso_plan_is_consistent() -> TestResult {
     tiny_run("a-pso")
 }
+
+/// A fleet plan that breaks limits (one iteration of a tiny swarm, no touch-up): exit 3, every
+/// violation printed, and the independent checker agrees with what `plan.json` says of it.
+#[test]
+fn an_infeasible_fleet_plan_exits_3_and_lists_its_violations() -> TestResult {
+    let dir = tempfile::tempdir()?;
+    let json = plan_and_check(
+        "amp-pso-2",
+        dir.path(),
+        &[
+            "--iterations",
+            "1",
+            "--populations",
+            "2",
+            "--particles",
+            "4",
+            "--no-touch-up",
+            "--seed",
+            "1",
+        ],
+    )?;
+    assert_eq!(key(&json, "feasible").as_bool(), Some(false));
+    let listed = key(&json, "violations").as_array().map_or(0, Vec::len);
+    assert!(listed >= 1, "{json}");
+    assert!(key(&json, "penalty").as_f64().is_some_and(|p| p > 0.0));
+    Ok(())
+}

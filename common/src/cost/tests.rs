@@ -244,3 +244,56 @@ fn a_swimmer_through_the_seabed_pays_for_it() -> Result<(), crate::scenario::Sce
     );
     Ok(())
 }
+
+#[test]
+fn early_arrival_penalty_by_hand() {
+    // 300 m at 0.5 m/s at the slowest: it cannot arrive later than 600 s.
+    let a = vehicle();
+    assert_eq!(early_arrival_penalty(300.0, &a, 600.0), 0.0);
+    assert_eq!(early_arrival_penalty(300.0, &a, 450.0), 0.0);
+    // Timed for 1000 s it arrives 400 s early: 1 + 400 / 1000.
+    assert_abs_diff_eq!(
+        early_arrival_penalty(300.0, &a, 1000.0),
+        1.4,
+        epsilon = 1e-12
+    );
+    // Half a second early already pays (so the swarm keeps clear of the 1 s threshold).
+    assert_abs_diff_eq!(
+        early_arrival_penalty(300.0, &a, 600.5),
+        1.0 + 0.5 / 600.5,
+        epsilon = 1e-12
+    );
+}
+
+/// eq. (12) added up by hand on two straight AUVs at half depth, and the early-arrival penalty
+/// of a vehicle too short to arrive with a slower one.
+#[test]
+fn the_fleet_fitness_adds_the_weighted_terms_by_hand() -> Result<(), crate::scenario::ScenarioError>
+{
+    use crate::fixtures::{scenario, straight_particle, vehicle_toml};
+    // a: 200 m, b: 900 m, both at z = 250 in a 500 m column, 800 m apart, mission time 400 s.
+    let a = vehicle_toml("a", [0.0, 100.0, 250.0], [200.0, 100.0, 250.0]);
+    let b = vehicle_toml("b", [0.0, 900.0, 250.0], [900.0, 900.0, 250.0]);
+    let model = FleetModel::new(&scenario(400.0, "", &[a.clone(), b])?);
+    let e = model.evaluate(&straight_particle(&model));
+    // b needs 600 s at 1.5 m/s, so everyone is timed for 600 s; a at 0.5 m/s takes 400 s.
+    assert_abs_diff_eq!(e.common_arrival, 600.0, epsilon = 1e-9);
+    assert_abs_diff_eq!(e.trajectories[0].arrival(), 400.0, epsilon = 1e-6);
+    // Per vehicle: λ1·F(L) + λ2·F(D) = 0.2·1 + 0.1·0.5 = 0.25; b also λ4·F(T) = 0.1 · (600 −
+    // 400) / 400 = 0.05. F(O) = F(S) = 0.
+    assert_abs_diff_eq!(e.vehicles[1].time, 0.5, epsilon = 1e-9);
+    assert_abs_diff_eq!(e.objective, 0.55, epsilon = 1e-9);
+    // a arrives 200 s early: 1 + 200 / 600; nothing else breaks a limit.
+    assert_abs_diff_eq!(e.vehicles[0].motion, 1.0 + 200.0 / 600.0, epsilon = 1e-9);
+    assert_abs_diff_eq!(e.penalty, 1.0 + 200.0 / 600.0, epsilon = 1e-9);
+    assert_abs_diff_eq!(e.total, 0.55 + 10.0 * (4.0 / 3.0), epsilon = 1e-9);
+    // With b 300 m long both arrive at the mission time: no penalty, no F(T).
+    let b = vehicle_toml("b", [0.0, 900.0, 250.0], [300.0, 900.0, 250.0]);
+    let model = FleetModel::new(&scenario(400.0, "", &[a, b])?);
+    let e = model.evaluate(&straight_particle(&model));
+    assert_abs_diff_eq!(e.common_arrival, 400.0, epsilon = 1e-9);
+    assert_abs_diff_eq!(e.objective, 0.5, epsilon = 1e-9);
+    assert_eq!(e.penalty, 0.0);
+    assert_abs_diff_eq!(e.total, 0.5, epsilon = 1e-9);
+    Ok(())
+}

@@ -200,6 +200,9 @@ pub struct Fleet {
     pub mission_time_s: f64,
 }
 
+/// The least distance between a vehicle's start and goal a path planner accepts, metres.
+pub const MIN_START_GOAL_DISTANCE_M: f64 = 1.0;
+
 impl Scenario {
     /// Reads, parses and validates a scenario file.
     pub fn load(path: &Path) -> Result<Scenario, ScenarioError> {
@@ -212,10 +215,21 @@ impl Scenario {
 
     /// Parses and validates scenario text; `file` is only used in error messages.
     pub fn parse(text: &str, file: &Path) -> Result<Scenario, ScenarioError> {
-        let mut scenario: Scenario = toml::from_str(text).map_err(|e| ScenarioError::Parse {
-            file: file.to_path_buf(),
-            message: e.to_string().trim_end().replace('\n', "\n  "),
-        })?;
+        let mut scenario: Scenario =
+            serde_path_to_error::deserialize(toml::Deserializer::new(text)).map_err(|e| {
+                // The path names the field even where toml's quoted line does not show its key
+                // (an element of an array written over several lines); "." is the whole file.
+                let field = e.path().to_string();
+                let message = e.into_inner().to_string().trim_end().replace('\n', "\n  ");
+                ScenarioError::Parse {
+                    file: file.to_path_buf(),
+                    message: if field == "." {
+                        message
+                    } else {
+                        format!("field {field}: {message}")
+                    },
+                }
+            })?;
         scenario.validate(file)?;
         if let Some(seabed) = &mut scenario.seabed {
             let bad = |field: String, value: String, reason: &str| ScenarioError::Invalid {
@@ -328,6 +342,22 @@ impl Scenario {
                         ));
                     }
                 }
+            }
+            // A path planner scores a path against its straight start-goal line (F(L) of seed
+            // 004 eq. (9), a crawler's standardisation): with the two on top of each other
+            // every score is a division by nothing. Tours and coverage have their own ends.
+            let straight = (v.goal() - v.start()).norm();
+            if self.inspection.is_none()
+                && self.coverage.is_none()
+                && straight < MIN_START_GOAL_DISTANCE_M
+            {
+                return Err(bad(
+                    format!("vehicles[{i}].goal"),
+                    format!("{:?}", v.goal),
+                    &format!(
+                        "lies {straight:.3} m from its start; a path needs them at least {MIN_START_GOAL_DISTANCE_M} m apart (a round trip is an [inspection] tour)"
+                    ),
+                ));
             }
             if !(v.speed_min_mps.is_finite() && v.speed_min_mps > 0.0) {
                 return Err(bad(

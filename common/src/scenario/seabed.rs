@@ -184,7 +184,9 @@ impl Seabed {
                 if !g.file.is_absolute() {
                     g.file = dir.join(&g.file);
                 }
-                Terrain::Grid(load_grid(g, file, bad)?)
+                let grid = load_grid(g, file, bad)?;
+                covers(&grid, area, &g.file, bad)?;
+                Terrain::Grid(grid)
             }
             (None, Some(r)) => {
                 let mut base = BaseRelief { datum_m: 0.0, ..*r };
@@ -205,6 +207,41 @@ impl Seabed {
         });
         Ok(())
     }
+}
+
+/// A grid must cover the scenario's horizontal box `[x_min, y_min, x_max, y_max]` (to within half
+/// a cell, for grids registered at cell centres): outside it the seabed would be made up from the
+/// edge heights, and a path planned over it would be checked against ground nobody measured.
+fn covers(
+    grid: &HeightGrid,
+    area: [f64; 4],
+    grid_file: &Path,
+    bad: Bad,
+) -> Result<(), ScenarioError> {
+    let half = 0.5 * grid.cell_m;
+    let x = [
+        grid.origin[0],
+        grid.origin[0] + (grid.cols.saturating_sub(1)) as f64 * grid.cell_m,
+    ];
+    let y = [
+        grid.origin[1],
+        grid.origin[1] + (grid.rows.saturating_sub(1)) as f64 * grid.cell_m,
+    ];
+    if x[0] - half <= area[0]
+        && x[1] + half >= area[2]
+        && y[0] - half <= area[1]
+        && y[1] + half >= area[3]
+    {
+        return Ok(());
+    }
+    Err(bad(
+        "seabed.grid.file".into(),
+        grid_file.display().to_string(),
+        &format!(
+            "covers x {:.1}..{:.1} m, y {:.1}..{:.1} m, less than the scenario's bounds x {:.1}..{:.1} m, y {:.1}..{:.1} m (outside a grid its edge heights would stand in for ground nobody measured)",
+            x[0], x[1], y[0], y[1], area[0], area[2], area[1], area[3]
+        ),
+    ))
 }
 
 /// Reads the grid file, naming the scenario and the grid file in errors.
@@ -404,6 +441,29 @@ mission_time_s = 200.0
         // The file path is stored absolute, so an agent elsewhere finds it too.
         let g = s.seabed.as_ref().and_then(|b| b.grid.as_ref());
         assert!(g.is_some_and(|g| g.file.is_absolute()));
+        Ok(())
+    }
+
+    #[test]
+    fn a_grid_smaller_than_the_area_is_refused() -> Result<(), Box<dyn std::error::Error>> {
+        let dir = tempfile::tempdir()?;
+        // 2 × 2 nodes 50 m apart: x and y 0..50 m of the 100 × 100 m box.
+        std::fs::write(dir.path().join("small.csv"), "0,1\n0,1\n")?;
+        let text = format!("{CRAWLER}[seabed.grid]\nfile = \"small.csv\"\ncell_m = 50.0\n");
+        let msg = message(Scenario::parse(&text, &dir.path().join("c.toml")));
+        assert!(
+            msg.contains("c.toml")
+                && msg.contains("seabed.grid.file")
+                && msg.contains("small.csv")
+                && msg.contains("covers x 0.0..50.0 m, y 0.0..50.0 m")
+                && msg.contains("x 0.0..100.0 m, y 0.0..100.0 m"),
+            "{msg}"
+        );
+        // 3 × 3 nodes 40 m apart reach 80 m: with the half cell of a centre-registered grid
+        // they cover the 100 m box.
+        std::fs::write(dir.path().join("centres.csv"), "0,1,2\n0,1,2\n0,1,2\n")?;
+        let text = format!("{CRAWLER}[seabed.grid]\nfile = \"centres.csv\"\ncell_m = 40.0\n");
+        assert!(Scenario::parse(&text, &dir.path().join("c.toml")).is_ok());
         Ok(())
     }
 }

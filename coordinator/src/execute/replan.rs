@@ -326,7 +326,8 @@ pub fn replan(r: &Request) -> Replanned {
     let model = FleetModel::new(&scenario);
     let context: Vec<Trajectory> = r.others.iter().map(|t| rebase(t, r.t0)).collect();
     let arrival = (r.arrival_s - r.t0).max(1.0);
-    let mut problem = VehicleProblem::new(&model, r.vehicle, &context, arrival);
+    let mut problem =
+        VehicleProblem::new(&model, r.vehicle, &context, arrival).early_arrival_allowed();
     if let Some(h) = r.heading {
         problem = problem.entering_along(h);
     }
