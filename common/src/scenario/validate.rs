@@ -1,0 +1,277 @@
+//! Scenario checks: every value a planner relies on, each bad one reported with the file, the
+//! field and the value (see [`ScenarioError::Invalid`]).
+
+use std::path::Path;
+
+use super::{ObstacleKind, Scenario, ScenarioError, VehicleKind};
+use crate::geometry::Vec3;
+
+/// The least distance between a vehicle's start and goal a path planner accepts, metres.
+pub const MIN_START_GOAL_DISTANCE_M: f64 = 1.0;
+
+impl Scenario {
+    /// Checks every value a planner relies on; the first bad one is reported.
+    pub fn validate(&self, file: &Path) -> Result<(), ScenarioError> {
+        let bad = |field: String, value: String, reason: &str| ScenarioError::Invalid {
+            file: file.to_path_buf(),
+            field,
+            value,
+            reason: reason.to_string(),
+        };
+        for axis in 0..3 {
+            let (lo, hi) = (self.bounds.min[axis], self.bounds.max[axis]);
+            if !(lo.is_finite() && hi.is_finite() && lo < hi) {
+                return Err(bad(
+                    format!("bounds.max[{axis}]"),
+                    format!("{hi}"),
+                    &format!("must be finite and greater than bounds.min[{axis}] = {lo}"),
+                ));
+            }
+        }
+        let inside =
+            |p: &[f64; 3]| (0..3).all(|a| p[a] >= self.bounds.min[a] && p[a] <= self.bounds.max[a]);
+        for (i, o) in self.obstacles.iter().enumerate() {
+            if !o.centre.iter().all(|c| c.is_finite()) {
+                return Err(bad(
+                    format!("obstacles[{i}].centre"),
+                    format!("{:?}", o.centre),
+                    "must be finite",
+                ));
+            }
+            if !(o.radius_m.is_finite() && o.radius_m > 0.0) {
+                return Err(bad(
+                    format!("obstacles[{i}].radius_m"),
+                    o.radius_m.to_string(),
+                    "must be a positive number of metres",
+                ));
+            }
+            if !(o.inflation_m.is_finite() && o.inflation_m >= 0.0) {
+                return Err(bad(
+                    format!("obstacles[{i}].inflation_m"),
+                    o.inflation_m.to_string(),
+                    "must be zero or a positive number of metres",
+                ));
+            }
+        }
+        if self.vehicles.is_empty() {
+            return Err(bad(
+                "vehicles".into(),
+                "[]".into(),
+                "at least one vehicle is needed",
+            ));
+        }
+        for (i, v) in self.vehicles.iter().enumerate() {
+            if crate::wire::topics::check_id("vehicle", &v.id).is_err() {
+                return Err(bad(
+                    format!("vehicles[{i}].id"),
+                    format!("{:?}", v.id),
+                    "must be 1-64 letters, digits, '-', '_' or '.' (it names the vehicle on the network)",
+                ));
+            }
+            if let Some(j) = self.vehicles[..i].iter().position(|w| w.id == v.id) {
+                return Err(bad(
+                    format!("vehicles[{i}].id"),
+                    format!("{:?}", v.id),
+                    &format!("duplicates vehicles[{j}].id"),
+                ));
+            }
+            for (name, p) in [("start", &v.start), ("goal", &v.goal)] {
+                if !inside(p) {
+                    return Err(bad(
+                        format!("vehicles[{i}].{name}"),
+                        format!("{p:?}"),
+                        "lies outside the bounds",
+                    ));
+                }
+                for o in self
+                    .obstacles
+                    .iter()
+                    .filter(|o| o.kind == ObstacleKind::Hard)
+                {
+                    let d = (Vec3::from(*p) - o.centre()).norm();
+                    if d < o.inflated_radius() {
+                        return Err(bad(
+                            format!("vehicles[{i}].{name}"),
+                            format!("{p:?}"),
+                            &format!("lies inside hard obstacle {} (radius plus inflation {:.1} m, distance {d:.1} m)", o.id, o.inflated_radius()),
+                        ));
+                    }
+                }
+            }
+            // A path planner scores a path against its straight start-goal line (F(L) of seed
+            // 004 eq. (9), a crawler's standardisation): with the two on top of each other
+            // every score is a division by nothing. Tours and coverage have their own ends.
+            let straight = (v.goal() - v.start()).norm();
+            if self.inspection.is_none()
+                && self.coverage.is_none()
+                && straight < MIN_START_GOAL_DISTANCE_M
+            {
+                return Err(bad(
+                    format!("vehicles[{i}].goal"),
+                    format!("{:?}", v.goal),
+                    &format!(
+                        "lies {straight:.3} m from its start; a path needs them at least {MIN_START_GOAL_DISTANCE_M} m apart (a round trip is an [inspection] tour)"
+                    ),
+                ));
+            }
+            if !(v.speed_min_mps.is_finite() && v.speed_min_mps > 0.0) {
+                return Err(bad(
+                    format!("vehicles[{i}].speed_min_mps"),
+                    v.speed_min_mps.to_string(),
+                    "must be a positive speed in m/s",
+                ));
+            }
+            if !(v.speed_max_mps.is_finite() && v.speed_max_mps >= v.speed_min_mps) {
+                return Err(bad(
+                    format!("vehicles[{i}].speed_max_mps"),
+                    v.speed_max_mps.to_string(),
+                    "must be at least speed_min_mps",
+                ));
+            }
+            if !(v.max_turn_deg > 0.0 && v.max_turn_deg <= 180.0) {
+                return Err(bad(
+                    format!("vehicles[{i}].max_turn_deg"),
+                    v.max_turn_deg.to_string(),
+                    "must be in (0, 180] degrees",
+                ));
+            }
+            if !(v.max_pitch_deg > 0.0 && v.max_pitch_deg <= 90.0) {
+                return Err(bad(
+                    format!("vehicles[{i}].max_pitch_deg"),
+                    v.max_pitch_deg.to_string(),
+                    "must be in (0, 90] degrees",
+                ));
+            }
+            if let Some(r) = v.turn_radius_m {
+                if !(r.is_finite() && r > 0.0) {
+                    return Err(bad(
+                        format!("vehicles[{i}].turn_radius_m"),
+                        r.to_string(),
+                        "must be a positive number of metres",
+                    ));
+                }
+            }
+        }
+        if !(self.fleet.d_min_m.is_finite() && self.fleet.d_min_m >= 0.0) {
+            return Err(bad(
+                "fleet.d_min_m".into(),
+                self.fleet.d_min_m.to_string(),
+                "must be zero or a positive number of metres",
+            ));
+        }
+        if !(self.fleet.mission_time_s.is_finite() && self.fleet.mission_time_s > 0.0) {
+            return Err(bad(
+                "fleet.mission_time_s".into(),
+                self.fleet.mission_time_s.to_string(),
+                "must be a positive number of seconds",
+            ));
+        }
+        self.optimizer.validate(&bad)?;
+        self.validate_crawlers(&bad)?;
+        self.energy.validate(self.currents.as_ref(), &bad)?;
+        let algorithm = self.optimizer.algorithm;
+        if let Some(inspection) = &self.inspection {
+            inspection.validate(self, &bad)?;
+        }
+        if let Some(coverage) = &self.coverage {
+            coverage.validate(&bad)?;
+        }
+        if algorithm.is_tour_planner() && self.inspection.is_none() {
+            return Err(bad(
+                "optimizer.algorithm".into(),
+                format!("{:?}", algorithm.as_str()),
+                "plans inspection tours (seed 003): add an [inspection] table",
+            ));
+        }
+        if algorithm.is_energy_planner() {
+            if self.vehicles.len() != 1 {
+                return Err(bad(
+                    "optimizer.algorithm".into(),
+                    format!("{:?}", algorithm.as_str()),
+                    &format!(
+                        "plans one AUV (seed 001); this scenario has {} vehicles",
+                        self.vehicles.len()
+                    ),
+                ));
+            }
+            if self.vehicles[0].kind != VehicleKind::Auv {
+                return Err(bad(
+                    "vehicles[0].kind".into(),
+                    format!("{:?}", self.vehicles[0].kind),
+                    &format!("{} plans AUVs, not crawlers", algorithm.as_str()),
+                ));
+            }
+        }
+        if self.inspection.is_some() && !algorithm.is_tour_planner() {
+            // Every vehicle of an inspection scenario returns to its base: any other planner
+            // would plan it a path of zero length and call it feasible.
+            return Err(bad(
+                "optimizer.algorithm".into(),
+                format!("{:?}", algorithm.as_str()),
+                "plans paths from a start to a goal, but this scenario has an [inspection] table: plan its tours with de-pso, ldiw-pso or lcpso",
+            ));
+        }
+        Ok(())
+    }
+
+    /// The crawler parts: hazards, crawler settings, and a seabed for every crawler.
+    fn validate_crawlers(
+        &self,
+        bad: &dyn Fn(String, String, &str) -> ScenarioError,
+    ) -> Result<(), ScenarioError> {
+        for (i, h) in self.hazards.iter().enumerate() {
+            if crate::wire::topics::check_id("hazard", &h.id).is_err() {
+                return Err(bad(
+                    format!("hazards[{i}].id"),
+                    format!("{:?}", h.id),
+                    "must be 1-64 letters, digits, '-', '_' or '.'",
+                ));
+            }
+            if !h.centre.iter().all(|c| c.is_finite()) {
+                return Err(bad(
+                    format!("hazards[{i}].centre"),
+                    format!("{:?}", h.centre),
+                    "must be finite",
+                ));
+            }
+            for (name, v) in [("radius_m", h.radius_m), ("height_m", h.height_m)] {
+                if !(v.is_finite() && v > 0.0) {
+                    return Err(bad(
+                        format!("hazards[{i}].{name}"),
+                        v.to_string(),
+                        "must be a positive number of metres",
+                    ));
+                }
+            }
+        }
+        self.crawler.validate(bad)?;
+        for (i, v) in self.vehicles.iter().enumerate() {
+            if v.kind != VehicleKind::Crawler {
+                continue;
+            }
+            if self.seabed.is_none() && self.coverage.is_none() {
+                return Err(bad(
+                    format!("vehicles[{i}].kind"),
+                    "\"crawler\"".into(),
+                    "a crawler drives on the seabed: add a [seabed] table (relief or grid) or a [coverage] table",
+                ));
+            }
+            for (name, p) in [("start", &v.start), ("goal", &v.goal)] {
+                for h in &self.hazards {
+                    let d = (p[0] - h.centre[0]).hypot(p[1] - h.centre[1]);
+                    if d < h.radius_m {
+                        return Err(bad(
+                            format!("vehicles[{i}].{name}"),
+                            format!("{p:?}"),
+                            &format!(
+                                "lies inside hazard {} (radius {:.1} m, distance {d:.1} m)",
+                                h.id, h.radius_m
+                            ),
+                        ));
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+}
