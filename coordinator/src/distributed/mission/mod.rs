@@ -12,11 +12,11 @@ use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use shoal_common::cost::FleetModel;
-use shoal_common::distributed::follower::{FollowerSettings, Followers};
+use shoal_common::distributed::follower::FollowerSettings;
 use shoal_common::distributed::leader::Leader;
 use shoal_common::distributed::lockstep::context_due;
 use shoal_common::distributed::{round_iterations, rounds, Chromosome, Context};
-use shoal_common::plan::{AgentFigures, DegradedVehicle, DistributedFigures};
+use shoal_common::plan::{AgentFigures, DistributedFigures};
 use shoal_common::scenario::Scenario;
 use shoal_common::swarm::{Progress, Termination};
 use shoal_common::wire::agent_to_coordinator::AgentToCoordinator;
@@ -24,8 +24,10 @@ use shoal_common::wire::coordinator_to_agent::CoordinatorToAgent;
 use shoal_common::wire::{WireChromosome, WireContext};
 
 mod join;
+mod seat;
 mod shares;
 
+use seat::{RoundSpan, Seat};
 pub use shares::{Share, ShareJob};
 
 use super::agents::LocalAgents;
@@ -54,37 +56,6 @@ pub struct Status {
     pub alive: usize,
     /// Vehicles.
     pub vehicles: usize,
-}
-
-/// One vehicle's seat in the mission.
-struct Seat {
-    id: String,
-    alive: bool,
-    joined: bool,
-    /// Followers run here after the agent was lost.
-    local: Option<Followers>,
-    degraded: Option<DegradedVehicle>,
-    last_elites: Vec<Chromosome>,
-    this_round: Option<Vec<Chromosome>>,
-    elites_received: u32,
-    agent_iterations: u32,
-    /// Evaluations the agent last reported.
-    agent_evaluations: u64,
-    done: Option<(u32, u64, u32)>,
-    /// When and why its agent was seen to go (token gone, process exited).
-    gone: Option<(Instant, String)>,
-    /// One-shot missions: the vehicle's share, from its agent or planned here.
-    share: Option<Share>,
-}
-
-impl Seat {
-    /// Keeps an agent's elites for the current round, with the figures they report.
-    fn take_elites(&mut self, iteration: u32, evaluations: u64, particles: Vec<WireChromosome>) {
-        self.elites_received += 1;
-        self.agent_iterations = iteration;
-        self.agent_evaluations = evaluations;
-        self.this_round = Some(particles.into_iter().map(Chromosome::from).collect());
-    }
 }
 
 /// How long a vehicle whose agent was seen to go keeps its seat: Zenoh sends declarations
@@ -135,7 +106,12 @@ pub fn run(
             break;
         }
         let n = round_iterations(o.iterations, o.distributed.exchange_every, round);
-        r.collect(round as u32, iteration, &context, local.as_deref_mut())?;
+        let span = RoundSpan {
+            index: round as u32,
+            start: iteration,
+            len: n,
+        };
+        r.collect(span, &context, local.as_deref_mut())?;
         for seat in &mut r.seats {
             // An agent lost after it sent this round's elites is planned here from the next.
             if seat.this_round.is_some() {
@@ -275,25 +251,7 @@ impl<'a> Run<'a> {
         timing: Timing,
         mission: &str,
     ) -> Run<'a> {
-        let seats = scenario
-            .vehicles
-            .iter()
-            .map(|v| Seat {
-                id: v.id.clone(),
-                alive: false,
-                joined: false,
-                local: None,
-                degraded: None,
-                last_elites: Vec::new(),
-                this_round: None,
-                elites_received: 0,
-                agent_iterations: 0,
-                agent_evaluations: 0,
-                done: None,
-                gone: None,
-                share: None,
-            })
-            .collect();
+        let seats = scenario.vehicles.iter().map(|v| Seat::new(&v.id)).collect();
         Run {
             scenario,
             model,
@@ -362,41 +320,19 @@ impl Run<'_> {
     }
 
     /// Plans vehicle `i` here from now on.
-    fn degrade(&mut self, i: usize, round: u32, iteration: usize, context: &Context, why: String) {
-        if self.seats[i].local.is_some() {
-            return;
-        }
-        let o = &self.scenario.optimizer;
-        let settings = FollowerSettings::of(o);
-        let seat = &mut self.seats[i];
-        tracing::warn!(
-            "planning {} in the coordinator from round {round}: {why}",
-            seat.id
-        );
-        seat.local = Some(Followers::resume(
-            Arc::clone(&self.model),
-            i,
-            settings,
-            context.clone(),
-            &seat.last_elites,
-            iteration,
-        ));
-        seat.alive = false;
-        seat.degraded = Some(DegradedVehicle {
-            vehicle: seat.id.clone(),
-            from_round: round,
-            reason: why,
-        });
+    fn degrade(&mut self, i: usize, span: RoundSpan, context: &Context, why: String) {
+        let settings = FollowerSettings::of(&self.scenario.optimizer);
+        self.seats[i].take_over(&self.model, i, settings, context, span, why);
     }
 
-    /// Gathers round `round`'s elites from every agent still planning.
+    /// Gathers round `span`'s elites from every agent still planning.
     fn collect(
         &mut self,
-        round: u32,
-        iteration: usize,
+        span: RoundSpan,
         context: &Context,
         mut local: Option<&mut LocalAgents>,
     ) -> anyhow::Result<()> {
+        let round = span.index;
         let deadline = Instant::now() + self.timing.round;
         loop {
             let waiting: Vec<usize> = (0..self.seats.len())
@@ -420,7 +356,7 @@ impl Run<'_> {
                     .map(|(_, why)| why.clone());
                 if let Some(why) = expired {
                     if !self.finished(i) {
-                        self.degrade(i, round, iteration, context, why);
+                        self.degrade(i, span, context, why);
                     }
                 }
             }
@@ -430,7 +366,7 @@ impl Run<'_> {
                         "no elites from its agent within {:.1} s in round {round}",
                         self.timing.round.as_secs_f64()
                     );
-                    self.degrade(i, round, iteration, context, why);
+                    self.degrade(i, span, context, why);
                 }
                 return Ok(());
             }
@@ -468,7 +404,7 @@ impl Run<'_> {
                         self.seats[i].agent_iterations = iterations;
                         if !self.finished(i) {
                             let why = "its agent ended the mission early (shut down or lost the coordinator)";
-                            self.degrade(i, round, iteration, context, why.into());
+                            self.degrade(i, span, context, why.into());
                         }
                     }
                 }
