@@ -142,11 +142,27 @@ mod tests {
         Ok(Arc::new(FleetModel::new(&s)))
     }
 
-    /// Two valid elites of vehicle 0, from followers of another seed.
-    fn elites(model: &Arc<FleetModel>, context: &Context) -> Vec<Chromosome> {
-        let mut settings = FollowerSettings::of(&model.scenario.optimizer);
-        settings.seed = 99;
-        Followers::new(Arc::clone(model), 0, settings, context.clone()).emigrants()
+    /// Scenario 1's model, follower settings, the leader's first context and two valid
+    /// elites of vehicle 0 (from followers of another seed).
+    type Mission = (Arc<FleetModel>, FollowerSettings, Context, Vec<Chromosome>);
+
+    fn mission() -> Result<Mission, Box<dyn std::error::Error>> {
+        let model = model()?;
+        let o = model.scenario.optimizer.clone();
+        let settings = FollowerSettings::of(&o);
+        let context = Leader::new(Arc::clone(&model), &o, settings.schedule).context(0);
+        let mut other = settings.clone();
+        other.seed = 99;
+        let elites = Followers::new(Arc::clone(&model), 0, other, context.clone()).emigrants();
+        Ok((model, settings, context, elites))
+    }
+
+    /// A one-gene elite `x` at velocity `v`.
+    fn elite(x: f64, v: f64) -> Vec<Chromosome> {
+        vec![Chromosome {
+            x: vec![x],
+            v: vec![v],
+        }]
     }
 
     const SPAN: RoundSpan = RoundSpan {
@@ -158,10 +174,7 @@ mod tests {
     #[test]
     fn an_agent_lost_before_its_elites_resumes_at_the_round_start_from_the_last_ones() {
         let mut seat = Seat::new("auv1");
-        seat.last_elites = vec![Chromosome {
-            x: vec![1.0],
-            v: vec![0.0],
-        }];
+        seat.last_elites = elite(1.0, 0.0);
         let (from, done) = seat.resume_point(SPAN);
         assert_eq!(done, 10);
         assert_eq!(from, seat.last_elites.as_slice());
@@ -170,14 +183,8 @@ mod tests {
     #[test]
     fn an_agent_lost_after_its_elites_resumes_after_the_round_from_those_elites() {
         let mut seat = Seat::new("auv1");
-        seat.last_elites = vec![Chromosome {
-            x: vec![1.0],
-            v: vec![0.0],
-        }];
-        let newer = vec![Chromosome {
-            x: vec![2.0],
-            v: vec![0.5],
-        }];
+        seat.last_elites = elite(1.0, 0.0);
+        let newer = elite(2.0, 0.5);
         seat.take_elites(15, 400, newer.iter().map(WireChromosome::from).collect());
         let (from, done) = seat.resume_point(SPAN);
         assert_eq!(done, 15);
@@ -189,12 +196,9 @@ mod tests {
     /// run once the mission loop has stepped the rounds after this one.
     #[test]
     fn a_vehicle_taken_over_after_its_elites_counts_the_round_its_agent_ran() -> TestResult {
-        let model = model()?;
-        let o = model.scenario.optimizer.clone();
-        let settings = FollowerSettings::of(&o);
-        let context = Leader::new(Arc::clone(&model), &o, settings.schedule).context(0);
+        let (model, settings, context, elites) = mission()?;
         let mut seat = Seat::new("auv1");
-        seat.last_elites = elites(&model, &context);
+        seat.last_elites = elites;
         seat.take_elites(
             15,
             400,
@@ -223,12 +227,9 @@ mod tests {
 
     #[test]
     fn a_vehicle_taken_over_before_its_elites_resumes_at_the_round_start() -> TestResult {
-        let model = model()?;
-        let o = model.scenario.optimizer.clone();
-        let settings = FollowerSettings::of(&o);
-        let context = Leader::new(Arc::clone(&model), &o, settings.schedule).context(0);
+        let (model, settings, context, elites) = mission()?;
         let mut seat = Seat::new("auv2");
-        seat.last_elites = elites(&model, &context);
+        seat.last_elites = elites;
         seat.take_over(&model, 1, settings, &context, SPAN, "silent".into());
         let f = seat.local.as_ref().ok_or("not planned here")?;
         assert_eq!((f.iterations, f.vehicle()), (10, 1));
