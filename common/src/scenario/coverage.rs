@@ -4,7 +4,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::ScenarioError;
+use super::{Bad, ScenarioError};
 use crate::coverage::params::CoverageParams;
 use crate::coverage::tracking::TrackingParams;
 use crate::coverage::{Terrain25Error, TerrainSpec, TraversalLimits};
@@ -48,10 +48,7 @@ impl Default for CoverageSettings {
 
 impl CoverageSettings {
     /// Checks every sub-table; errors name `coverage.<table>.<field>`.
-    pub fn validate(
-        &self,
-        bad: &dyn Fn(String, String, &str) -> ScenarioError,
-    ) -> Result<(), ScenarioError> {
+    pub fn validate(&self, bad: Bad) -> Result<(), ScenarioError> {
         let wrap = |table: &str, e: Terrain25Error| match e {
             Terrain25Error::InvalidSpec { field, what }
             | Terrain25Error::InvalidParam { field, what } => {

@@ -5,7 +5,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::{ObstacleKind, Scenario, ScenarioError, VehicleKind};
+use super::{Bad, ObstacleKind, Scenario, ScenarioError, VehicleKind};
 
 /// How the first inspection point of each cage is placed (the second mirrors it).
 #[derive(Debug, Clone, Copy, Serialize, Deserialize, PartialEq, Eq, Default)]
@@ -62,11 +62,7 @@ impl InspectionSettings {
     }
 
     /// Checks the table against the scenario it belongs to.
-    pub fn validate(
-        &self,
-        scenario: &Scenario,
-        bad: &dyn Fn(String, String, &str) -> ScenarioError,
-    ) -> Result<(), ScenarioError> {
+    pub fn validate(&self, scenario: &Scenario, bad: Bad) -> Result<(), ScenarioError> {
         for (i, id) in self.cages.iter().enumerate() {
             let found = scenario.obstacles.iter().find(|o| &o.id == id);
             match found {

@@ -53,6 +53,19 @@ pub enum ScenarioError {
     },
 }
 
+/// Reports a bad value (field, value, reason) of the scenario file: what every check is handed.
+type Bad<'a> = &'a dyn Fn(String, String, &str) -> ScenarioError;
+
+/// The [`Bad`] reporter of scenario `file`.
+fn invalid_in(file: &Path) -> impl Fn(String, String, &str) -> ScenarioError + '_ {
+    move |field, value, reason| ScenarioError::Invalid {
+        file: file.to_path_buf(),
+        field,
+        value,
+        reason: reason.to_string(),
+    }
+}
+
 /// A whole mission: where, what is in the way, who goes where, and how to optimise.
 #[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
@@ -230,25 +243,14 @@ impl Scenario {
                 }
             })?;
         scenario.validate(file)?;
+        let bad = invalid_in(file);
         if let Some(seabed) = &mut scenario.seabed {
-            let bad = |field: String, value: String, reason: &str| ScenarioError::Invalid {
-                file: file.to_path_buf(),
-                field,
-                value,
-                reason: reason.to_string(),
-            };
             let dir = file.parent().unwrap_or(Path::new("."));
             let b = &scenario.bounds;
             let area = [b.min[0], b.min[1], b.max[0], b.max[1]];
             seabed.resolve(area, dir, file, &bad)?;
         }
         if let Some(currents) = &mut scenario.currents {
-            let bad = |field: String, value: String, reason: &str| ScenarioError::Invalid {
-                file: file.to_path_buf(),
-                field,
-                value,
-                reason: reason.to_string(),
-            };
             currents.resolve(file.parent().unwrap_or(Path::new(".")), file, &bad)?;
         }
         Ok(scenario)

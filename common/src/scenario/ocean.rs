@@ -6,12 +6,10 @@ use std::sync::Arc;
 
 use serde::{Deserialize, Serialize};
 
-use super::ScenarioError;
+use super::{Bad, ScenarioError};
 use crate::current::{CurrentField, DepthDecayCurrent, StillWater};
 use crate::current_grid::GridCurrent;
 use crate::energy::Weights;
-
-type Bad<'a> = &'a dyn Fn(String, String, &str) -> ScenarioError;
 
 /// Which current model a scenario uses.
 #[derive(Debug, Clone, Copy, Serialize, Deserialize, PartialEq, Eq, Default)]
@@ -212,11 +210,7 @@ impl EnergySettings {
     }
 
     /// Checks every value; `bad` builds the error naming the field.
-    pub fn validate(
-        &self,
-        currents: Option<&Currents>,
-        bad: &dyn Fn(String, String, &str) -> ScenarioError,
-    ) -> Result<(), ScenarioError> {
+    pub fn validate(&self, currents: Option<&Currents>, bad: Bad) -> Result<(), ScenarioError> {
         let positive = [
             ("energy.min_turn_radius_m", self.min_turn_radius_m),
             ("energy.mu", self.mu),

@@ -3,7 +3,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::ScenarioError;
+use super::{Bad, ScenarioError};
 
 /// The optimizers `plan` can run.
 #[derive(Debug, Clone, Copy, Serialize, Deserialize, PartialEq, Eq, Default)]
@@ -217,10 +217,7 @@ impl Default for OptimizerSettings {
 
 impl OptimizerSettings {
     /// Checks every setting; `bad(field, value, reason)` builds the error naming the file.
-    pub(super) fn validate(
-        &self,
-        bad: &dyn Fn(String, String, &str) -> ScenarioError,
-    ) -> Result<(), ScenarioError> {
+    pub(super) fn validate(&self, bad: Bad) -> Result<(), ScenarioError> {
         let o = self;
         let positive = [
             ("optimizer.populations", o.populations),

@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
-use super::ScenarioError;
+use super::{Bad, ScenarioError};
 use crate::terrain::{BaseRelief, HeightGrid, Mountain, Terrain};
 
 /// The seabed: the analytic model of eq. (2) + (3), or a measured height grid from a file.
@@ -104,8 +104,6 @@ impl Default for CrawlerSettings {
         }
     }
 }
-
-type Bad<'a> = &'a dyn Fn(String, String, &str) -> ScenarioError;
 
 impl Seabed {
     /// Checks the values and builds the terrain (reading a grid file relative to `dir`).

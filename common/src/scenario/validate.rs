@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-use super::{ObstacleKind, Scenario, ScenarioError, VehicleKind};
+use super::{invalid_in, Bad, ObstacleKind, Scenario, ScenarioError, VehicleKind};
 use crate::geometry::Vec3;
 
 /// The least distance between a vehicle's start and goal a path planner accepts, metres.
@@ -12,12 +12,7 @@ pub const MIN_START_GOAL_DISTANCE_M: f64 = 1.0;
 impl Scenario {
     /// Checks every value a planner relies on; the first bad one is reported.
     pub fn validate(&self, file: &Path) -> Result<(), ScenarioError> {
-        let bad = |field: String, value: String, reason: &str| ScenarioError::Invalid {
-            file: file.to_path_buf(),
-            field,
-            value,
-            reason: reason.to_string(),
-        };
+        let bad = invalid_in(file);
         for axis in 0..3 {
             let (lo, hi) = (self.bounds.min[axis], self.bounds.max[axis]);
             if !(lo.is_finite() && hi.is_finite() && lo < hi) {
@@ -215,10 +210,7 @@ impl Scenario {
     }
 
     /// The crawler parts: hazards, crawler settings, and a seabed for every crawler.
-    fn validate_crawlers(
-        &self,
-        bad: &dyn Fn(String, String, &str) -> ScenarioError,
-    ) -> Result<(), ScenarioError> {
+    fn validate_crawlers(&self, bad: Bad) -> Result<(), ScenarioError> {
         for (i, h) in self.hazards.iter().enumerate() {
             if crate::wire::topics::check_id("hazard", &h.id).is_err() {
                 return Err(bad(
