@@ -258,7 +258,6 @@ fn a_goal_on_top_of_its_start_is_named() {
 /// HObs#4, which the table lists and the text never adds).
 #[test]
 fn the_shipped_amp_pso_scenarios_are_seed_004_tables_2_to_4() -> Result<(), ScenarioError> {
-    const KNOT: f64 = 1852.0 / 3600.0;
     let obstacles = [
         ("HObs#1", ObstacleKind::Hard, [10.0, 10.0, 10.0], 0.3),
         ("SObs#1", ObstacleKind::Soft, [8.0, 2.0, 12.0], 0.2),
@@ -307,8 +306,11 @@ fn the_shipped_amp_pso_scenarios_are_seed_004_tables_2_to_4() -> Result<(), Scen
         assert_eq!(s.vehicles.len(), n_auvs, "{file}");
         for (v, (id, start, goal)) in s.vehicles.iter().zip(&auvs) {
             assert_eq!((v.id.as_str(), v.start, v.goal), (*id, m(*start), m(*goal)));
-            assert!((v.speed_min_mps - KNOT).abs() < 1e-3, "{file}: {id}");
-            assert!((v.speed_max_mps - 3.0 * KNOT).abs() < 1e-3, "{file}: {id}");
+            assert!((v.speed_min_mps - KNOT_MPS).abs() < 1e-3, "{file}: {id}");
+            assert!(
+                (v.speed_max_mps - 3.0 * KNOT_MPS).abs() < 1e-3,
+                "{file}: {id}"
+            );
             assert_eq!(
                 (v.max_turn_deg, v.max_pitch_deg),
                 (35.0, 20.0),
