@@ -17,6 +17,7 @@ pub mod fleet;
 pub mod geometry;
 pub mod gridsearch;
 pub mod health;
+pub mod limits;
 pub mod plan;
 pub mod queue;
 pub mod scenario;
