@@ -67,9 +67,15 @@ fn main() -> Result<(), Box<dyn std::error::Error + Send + Sync>> {
     let router = zenoh::open(session::router_config(
         std::slice::from_ref(&endpoint),
         &[],
+        &Default::default(),
     )?)
     .wait()?;
-    let client = zenoh::open(session::client_config(&[endpoint], false)?).wait()?;
+    let client = zenoh::open(session::client_config(
+        &[endpoint],
+        false,
+        &Default::default(),
+    )?)
+    .wait()?;
     let up = topics::to_coordinator("bench", "auv1")?;
     let down = topics::to_agent("bench", "auv1")?;
     let inbox = router.declare_subscriber(up.as_str()).wait()?;

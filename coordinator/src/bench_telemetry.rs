@@ -73,6 +73,7 @@ pub fn command(args: &BenchTelemetryArgs, stop: &AtomicBool) -> anyhow::Result<i
         agents: AgentsMode::Embedded,
         listen: vec!["tcp/127.0.0.1:0".into()],
         routers: Vec::new(),
+        security: Default::default(),
         join_timeout: Duration::from_secs(60),
         round_timeout: Duration::from_secs(10),
         agent_bin: None,

@@ -30,6 +30,9 @@ pub enum Command {
     /// Run only a Zenoh router (what `zenohd` does) until Ctrl-C: a hub that outlives missions,
     /// so several coordinators (`plan --router`) and one set of agents can share it.
     Router(RouterArgs),
+    /// Make a secured fleet's certificates and Zenoh configurations: a local CA, one
+    /// certificate per member (coordinator, vehicles, operators) and the access-control rules.
+    Keys(crate::keys::KeysArgs),
     /// Container healthcheck: exit 0 if the health file was rewritten in the last 10 s.
     Health(HealthArgs),
     /// Run the benchmark-function suite (seed 000 Table 3–6).
@@ -108,6 +111,14 @@ pub struct PlanArgs {
     /// two missions share one network and its agents (comma-separated).
     #[arg(long, env = "SHOAL_ROUTERS", value_delimiter = ',')]
     pub router: Vec<String>,
+    /// Distributed mode: how members authenticate to the embedded router (listening beyond
+    /// loopback needs it, or --insecure).
+    #[command(flatten)]
+    pub zenoh: shoal_common::wire::flags::ZenohSecurityArgs,
+    /// Set by `serve` (never a flag): the identity its mission routers link to the serving
+    /// router with, instead of `zenoh`.
+    #[arg(skip)]
+    pub link_security: Option<shoal_common::wire::security::Security>,
     /// Distributed mode: seconds the agents have to join.
     #[arg(long, env = "SHOAL_JOIN_TIMEOUT", default_value_t = 30.0)]
     pub join_timeout: f64,
@@ -138,6 +149,9 @@ pub struct RouterArgs {
         default_value = "tcp/0.0.0.0:7447"
     )]
     pub listen: Vec<String>,
+    /// How members authenticate (a router beyond loopback needs it, or --insecure).
+    #[command(flatten)]
+    pub zenoh: shoal_common::wire::flags::ZenohSecurityArgs,
 }
 
 /// `shoal-coordinator health`.

@@ -1,6 +1,7 @@
 //! Shoal's coordinator as a library: the binary parses its command line and calls [`run`]; tests
 //! call [`run`] (or the functions it uses) directly.
 
+pub mod acl;
 pub mod bench_cages;
 pub mod bench_energy;
 pub mod bench_functions;
@@ -16,6 +17,7 @@ pub mod distributed;
 pub mod energy_planner;
 pub mod execute;
 pub mod generate;
+pub mod keys;
 pub mod planner;
 pub mod replay;
 pub mod run_cmd;
@@ -78,9 +80,10 @@ pub fn run(command: Command, shutdown: Arc<AtomicBool>) -> anyhow::Result<i32> {
             Ok(EXIT_FEASIBLE)
         }
         Command::Router(args) => {
-            distributed::network::serve_router(&args.listen, &shutdown)?;
+            distributed::network::serve_router(&args.listen, &args.zenoh.security()?, &shutdown)?;
             Ok(EXIT_FEASIBLE)
         }
+        Command::Keys(args) => keys::command(&args),
         Command::Generate(args) => {
             generate::generate(&args)?;
             say(&format!("Wrote {}\n", args.out.display()));
@@ -122,6 +125,7 @@ fn compare_command(args: &compare::CompareArgs, stop: &Arc<AtomicBool>) -> anyho
         agents: distributed::AgentsMode::Embedded,
         listen: vec!["tcp/127.0.0.1:0".into()],
         routers: Vec::new(),
+        security: Default::default(),
         join_timeout: std::time::Duration::from_secs(30),
         round_timeout: std::time::Duration::from_secs(10),
         agent_bin: None,
@@ -244,6 +248,10 @@ pub fn distributed_options(
         agents: args.agents,
         listen,
         routers: args.router.clone(),
+        security: match &args.link_security {
+            Some(s) => s.clone(),
+            None => args.zenoh.security()?,
+        },
         join_timeout: seconds("--join-timeout (SHOAL_JOIN_TIMEOUT)", args.join_timeout)?,
         round_timeout: seconds("--round-timeout (SHOAL_ROUND_TIMEOUT)", args.round_timeout)?,
         agent_bin: args.agent_bin.clone(),

@@ -31,6 +31,9 @@ pub struct ServeArgs {
         default_value = "tcp/0.0.0.0:7447"
     )]
     pub listen: Vec<String>,
+    /// How clients and agents authenticate (listening beyond loopback needs it, or --insecure).
+    #[command(flatten)]
+    pub zenoh: shoal_common::wire::flags::ZenohSecurityArgs,
     /// Where each mission's files go (`<out>/<mission>/`).
     #[arg(long, env = "SHOAL_OUT", default_value = "missions")]
     pub out: PathBuf,
@@ -125,7 +128,9 @@ pub fn command(args: &ServeArgs, shutdown: Arc<AtomicBool>) -> anyhow::Result<i3
         .iter()
         .map(|e| crate::distributed::network::resolve_port_zero(e))
         .collect::<anyhow::Result<_>>()?;
-    let config = session::router_config(&listen, &[])?;
+    let config = session::router_config(&listen, &[], &args.zenoh.security()?)?;
+    // Each mission's router links to this one with this router's own identity.
+    let link_security = shoal_common::wire::security::link_identity(&config);
     let router = zenoh::open(config)
         .wait()
         .map_err(|e| anyhow::anyhow!("cannot open a Zenoh router on {}: {e}", listen.join(", ")))?;
@@ -211,7 +216,10 @@ pub fn command(args: &ServeArgs, shutdown: Arc<AtomicBool>) -> anyhow::Result<i3
         }
         served += 1;
         let run = match Wrapper::try_parse_from(&argv) {
-            Ok(w) => w.run,
+            Ok(mut w) => {
+                w.run.plan.link_security = Some(link_security.clone());
+                w.run
+            }
             Err(e) => {
                 tracing::error!("mission {mission}: {e}");
                 continue;

@@ -21,6 +21,9 @@ pub struct StatusArgs {
         default_value = "tcp/127.0.0.1:7447"
     )]
     pub connect: Vec<String>,
+    /// How to authenticate to the fleet's network.
+    #[command(flatten)]
+    pub zenoh: shoal_common::wire::flags::ZenohSecurityArgs,
     /// Only this mission (default: every running one).
     #[arg(long, env = "SHOAL_MISSION")]
     pub mission: Option<String>,
@@ -51,7 +54,7 @@ pub fn command(args: &StatusArgs) -> anyhow::Result<i32> {
                 args.timeout
             )
         })?;
-    let statuses = query(&args.connect, &key, timeout)?;
+    let statuses = query(&args.connect, &args.zenoh.security()?, &key, timeout)?;
     if statuses.is_empty() {
         eprintln!(
             "no running mission answered on {key} within {:.1} s",
@@ -74,8 +77,13 @@ pub fn command(args: &StatusArgs) -> anyhow::Result<i32> {
 
 /// The fleet pictures the missions matching `key` answer with (bad answers are skipped, with a
 /// warning).
-pub fn query(connect: &[String], key: &str, timeout: Duration) -> anyhow::Result<Vec<FleetStatus>> {
-    let config = session::client_config(connect, false)?;
+pub fn query(
+    connect: &[String],
+    security: &shoal_common::wire::security::Security,
+    key: &str,
+    timeout: Duration,
+) -> anyhow::Result<Vec<FleetStatus>> {
+    let config = session::client_config(connect, false, security)?;
     let s = zenoh::open(config).wait().map_err(|e| {
         // Zenoh's own text names its source files; it goes to the debug log, not to the user.
         tracing::debug!("zenoh: {e}");

@@ -44,6 +44,7 @@ fn options(mission: &str, endpoint: &str, join_s: u64) -> DistributedOptions {
         agents: AgentsMode::External,
         listen: vec![endpoint.into()],
         routers: vec![],
+        security: Default::default(),
         join_timeout: Duration::from_secs(join_s),
         round_timeout: Duration::from_secs(10),
         agent_bin: None,
@@ -182,7 +183,8 @@ fn fleeting_agent(
     use zenoh::Wait;
     let (vehicle, endpoint) = (vehicle.to_string(), endpoint.to_string());
     std::thread::spawn(move || {
-        let config = shoal_common::wire::session::client_config(&[endpoint], true)?;
+        let config =
+            shoal_common::wire::session::client_config(&[endpoint], true, &Default::default())?;
         let session = zenoh::open(config)
             .wait()
             .map_err(|e| anyhow::anyhow!("open: {e}"))?;

@@ -115,6 +115,7 @@ fn settings(
         agents: AgentsMode::External,
         listen: vec![endpoint.to_string()],
         routers: Vec::new(),
+        security: Default::default(),
         join_timeout: Duration::from_secs(30),
         round_timeout: Duration::from_secs(10),
         agent_bin: None,

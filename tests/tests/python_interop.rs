@@ -14,18 +14,7 @@ use std::time::{Duration, Instant};
 
 use common::fleet::{endpoint, free_port, Fleet};
 use common::process::{coordinator, root};
-use common::{scenario, without_shoal_env, TestResult};
-
-fn python() -> Option<String> {
-    if let Ok(p) = std::env::var("SHOAL_INTEROP_PYTHON") {
-        return Some(p);
-    }
-    let ok = Command::new("python3")
-        .args(["-c", "import zenoh"])
-        .output()
-        .is_ok_and(|o| o.status.success());
-    ok.then(|| "python3".to_string())
-}
+use common::{interop_python as python, scenario, without_shoal_env, TestResult};
 
 #[test]
 fn a_python_client_submits_scenario_2_and_reads_plan_telemetry_and_status() -> TestResult {

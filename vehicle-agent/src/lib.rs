@@ -38,6 +38,9 @@ pub struct AgentArgs {
         default_value = "tcp/127.0.0.1:7447"
     )]
     pub connect: Vec<String>,
+    /// How the agent authenticates to the coordinator (its vehicle's certificate).
+    #[command(flatten)]
+    pub zenoh: shoal_common::wire::flags::ZenohSecurityArgs,
     /// Leave after the first mission ends (the coordinator's own agents do).
     #[arg(long, env = "SHOAL_ONCE")]
     pub once: bool,

@@ -57,7 +57,7 @@ impl Drops {
 /// Opens a client session on a thread of its own (zenoh's open blocks while it waits for the
 /// router), giving up when `shutdown` is raised.
 fn open(args: &AgentArgs, shutdown: &AtomicBool) -> anyhow::Result<Option<Session>> {
-    let config = session::client_config(&args.connect, true)?;
+    let config = session::client_config(&args.connect, true, &args.zenoh.security()?)?;
     let (tx, rx) = mpsc::channel();
     std::thread::spawn(move || {
         let _ = tx.send(zenoh::open(config).wait());

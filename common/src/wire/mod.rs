@@ -8,11 +8,15 @@
 //! - [`session`] is the only code that builds a Zenoh configuration (coordinator = embedded
 //!   router, agents = clients, multicast scouting off). Note: in zenoh 1.10 `open(...).await`
 //!   runs synchronously, so a timeout around it bounds nothing; open on a thread of its own.
+//! - [`security`] says how members authenticate (TLS, mutual TLS, user/password, access
+//!   control from a Zenoh configuration file); [`flags`] is the one flag group for it.
 
 pub mod agent_to_coordinator;
 pub mod codec;
 pub mod coordinator_to_agent;
+pub mod flags;
 pub mod open;
+pub mod security;
 pub mod session;
 pub mod topics;
 

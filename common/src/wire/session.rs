@@ -4,8 +4,10 @@
 //! and multicast fails inside Docker networks and CI sandboxes.
 //!
 //! Endpoints come from users (CLI flags, `SHOAL_*` variables), so each is checked here and a bad
-//! one is an error naming it. Only `tcp/<host>:<port>` is accepted: it is the only transport
-//! built in, and a client waiting for its router would otherwise retry a typo forever.
+//! one is an error naming it. Only `tcp/<host>:<port>` and `tls/<host>:<port>` are accepted:
+//! they are the transports built in, and a client waiting for its router would otherwise retry
+//! a typo forever. How members authenticate is [`super::security`]'s; a router refuses to
+//! listen beyond loopback unless whoever connects is authenticated (or `insecure` is set).
 //!
 //! Beware: in zenoh 1.10, `zenoh::open(config).await` (like every builder but `close`) resolves
 //! synchronously inside `into_future`, so `tokio::time::timeout` around it bounds nothing. To
@@ -17,10 +19,11 @@ use zenoh::config::EndPoint;
 use zenoh::Config;
 
 use super::codec::MAX_MESSAGE_BYTES;
+use super::security::{self, Security};
 
-/// Transports compiled into zenoh (the workspace enables only `transport_tcp`); extend together
-/// with the zenoh features.
-const SUPPORTED_PROTOCOLS: &[&str] = &["tcp"];
+/// Transports compiled into zenoh (the workspace enables `transport_tcp` and `transport_tls`);
+/// extend together with the zenoh features.
+const SUPPORTED_PROTOCOLS: &[&str] = &["tcp", "tls"];
 
 /// Why a Zenoh configuration could not be built.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
@@ -41,6 +44,27 @@ pub enum SessionError {
         /// What is wrong with it.
         reason: String,
     },
+    /// A Zenoh configuration file that cannot be read or parsed.
+    #[error("Zenoh configuration {path}: {reason}")]
+    ConfigFile {
+        /// The file.
+        path: std::path::PathBuf,
+        /// What is wrong.
+        reason: String,
+    },
+    /// A router endpoint beyond loopback that anyone could join.
+    #[error(
+        "refusing to listen on {endpoint} without authentication: anyone who reaches this \
+         machine could join the fleet, read its plans and send its vehicles orders. Secure it: \
+         `shoal-coordinator keys --out keys --vehicles auv1,auv2,...` writes certificates and \
+         configurations; then listen on tls/HOST:PORT with --zenoh-config keys/coordinator.json5 \
+         (see docs/guide/security.md). Or listen on 127.0.0.1 only, or pass --insecure on a lab \
+         network nobody else reaches"
+    )]
+    Unauthenticated {
+        /// The endpoint as given.
+        endpoint: String,
+    },
     /// Zenoh refused a setting (a bug here rather than bad input: inputs are checked first).
     #[error("zenoh refused {key} = {value}: {reason}")]
     Setting {
@@ -59,13 +83,28 @@ pub enum SessionError {
 /// `routers` (usually empty) are other routers this one links to, retrying until they answer:
 /// a second coordinator joins the first one's network this way, so two missions share one
 /// Zenoh network and the same agents.
-pub fn router_config(listen: &[String], routers: &[String]) -> Result<Config, SessionError> {
-    let mut config = base("router")?;
-    let listen = endpoints("listen/endpoints", listen)?;
-    set(&mut config, "listen/endpoints", &listen)?;
+///
+/// `security` says who may connect; an endpoint beyond loopback that anyone could join is an
+/// error ([`SessionError::Unauthenticated`]) unless `security.insecure`.
+pub fn router_config(
+    listen: &[String],
+    routers: &[String],
+    security: &Security,
+) -> Result<Config, SessionError> {
+    let mut config = base("router", security)?;
+    security.apply(&mut config, true)?;
+    let listen_json = endpoints("listen/endpoints", listen)?;
+    set(&mut config, "listen/endpoints", &listen_json)?;
+    for endpoint in listen {
+        security::check_tls_ready(&config, endpoint, true)?;
+        security::check_exposure(&config, endpoint, security.insecure)?;
+    }
     if !routers.is_empty() {
         let connect = endpoints("connect/endpoints", routers)?;
         set(&mut config, "connect/endpoints", &connect)?;
+        for endpoint in routers {
+            security::check_tls_ready(&config, endpoint, false)?;
+        }
     }
     Ok(config)
 }
@@ -75,10 +114,18 @@ pub fn router_config(listen: &[String], routers: &[String]) -> Result<Config, Se
 /// With `wait_for_router`, opening waits (retrying after 1 s, backing off to every 4 s) until a
 /// router answers, so an agent may start before the coordinator. Without it, opening fails at
 /// once when no router is up. Either way a client reconnects by itself if the router restarts.
-pub fn client_config(connect: &[String], wait_for_router: bool) -> Result<Config, SessionError> {
-    let mut config = base("client")?;
-    let connect = endpoints("connect/endpoints", connect)?;
-    set(&mut config, "connect/endpoints", &connect)?;
+pub fn client_config(
+    connect: &[String],
+    wait_for_router: bool,
+    security: &Security,
+) -> Result<Config, SessionError> {
+    let mut config = base("client", security)?;
+    security.apply(&mut config, false)?;
+    let connect_json = endpoints("connect/endpoints", connect)?;
+    set(&mut config, "connect/endpoints", &connect_json)?;
+    for endpoint in connect {
+        security::check_tls_ready(&config, endpoint, false)?;
+    }
     // Whole connect phase, i64 ms: -1 = forever, 0 = one try (the client default). Clients take
     // zenoh's single-link path, which never reads `connect/exit_on_failure`.
     let timeout_ms = if wait_for_router { "-1" } else { "0" };
@@ -86,9 +133,9 @@ pub fn client_config(connect: &[String], wait_for_router: bool) -> Result<Config
     Ok(config)
 }
 
-/// Settings both sides share.
-fn base(mode: &str) -> Result<Config, SessionError> {
-    let mut config = Config::default();
+/// Settings both sides share, over the configuration file's.
+fn base(mode: &str, security: &Security) -> Result<Config, SessionError> {
+    let mut config = security.base()?;
     set(&mut config, "mode", &format!("{mode:?}"))?;
     set(&mut config, "scouting/multicast/enabled", "false")?;
     // Largest message zenoh reassembles (default 1 GiB): the codec refuses anything over
@@ -156,6 +203,11 @@ mod tests {
 
     const LIMIT: Duration = Duration::from_secs(10);
 
+    /// Plain TCP, as on loopback.
+    fn plain() -> Security {
+        Security::default()
+    }
+
     /// `f` under the test time limit; the error names the step that hung. (Zenoh builders
     /// other than `close` resolve synchronously, so for them this is a label, not a bound.)
     async fn within<F: IntoFuture>(step: &str, f: F) -> Result<F::Output, String> {
@@ -184,19 +236,27 @@ mod tests {
 
     async fn router_and_client() -> zenoh::Result<(Session, Session)> {
         let endpoint = free_endpoint()?;
-        let router = open("router open", router_config(from_ref(&endpoint), &[])?).await?;
-        let client = open("client open", client_config(&[endpoint], false)?).await?;
+        let router = open(
+            "router open",
+            router_config(from_ref(&endpoint), &[], &plain())?,
+        )
+        .await?;
+        let client = open("client open", client_config(&[endpoint], false, &plain())?).await?;
         Ok((router, client))
     }
 
     #[test]
     fn settings_read_back() -> TestResult {
-        let wait = client_config(&["tcp/coordinator:7447".into()], true)?;
-        let once = client_config(&["tcp/10.0.0.1:7447".into()], false)?;
+        let wait = client_config(&["tcp/coordinator:7447".into()], true, &plain())?;
+        let once = client_config(&["tcp/10.0.0.1:7447".into()], false, &plain())?;
         // A quote in a user string stays inside its endpoint (a bad host, found at open).
         let router = router_config(
             &["tcp/[::]:7447".into(), r#"tcp/a",b:1"#.into()],
             &["tcp/first:7447".into()],
+            &Security {
+                insecure: true,
+                ..Security::default()
+            },
         )?;
         let expected = [
             (&wait, "mode", r#""client""#),
@@ -237,9 +297,9 @@ mod tests {
             .chain(["udp/127.0.0.1:7447", "tls/127.0.0.1:7447"])
         {
             let results = [
-                client_config(&[s.into()], false),
-                client_config(&["tcp/127.0.0.1:7447".into(), s.into()], true),
-                router_config(&[s.into()], &[]),
+                client_config(&[s.into()], false, &plain()),
+                client_config(&["tcp/127.0.0.1:7447".into(), s.into()], true, &plain()),
+                router_config(&[s.into()], &[], &plain()),
             ];
             for result in results {
                 match result {
@@ -250,9 +310,13 @@ mod tests {
                 }
             }
         }
-        let e = client_config(&[], true).err().map(|e| e.to_string());
+        let e = client_config(&[], true, &plain())
+            .err()
+            .map(|e| e.to_string());
         assert!(e.is_some_and(|e| e.contains("connect/endpoints")));
-        let e = router_config(&[], &[]).err().map(|e| e.to_string());
+        let e = router_config(&[], &[], &plain())
+            .err()
+            .map(|e| e.to_string());
         assert!(e.is_some_and(|e| e.contains("listen/endpoints")));
     }
 
@@ -263,7 +327,7 @@ mod tests {
         let endpoint = format!("tcp/127.0.0.1:{}", busy.local_addr()?.port());
         let router = open(
             "router on a busy port",
-            router_config(from_ref(&endpoint), &[])?,
+            router_config(from_ref(&endpoint), &[], &plain())?,
         )
         .await;
         let e = router.err().map(|e| e.to_string()).unwrap_or_default();
@@ -271,7 +335,7 @@ mod tests {
         let endpoint = free_endpoint()?;
         let client = open(
             "client, no router",
-            client_config(from_ref(&endpoint), false)?,
+            client_config(from_ref(&endpoint), false, &plain())?,
         )
         .await;
         let e = client.err().map(|e| e.to_string()).unwrap_or_default();
@@ -282,10 +346,10 @@ mod tests {
     #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
     async fn a_waiting_client_connects_once_the_router_starts() -> TestResult {
         let endpoint = free_endpoint()?;
-        let mut client = open_in_thread(client_config(from_ref(&endpoint), true)?);
+        let mut client = open_in_thread(client_config(from_ref(&endpoint), true, &plain())?);
         tokio::time::sleep(Duration::from_millis(500)).await;
         assert!(client.try_recv().is_err(), "the client did not wait");
-        let router = open("router open", router_config(&[endpoint], &[])?).await?;
+        let router = open("router open", router_config(&[endpoint], &[], &plain())?).await?;
         let client = within("client open", client).await???;
         within("client close", client.close()).await??;
         within("router close", router.close()).await??;

@@ -7,6 +7,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 
 use anyhow::Context as _;
+use shoal_common::wire::flags::ZenohSecurityArgs;
 
 /// Spawned agent processes, killed on drop.
 pub struct LocalAgents {
@@ -60,7 +61,12 @@ impl LocalAgents {
             let log_path = log_dir.join(format!("{v}.log"));
             let log = File::create(&log_path)
                 .with_context(|| format!("cannot create {}", log_path.display()))?;
-            let child = Command::new(binary)
+            let mut command = Command::new(binary);
+            // The coordinator's identity (certificate, password) is not the agents'.
+            for var in ZenohSecurityArgs::ENV {
+                command.env_remove(var);
+            }
+            let child = command
                 .args(["--vehicle", v, "--connect", endpoint, "--once"])
                 .args(extra_args)
                 // The coordinator's settings must not leak into the agents through SHOAL_*.

@@ -44,6 +44,8 @@ pub struct DistributedOptions {
     pub listen: Vec<String>,
     /// Other routers to link to (a second coordinator joining a first one's network).
     pub routers: Vec<String>,
+    /// How members authenticate to the router (TLS, users, access control).
+    pub security: shoal_common::wire::security::Security,
     /// How long agents have to join.
     pub join_timeout: Duration,
     /// How long a round waits for an agent before planning its vehicle here.
@@ -232,8 +234,13 @@ impl Session {
         options: &DistributedOptions,
     ) -> anyhow::Result<Session> {
         let ids: Vec<String> = scenario.vehicles.iter().map(|v| v.id.clone()).collect();
-        let net =
-            network::Network::open(&options.listen, &options.routers, &options.mission, &ids)?;
+        let net = network::Network::open(
+            &options.listen,
+            &options.routers,
+            &options.security,
+            &options.mission,
+            &ids,
+        )?;
         let health = options
             .health_file
             .as_deref()

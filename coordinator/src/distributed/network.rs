@@ -13,6 +13,7 @@ use anyhow::Context as _;
 use shoal_common::wire::agent_to_coordinator::AgentToCoordinator;
 use shoal_common::wire::codec::{self, DecodeError};
 use shoal_common::wire::coordinator_to_agent::CoordinatorToAgent;
+use shoal_common::wire::security::Security;
 use shoal_common::wire::{session, topics, Envelope};
 use zenoh::liveliness::LivelinessToken;
 use zenoh::pubsub::Subscriber;
@@ -59,6 +60,7 @@ impl Network {
     pub fn open(
         listen: &[String],
         routers: &[String],
+        security: &Security,
         mission: &str,
         vehicles: &[String],
     ) -> anyhow::Result<Network> {
@@ -66,7 +68,7 @@ impl Network {
             .iter()
             .map(|e| resolve_port_zero(e))
             .collect::<anyhow::Result<Vec<_>>>()?;
-        let config = session::router_config(&endpoints, routers)?;
+        let config = session::router_config(&endpoints, routers, security)?;
         let session = zenoh::open(config).wait().map_err(|e| {
             anyhow::anyhow!(
                 "cannot open the coordinator's Zenoh router on {}: {e}",
@@ -231,9 +233,10 @@ impl Network {
 /// Runs a bare router on `listen` until `shutdown` is raised (`shoal-coordinator router`).
 pub fn serve_router(
     listen: &[String],
+    security: &Security,
     shutdown: &std::sync::atomic::AtomicBool,
 ) -> anyhow::Result<()> {
-    let config = session::router_config(listen, &[])?;
+    let config = session::router_config(listen, &[], security)?;
     let session = zenoh::open(config)
         .wait()
         .map_err(|e| anyhow::anyhow!("cannot open a Zenoh router on {}: {e}", listen.join(", ")))?;

@@ -26,6 +26,7 @@ pub fn agent(vehicle: &str, endpoint: &str) -> Agent {
     let args = AgentArgs {
         vehicle: vehicle.into(),
         connect: vec![endpoint.into()],
+        zenoh: Default::default(),
         once: true,
         threads: 1,
         idle_timeout: 10.0,

@@ -37,6 +37,20 @@ pub const CAGES_FLEET_QUICK: [&str; 6] = [
     "ldiw-pso",
 ];
 
+/// The Python interpreter of the interop tests: `$SHOAL_INTEROP_PYTHON` (CI sets it to a venv
+/// with eclipse-zenoh 1.10.2: then a missing package is a failure); without it, `python3` if it
+/// can import `zenoh`; `None` otherwise (the test says SKIPPED).
+pub fn interop_python() -> Option<String> {
+    if let Ok(p) = std::env::var("SHOAL_INTEROP_PYTHON") {
+        return Some(p);
+    }
+    let ok = Command::new("python3")
+        .args(["-c", "import zenoh"])
+        .output()
+        .is_ok_and(|o| o.status.success());
+    ok.then(|| "python3".to_string())
+}
+
 /// The JSON file at `path` (a `plan.json`, `execution.json`, …); an error names the file.
 pub fn read_json(path: &Path) -> Result<Value, Box<dyn Error>> {
     let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;

@@ -163,6 +163,29 @@ fn locate_and_build() -> Result<Binaries, String> {
     };
     let bin = |name: &str| profile_dir.join(format!("{name}{}", std::env::consts::EXE_SUFFIX));
     let mut cmd = Command::new(env!("CARGO"));
+    // Cargo gives this test process the test crate's package variables (CARGO_MANIFEST_DIR,
+    // CARGO_PKG_NAME, ...). Some build scripts (ring's) declare them as inputs, so a nested
+    // build that inherits them rebuilds ring, rustls and zenoh, and the next top-level build
+    // rebuilds them back: minutes each way.
+    for (name, _) in std::env::vars_os() {
+        let name = name.to_string_lossy();
+        let package_var = ["CARGO_PKG_", "CARGO_BIN_EXE_", "CARGO_CFG_"]
+            .iter()
+            .any(|p| name.starts_with(p))
+            || [
+                "CARGO_MANIFEST_DIR",
+                "CARGO_MANIFEST_PATH",
+                "CARGO_MANIFEST_LINKS",
+                "CARGO_CRATE_NAME",
+                "CARGO_PRIMARY_PACKAGE",
+                "CARGO_TARGET_TMPDIR",
+                "OUT_DIR",
+            ]
+            .contains(&name.as_ref());
+        if package_var {
+            cmd.env_remove(name.as_ref());
+        }
+    }
     cmd.current_dir(root()).args([
         "build",
         "-p",

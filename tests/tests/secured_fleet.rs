@@ -1,0 +1,165 @@
+//! A secured fleet end to end: `shoal-coordinator keys` makes the CA, the members' certificates
+//! and configurations; the coordinator listens on mutual TLS and enforces the generated access
+//! control; the agents join with their vehicles' certificates. An independent client (the Python
+//! `eclipse-zenoh` package, `tests/python/secured_client.py`) then tries what a stranger and a
+//! misbehaving vehicle would, and what an operator must be able to do.
+//!
+//! The interpreter is found as for the other interop tests ([`common::interop_python`]).
+
+mod common;
+
+use std::path::Path;
+use std::process::Command;
+use std::time::{Duration, Instant};
+
+use common::fleet::{free_port, Fleet};
+use common::process::{coordinator, root};
+use common::{interop_python, scenario, without_shoal_env, TestResult};
+
+fn deadline(s: u64) -> Instant {
+    Instant::now() + Duration::from_secs(s)
+}
+
+/// `keys` for scenario 2's vehicles and one operator, into `dir`.
+fn make_keys(fleet: &mut Fleet, dir: &Path) {
+    let mut cmd = Command::new(coordinator());
+    without_shoal_env(&mut cmd);
+    cmd.current_dir(root())
+        .arg("keys")
+        .arg("--out")
+        .arg(dir)
+        .arg("--scenario")
+        .arg(scenario("amp-pso-2"));
+    let k = fleet.spawn("keys", cmd);
+    let k = fleet.wait(k, deadline(30));
+    assert_eq!(k.code(), Some(0), "{}", k.stderr);
+}
+
+fn coordinator_cmd(keys: &Path, args: &[&str]) -> Command {
+    let mut cmd = Command::new(coordinator());
+    without_shoal_env(&mut cmd);
+    cmd.current_dir(root())
+        .args(args)
+        .arg("--zenoh-config")
+        .arg(keys.join("coordinator.json5"));
+    cmd
+}
+
+fn python_client(py: &str, endpoint: &str, keys: &Path, mission: &str) -> Command {
+    let mut cmd = Command::new(py);
+    cmd.current_dir(root())
+        .arg(root().join("tests/python/secured_client.py"))
+        .arg(endpoint)
+        .arg(keys)
+        .arg(mission);
+    cmd
+}
+
+#[test]
+fn strangers_and_a_vehicle_forging_for_another_are_kept_out_and_the_mission_is_met() -> TestResult {
+    let Some(py) = interop_python() else {
+        eprintln!("SKIPPED: no Python with eclipse-zenoh (set SHOAL_INTEROP_PYTHON; .ci/run does)");
+        return Ok(());
+    };
+    let mut fleet = Fleet::new();
+    let keys = fleet.dir().join("keys");
+    make_keys(&mut fleet, &keys);
+    let endpoint = format!("tls/127.0.0.1:{}", free_port());
+    let out = fleet.dir().join("out");
+    let mut run = coordinator_cmd(&keys, &["run"]);
+    run.arg(scenario("amp-pso-2"))
+        .args(["--agents", "external", "--listen", &endpoint])
+        .args(["--mission", "secured", "--time-scale", "100"])
+        .args(["--iterations", "40", "--quiet", "--out"])
+        .arg(&out);
+    let c = fleet.spawn("coordinator", run);
+    fleet.wait_for_stderr(c, "waiting up to", deadline(60));
+    let mut agents = Vec::new();
+    for v in ["auv1", "auv2", "auv3"] {
+        let config = keys.join(format!("{v}.json5"));
+        let config = config.to_string_lossy();
+        // Not --once: `run` plans one mission with them, then executes another.
+        agents.push(fleet.agent(v, &endpoint, &["--zenoh-config", &config]));
+    }
+    let client = fleet.spawn(
+        "python-client",
+        python_client(&py, &endpoint, &keys, "secured"),
+    );
+    let client = fleet.wait(client, deadline(240));
+    assert_eq!(
+        client.code(),
+        Some(0),
+        "{}\n{}",
+        client.stdout,
+        client.stderr
+    );
+    let summary: serde_json::Value = serde_json::from_str(client.stdout.trim())?;
+    assert_eq!(summary["forgeries_delivered"], serde_json::json!([]));
+    let c = fleet.wait(c, deadline(240));
+    assert_eq!(c.code(), Some(0), "{}", c.stderr);
+    for a in agents {
+        assert!(fleet.running(a), "an agent died:\n{}", fleet.stderr(a));
+    }
+    let report = common::read_json(&out.join("execution.json"))?;
+    let min = report["figures"]["min_separation_m"]
+        .as_f64()
+        .unwrap_or(0.0);
+    assert!(min >= 50.0, "separation {min} m under d_min: {report}");
+    fleet.passed();
+    Ok(())
+}
+
+#[test]
+fn an_operator_submits_to_a_secured_serve_and_a_vehicle_cannot() -> TestResult {
+    let Some(py) = interop_python() else {
+        eprintln!("SKIPPED: no Python with eclipse-zenoh (set SHOAL_INTEROP_PYTHON; .ci/run does)");
+        return Ok(());
+    };
+    let mut fleet = Fleet::new();
+    let keys = fleet.dir().join("keys");
+    make_keys(&mut fleet, &keys);
+    let endpoint = format!("tls/127.0.0.1:{}", free_port());
+    let missions = fleet.dir().join("missions");
+    let mut serve = coordinator_cmd(&keys, &["serve", "--missions", "1"]);
+    serve.args(["--listen", &endpoint, "--out"]).arg(&missions);
+    let s = fleet.spawn("serve", serve);
+    fleet.wait_for_stderr(s, "serving missions", deadline(60));
+    let mut cmd = python_client(&py, &endpoint, &keys, "secured-submit");
+    cmd.arg("--submit")
+        .arg("--scenario")
+        .arg(scenario("amp-pso-2"));
+    let client = fleet.spawn("python-client", cmd);
+    let client = fleet.wait(client, deadline(120));
+    assert_eq!(
+        client.code(),
+        Some(0),
+        "{}\n{}",
+        client.stdout,
+        client.stderr
+    );
+    let s = fleet.wait(s, deadline(240));
+    assert_eq!(s.code(), Some(0), "{}", s.stderr);
+    let report = common::read_json(&missions.join("secured-submit/execution.json"))?;
+    assert!(report["figures"].is_object(), "{report}");
+    fleet.passed();
+    Ok(())
+}
+
+#[test]
+fn a_router_beyond_loopback_without_authentication_is_refused_and_says_how() {
+    let mut fleet = Fleet::new();
+    let mut cmd = Command::new(coordinator());
+    without_shoal_env(&mut cmd);
+    cmd.args([
+        "router",
+        "--listen",
+        &format!("tcp/0.0.0.0:{}", free_port()),
+    ]);
+    let r = fleet.spawn("router", cmd);
+    let r = fleet.wait(r, deadline(30));
+    assert_eq!(r.code(), Some(1), "{}", r.stderr);
+    for needle in ["refusing to listen", "shoal-coordinator keys", "--insecure"] {
+        assert!(r.stderr.contains(needle), "{needle:?} not in {}", r.stderr);
+    }
+    fleet.passed();
+}
