@@ -12,6 +12,7 @@ mod ground;
 mod keep_out;
 mod lead;
 pub mod log;
+pub mod plausible;
 mod react;
 mod repair;
 pub mod replan;
@@ -111,6 +112,8 @@ pub(crate) struct Exec<'a> {
     /// Decision times of obstacle replans (obstacle received → update sent), ms.
     pub(crate) decisions_ms: Vec<f64>,
     dropped: u64,
+    /// Implausible reports and obstacles refused, the obstacles' rate limit.
+    guard: plausible::Guard,
     /// Longest wall time between two passes of the loop (see [`ExecutionReport`]).
     longest_pause: Duration,
     /// A coverage fleet's seabed map, for a crawler's way round a new obstacle; `None` for
@@ -133,6 +136,9 @@ pub struct ExecutionReport {
     pub update_delivery_ms: Vec<f64>,
     /// Malformed or unusable open-interface messages dropped.
     pub dropped: u64,
+    /// Well-formed reports and obstacles refused as implausible (or over a limit), per reason
+    /// (see [`plausible`]).
+    pub implausible: plausible::Refusals,
     /// Longest wall time between two passes of the execution loop, milliseconds: for that long
     /// no report was read, no conflict looked for and no status published.
     pub loop_longest_pause_ms: f64,
@@ -306,6 +312,7 @@ pub fn execute_trajectories(
         deliveries_ms: Vec::new(),
         decisions_ms: Vec::new(),
         dropped: 0,
+        guard: plausible::Guard::default(),
         longest_pause: Duration::ZERO,
         ground,
     };
@@ -342,6 +349,7 @@ pub fn execute_trajectories(
         obstacle_decision_ms: x.decisions_ms.clone(),
         update_delivery_ms: x.deliveries_ms.clone(),
         dropped: x.dropped,
+        implausible: x.guard.refusals.clone(),
         loop_longest_pause_ms: x.longest_pause.as_secs_f64() * 1000.0,
         ended,
     };
