@@ -1,7 +1,8 @@
 //! What a stranger on an unsecured network sends during an execution, end to end: a forged
-//! fix far from where the vehicle is, and a forged `Hold` carrying an order number already
-//! used. The coordinator drops the fix (counted, one event) and the agent the hold; the
-//! mission is met as if neither had come. The agent is `shoal_agent::run` on a thread driving
+//! fix far from where the vehicle is, a forged `Hold` carrying an order number already used,
+//! an obstacle of radius 1e300 and a flood of small ones. The coordinator drops the fix
+//! (counted, one event), the huge obstacle and the flood past the rate limit, and the agent
+//! the hold; the mission is met as if none had come. The agent is `shoal_agent::run` on a thread driving
 //! a simulated vehicle; the stranger is a plain Zenoh client on loopback.
 
 mod common;
@@ -13,17 +14,31 @@ use std::time::Duration;
 use common::{agent, finish, free_endpoint, TestResult};
 use serde_json::Value;
 use shoal_common::geometry::Vec3;
-use shoal_common::scenario::Scenario;
+use shoal_common::scenario::{Obstacle, ObstacleKind, Scenario};
 use shoal_common::trajectory::Trajectory;
 use shoal_common::wire::codec;
 use shoal_common::wire::coordinator_to_agent::CoordinatorToAgent;
 use shoal_common::wire::open::Telemetry;
+use shoal_common::wire::topics::OpenKey;
 use shoal_common::wire::{session, topics, Envelope};
 use shoal_coordinator::distributed::{AgentsMode, DistributedOptions};
 use shoal_coordinator::execute::{execute_trajectories, ExecOptions};
 use zenoh::Wait;
 
 const MISSION: &str = "plausibility";
+
+/// Small obstacles the stranger publishes at once.
+const FLOOD: usize = 40;
+
+fn obstacle(id: &str, centre: [f64; 3], radius_m: f64) -> Obstacle {
+    Obstacle {
+        id: id.into(),
+        kind: ObstacleKind::Hard,
+        centre,
+        radius_m,
+        inflation_m: 5.0,
+    }
+}
 
 /// auv1 from (100, 1000, 200) to (1900, 1000, 200) at 1.5 m/s: 1,200 mission seconds.
 fn mission() -> Result<(Scenario, Vec<Trajectory>), Box<dyn std::error::Error>> {
@@ -49,7 +64,8 @@ type Sent = anyhow::Result<(u64, u64)>;
 /// The stranger: reads auv1's orders and reports like anyone could; once auv1 has reported
 /// four times, publishes a copy of its latest report moved 800 m south (numbered two past it,
 /// which a receiver checking numbers only would take), and a `Hold` numbered like the first
-/// `Execute` it saw (or 1, when it saw none).
+/// `Execute` it saw (or 1, when it saw none); then an obstacle of radius 1e300 and a flood of
+/// [`FLOOD`] small ones off auv1's path.
 fn stranger(endpoint: String) -> std::thread::JoinHandle<Sent> {
     std::thread::spawn(move || {
         let e = |what: &str| {
@@ -108,6 +124,18 @@ fn stranger(endpoint: String) -> std::thread::JoinHandle<Sent> {
             s.put(topics::to_agent(MISSION, "auv1")?, codec::encode(&hold)?)
                 .wait()
                 .map_err(e("put"))?;
+            // One obstacle as large as the ocean, then a flood of small ones off the path.
+            let obstacles = topics::open_key(MISSION, OpenKey::Obstacles)?;
+            let huge = obstacle("huge", [1000.0, 1000.0, 200.0], 1e300);
+            s.put(&obstacles, codec::encode_json(&huge)?)
+                .wait()
+                .map_err(e("put"))?;
+            for k in 0..FLOOD {
+                let small = obstacle(&format!("flood-{k}"), [1000.0, 1800.0, 200.0], 1.0);
+                s.put(&obstacles, codec::encode_json(&small)?)
+                    .wait()
+                    .map_err(e("put"))?;
+            }
             let _ = s.close().wait();
             return Ok((t.seq, replayed));
         }
@@ -166,7 +194,6 @@ fn a_forged_far_fix_and_a_replayed_hold_leave_the_mission_met_and_are_counted() 
     // The fix: refused as a jump, counted once, told once; never a replan, never logged as a
     // report (replay would draw it).
     assert_eq!(report.implausible.jump, 1, "{:?}", report.implausible);
-    assert_eq!(report.implausible.total(), 1, "{:?}", report.implausible);
     assert_eq!(kinds("implausible_report"), 1);
     assert_eq!(report.replans, 0, "replanned toward the forged fix");
     let far = log.iter().any(|r| {
@@ -178,6 +205,15 @@ fn a_forged_far_fix_and_a_replayed_hold_leave_the_mission_met_and_are_counted() 
         .iter()
         .any(|r| r["record"] == "telemetry" && r["telemetry"]["state"]["status"] == "holding");
     assert!(!held, "auv1 obeyed a replayed hold numbered {replayed}");
+    // The obstacles: the huge one dropped; of the flood, about a second's worth (5) taken and
+    // the rest dropped by the rate limit, each reason told once.
+    let r = &report.implausible;
+    assert_eq!(r.obstacle_out_of_scale, 1, "{r:?}");
+    let taken = log.iter().filter(|x| x["record"] == "obstacle").count() as u64;
+    assert_eq!(taken + r.obstacle_rate, FLOOD as u64, "{r:?}");
+    assert!((5..=8).contains(&taken), "{taken} of {FLOOD} taken at once");
+    assert_eq!(kinds("obstacle_dropped"), 2);
+    assert_eq!(r.total(), 1 + 1 + r.obstacle_rate, "{r:?}");
     assert!(
         shoal_coordinator::run_cmd::execution_ok(&report),
         "{}",

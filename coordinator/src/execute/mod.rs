@@ -79,7 +79,8 @@ pub struct ExecOptions {
 /// Raw input from the open-interface subscriptions (callbacks do no work themselves).
 enum Open {
     Telemetry(Vec<u8>, u64),
-    Obstacle(Vec<u8>),
+    /// An obstacle and when it came (the rate limit counts arrivals, not the loop's pace).
+    Obstacle(Vec<u8>, Instant),
 }
 
 /// Everything the execution loop shares.
@@ -265,7 +266,10 @@ pub fn execute_trajectories(
     let _obstacles = net_session
         .declare_subscriber(obs_key.as_str())
         .callback(move |s| {
-            let _ = tx.send(Open::Obstacle(s.payload().to_bytes().into_owned()));
+            let _ = tx.send(Open::Obstacle(
+                s.payload().to_bytes().into_owned(),
+                Instant::now(),
+            ));
         })
         .wait()
         .map_err(|e| anyhow::anyhow!("cannot subscribe to {obs_key}: {e}"))?;
@@ -405,7 +409,7 @@ fn run_loop(
         }
         match rx.recv_timeout(Duration::from_millis(20)) {
             Ok(Open::Telemetry(bytes, received)) => react::telemetry(x, &bytes, received),
-            Ok(Open::Obstacle(bytes)) => react::obstacle_bytes(x, &bytes),
+            Ok(Open::Obstacle(bytes, arrived)) => react::obstacle_bytes(x, &bytes, arrived),
             Err(RecvTimeoutError::Timeout) => {}
             Err(RecvTimeoutError::Disconnected) => return "the network closed".into(),
         }

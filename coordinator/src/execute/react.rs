@@ -174,8 +174,8 @@ fn drop_message(x: &mut Exec, detail: &str) {
     }
 }
 
-/// A new obstacle from the obstacles key.
-pub(super) fn obstacle_bytes(x: &mut Exec, bytes: &[u8]) {
+/// A new obstacle from the obstacles key, come at `arrived`.
+pub(super) fn obstacle_bytes(x: &mut Exec, bytes: &[u8], arrived: Instant) {
     let received = Instant::now();
     let o: Obstacle = match codec::decode_json(bytes) {
         Ok(o) => o,
@@ -233,7 +233,7 @@ pub(super) fn obstacle_bytes(x: &mut Exec, bytes: &[u8]) {
             why,
         );
     }
-    if !x.guard.obstacles.take(received) {
+    if !x.guard.obstacles.take(arrived) {
         let why = format!(
             "obstacle {:?}: over the limit of {} obstacles a second",
             o.id,
