@@ -272,6 +272,7 @@ fn bincode_str(s: &str) -> Vec<u8> {
 /// `AgentToCoordinator::Joined` (variant 2) claiming `vehicle`.
 fn wrong_version(mission: &str, to_agent: bool, vehicle: &str) -> Vec<u8> {
     let mut m = (PROTOCOL_VERSION + 1).to_le_bytes().to_vec();
+    m.extend_from_slice(&1u64.to_le_bytes());
     if to_agent {
         m.extend_from_slice(&3u32.to_le_bytes());
         m.extend(bincode_str(mission));
@@ -284,11 +285,12 @@ fn wrong_version(mission: &str, to_agent: bool, vehicle: &str) -> Vec<u8> {
     m
 }
 
-/// This build's version, then an enum variant no message has: malformed for any reader of this
-/// version.
+/// This build's version and an order number, then an enum variant no message has: malformed
+/// for any reader of this version.
 fn malformed_this_version(state: &mut u64) -> Vec<u8> {
     [
         &PROTOCOL_VERSION.to_le_bytes()[..],
+        &[1, 0, 0, 0, 0, 0, 0, 0],
         &[0xff, 0xff, 0xff, 0xff],
         &random_bytes(state),
     ]

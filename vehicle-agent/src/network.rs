@@ -2,8 +2,9 @@
 //! (`shoal/*/vehicle/<id>/in`) and the fleets' context keys (`shoal/*/fleet`), its liveliness
 //! token, and one planning thread per mission it serves.
 //!
-//! Every message is decoded here. One that does not decode, has another protocol version, or
-//! names a mission or vehicle this agent does not serve is dropped, counted and logged once per
+//! Every message is decoded here. One that does not decode, has another protocol version,
+//! names a mission or vehicle this agent does not serve, or (on its inbox) carries an order
+//! number not after the last one taken ([`order_seq`]) is dropped, counted and logged once per
 //! kind — never a panic, never a stall.
 
 use std::collections::{HashMap, HashSet};
@@ -27,9 +28,14 @@ use crate::mission::{self, Assignment, MissionReport};
 use crate::AgentArgs;
 use shoal_common::wire::open::Telemetry;
 
+mod order_seq;
+use order_seq::OrderSeqs;
+
 /// A mission being planned on its own thread.
 struct Worker {
     tx: Sender<CoordinatorToAgent>,
+    /// It drives the vehicle (an execution), rather than plans: one at a time.
+    drives: bool,
     stop: Arc<AtomicBool>,
     handle: JoinHandle<MissionReport>,
 }
@@ -172,6 +178,7 @@ pub fn serve(args: &AgentArgs, shutdown: &AtomicBool) -> anyhow::Result<()> {
         .map_err(|e| anyhow::anyhow!("cannot declare the liveliness token {token_key}: {e}"))?;
     tracing::info!("agent for {vehicle}: connected, waiting for missions");
     let mut drops = Drops::default();
+    let mut seqs = OrderSeqs::default();
     let mut workers: HashMap<String, Worker> = HashMap::new();
     let mut finished: HashSet<String> = HashSet::new();
     let mut served = 0usize;
@@ -184,6 +191,7 @@ pub fn serve(args: &AgentArgs, shutdown: &AtomicBool) -> anyhow::Result<()> {
                     workers: &mut workers,
                     finished: &finished,
                     drops: &mut drops,
+                    seqs: &mut seqs,
                 };
                 m.handle(&key, &bytes);
             }
@@ -243,12 +251,14 @@ struct Inbound<'a> {
     workers: &'a mut HashMap<String, Worker>,
     finished: &'a HashSet<String>,
     drops: &'a mut Drops,
+    /// Order numbers taken on the inbox, per mission.
+    seqs: &'a mut OrderSeqs,
 }
 
 impl Inbound<'_> {
     fn handle(self, key: &str, bytes: &[u8]) {
-        let message = match codec::decode::<CoordinatorToAgent>(bytes) {
-            Ok(m) => m.body,
+        let (seq, message) = match codec::decode::<CoordinatorToAgent>(bytes) {
+            Ok(m) => (m.seq, m.body),
             Err(e @ DecodeError::Version { .. }) => {
                 return self
                     .drops
@@ -265,7 +275,17 @@ impl Inbound<'_> {
             );
         }
         let mission = message.mission().to_string();
+        // Orders on the inbox are numbered (see `order_seq`); the fleet key is not.
+        let numbered = topics::mission_and_vehicle(key).is_some();
+        if numbered && !self.seqs.admits(self.drops, &mission, seq) {
+            return;
+        }
         let vehicle = &self.args.vehicle;
+        let take = |seqs: &mut OrderSeqs| {
+            if numbered {
+                seqs.take(&mission, seq);
+            }
+        };
         match message {
             CoordinatorToAgent::Assign {
                 vehicle: v,
@@ -280,12 +300,16 @@ impl Inbound<'_> {
                     );
                 }
                 if self.workers.contains_key(&mission) || self.finished.contains(&mission) {
-                    // A repeat: our Joined was lost or is on its way.
+                    // A repeat (with a number of its own): our Joined was lost or is on its way.
+                    take(self.seqs);
                     send(self.session, vehicle, joined(&mission, vehicle));
                     return;
                 }
                 match Assignment::new(&mission, vehicle, &scenario_toml, &context) {
-                    Ok(a) => self.start(a),
+                    Ok(a) => {
+                        take(self.seqs);
+                        self.start(a)
+                    }
                     Err(why) => self.drops.drop_message("unusable assignment", &why),
                 }
             }
@@ -306,7 +330,16 @@ impl Inbound<'_> {
                     );
                 }
                 if self.workers.contains_key(&mission) || self.finished.contains(&mission) {
+                    take(self.seqs);
                     return; // a repeat: our telemetry is on its way
+                }
+                // One vehicle drives one mission: an order to drive another while it does is
+                // refused (a genuine next mission repeats its order until this one ends).
+                if let Some((other, _)) = self.workers.iter().find(|(_, w)| w.drives) {
+                    return self.drops.drop_message(
+                        "busy driving",
+                        &format!("mission {mission} asked {vehicle} to drive while it drives mission {other}"),
+                    );
                 }
                 match Order::new(
                     &mission,
@@ -318,7 +351,10 @@ impl Inbound<'_> {
                     telemetry_hz,
                     seed,
                 ) {
-                    Ok(order) => self.start_execution(order),
+                    Ok(order) => {
+                        take(self.seqs);
+                        self.start_execution(order)
+                    }
                     Err(why) => self.drops.drop_message("unusable execution order", &why),
                 }
             }
@@ -334,6 +370,7 @@ impl Inbound<'_> {
             }
             other => match self.workers.get(&mission) {
                 Some(w) => {
+                    take(self.seqs);
                     let _ = w.tx.send(other);
                 }
                 None if self.finished.contains(&mission) => {}
@@ -378,7 +415,15 @@ impl Inbound<'_> {
                     "mission {mission}: joined; planning {} in {what}",
                     self.args.vehicle
                 );
-                self.workers.insert(mission, Worker { tx, stop, handle });
+                self.workers.insert(
+                    mission,
+                    Worker {
+                        tx,
+                        drives: false,
+                        stop,
+                        handle,
+                    },
+                );
             }
             Err(e) => tracing::error!("mission {mission}: {e:#}"),
         }
@@ -431,7 +476,15 @@ impl Inbound<'_> {
             .context("cannot start an execution thread");
         match spawned {
             Ok(handle) => {
-                self.workers.insert(mission, Worker { tx, stop, handle });
+                self.workers.insert(
+                    mission,
+                    Worker {
+                        tx,
+                        drives: true,
+                        stop,
+                        handle,
+                    },
+                );
             }
             Err(e) => tracing::error!("mission {mission}: {e:#}"),
         }

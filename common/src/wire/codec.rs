@@ -92,6 +92,10 @@ pub fn decode_json<T: DeserializeOwned>(bytes: &[u8]) -> Result<T, DecodeError> 
 }
 
 #[cfg(test)]
+#[path = "codec_fuzz_tests.rs"]
+mod fuzz_tests;
+
+#[cfg(test)]
 mod tests {
     use super::*;
     use crate::wire::agent_to_coordinator::AgentToCoordinator;
@@ -101,14 +105,19 @@ mod tests {
 
     #[test]
     fn golden_bytes_of_a_stop_message() -> Result<(), Box<dyn std::error::Error>> {
-        let m = Envelope::new(CoordinatorToAgent::Stop {
-            mission: "m1".into(),
-            reason: "ok".into(),
-        });
+        let m = Envelope::sequenced(
+            CoordinatorToAgent::Stop {
+                mission: "m1".into(),
+                reason: "ok".into(),
+            },
+            0x0102,
+        );
         let bytes = encode(&m)?;
-        // version 5 (u16 LE) | variant 3 (u32 LE) | len 2 (u64 LE) "m1" | len 2 "ok"
+        // version 6 (u16 LE) | seq 0x0102 (u64 LE) | variant 3 (u32 LE) | len 2 (u64 LE) "m1"
+        // | len 2 "ok"
         let expected: Vec<u8> = [
-            &[5u8, 0][..],
+            &[6u8, 0][..],
+            &[2, 1, 0, 0, 0, 0, 0, 0],
             &[3, 0, 0, 0],
             &[2, 0, 0, 0, 0, 0, 0, 0],
             b"m1",
@@ -156,6 +165,7 @@ mod tests {
         ));
         // A length prefix claiming 2^60 bytes must not allocate: the limit stops it.
         let mut huge = PROTOCOL_VERSION.to_le_bytes().to_vec();
+        huge.extend_from_slice(&[0; 8]);
         huge.extend_from_slice(&[0, 0, 0, 0]);
         huge.extend_from_slice(&(1u64 << 60).to_le_bytes());
         assert!(matches!(

@@ -30,8 +30,9 @@ use crate::trajectory::Trajectory;
 /// 2 — `AgentToCoordinator::Tour` carries the tour's evaluations;
 /// 3 — and whether a stop cut its swarms short;
 /// 4 — a coverage strip's tracking report says whether a stop cut the simulation short;
-/// 5 — `AgentToCoordinator::Tour` carries the tour's convergence curve.
-pub const PROTOCOL_VERSION: u16 = 5;
+/// 5 — `AgentToCoordinator::Tour` carries the tour's convergence curve;
+/// 6 — every [`Envelope`] carries an order sequence number, checked by the agents.
+pub const PROTOCOL_VERSION: u16 = 6;
 
 /// A message of either direction with its protocol version.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -39,15 +40,25 @@ pub struct Envelope<T> {
     /// [`PROTOCOL_VERSION`] of the sender. It is the first field, so a receiver can read it
     /// before it knows how to read the rest.
     pub version: u16,
+    /// The coordinator's order number: counts up over everything one coordinator sends for a
+    /// mission, so an agent acts on an order on its inbox only if its number is above the last
+    /// one it took (a replayed or reordered order is dropped). 0 in what agents send.
+    pub seq: u64,
     /// The message.
     pub body: T,
 }
 
 impl<T> Envelope<T> {
-    /// `body` stamped with this build's protocol version.
+    /// `body` stamped with this build's protocol version, unsequenced (agents' messages).
     pub fn new(body: T) -> Envelope<T> {
+        Envelope::sequenced(body, 0)
+    }
+
+    /// `body` stamped with this build's protocol version and order number `seq`.
+    pub fn sequenced(body: T, seq: u64) -> Envelope<T> {
         Envelope {
             version: PROTOCOL_VERSION,
+            seq,
             body,
         }
     }

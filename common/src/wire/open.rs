@@ -104,7 +104,9 @@ pub struct MissionEvent {
     /// Mission time, seconds.
     pub t_s: f64,
     /// What kind: `conflict_predicted`, `deviation`, `vehicle_lost`, `obstacle`, `replanned`,
-    /// `hold`, `arrived`, `mission_end`, …
+    /// `hold`, `arrived`, `mission_end`, `implausible_report` (a report refused: a jump, out of
+    /// bounds, numbered far ahead, off the clock), `obstacle_dropped` (a published obstacle
+    /// refused: out of scale, a known id, over the cap or the rate), …
     pub kind: String,
     /// Vehicles concerned.
     pub vehicles: Vec<String>,

@@ -6,6 +6,7 @@
 //! never a panic, never a stall.
 
 use std::collections::HashSet;
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::mpsc::{self, Receiver, RecvTimeoutError};
 use std::time::{Duration, Instant};
 
@@ -52,6 +53,10 @@ pub struct Network {
     /// Messages dropped so far.
     pub dropped: u64,
     logged: HashSet<&'static str>,
+    /// The last order number stamped on a message sent (see [`Envelope::seq`]). It starts at
+    /// the opening's unix time in microseconds, so a coordinator restarted under the same
+    /// mission id still counts up past what the agents took from the first.
+    last_seq: AtomicU64,
 }
 
 impl Network {
@@ -117,6 +122,7 @@ impl Network {
                 .collect(),
             dropped: 0,
             logged: HashSet::new(),
+            last_seq: AtomicU64::new(shoal_common::execution::unix_us()),
         })
     }
 
@@ -199,7 +205,8 @@ impl Network {
     }
 
     fn put(&self, key: &str, message: CoordinatorToAgent) -> anyhow::Result<()> {
-        let bytes = codec::encode(&Envelope::new(message))?;
+        let seq = self.last_seq.fetch_add(1, Ordering::Relaxed) + 1;
+        let bytes = codec::encode(&Envelope::sequenced(message, seq))?;
         self.session
             .put(key, bytes)
             .congestion_control(CongestionControl::Block)

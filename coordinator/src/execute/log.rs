@@ -23,6 +23,13 @@ pub const EVENT_HOLD: &str = "hold";
 /// The event kind of a vehicle whose link reports a fault (its `vehicles` names it).
 pub const EVENT_FAULT: &str = "fault";
 
+/// Kind of the event of a telemetry report refused as implausible (see [`super::plausible`]).
+pub const EVENT_IMPLAUSIBLE: &str = "implausible_report";
+
+/// Kind of the event of a published obstacle refused (out of scale, a known id, over the cap
+/// or the rate limit).
+pub const EVENT_OBSTACLE_DROPPED: &str = "obstacle_dropped";
+
 /// What starts a log.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Start {

@@ -12,6 +12,7 @@ mod ground;
 mod keep_out;
 mod lead;
 pub mod log;
+pub mod plausible;
 mod react;
 mod repair;
 pub mod replan;
@@ -78,7 +79,8 @@ pub struct ExecOptions {
 /// Raw input from the open-interface subscriptions (callbacks do no work themselves).
 enum Open {
     Telemetry(Vec<u8>, u64),
-    Obstacle(Vec<u8>),
+    /// An obstacle and when it came (the rate limit counts arrivals, not the loop's pace).
+    Obstacle(Vec<u8>, Instant),
 }
 
 /// Everything the execution loop shares.
@@ -111,6 +113,8 @@ pub(crate) struct Exec<'a> {
     /// Decision times of obstacle replans (obstacle received → update sent), ms.
     pub(crate) decisions_ms: Vec<f64>,
     dropped: u64,
+    /// Implausible reports and obstacles refused, the obstacles' rate limit.
+    guard: plausible::Guard,
     /// Longest wall time between two passes of the loop (see [`ExecutionReport`]).
     longest_pause: Duration,
     /// A coverage fleet's seabed map, for a crawler's way round a new obstacle; `None` for
@@ -133,6 +137,9 @@ pub struct ExecutionReport {
     pub update_delivery_ms: Vec<f64>,
     /// Malformed or unusable open-interface messages dropped.
     pub dropped: u64,
+    /// Well-formed reports and obstacles refused as implausible (or over a limit), per reason
+    /// (see [`plausible`]).
+    pub implausible: plausible::Refusals,
     /// Longest wall time between two passes of the execution loop, milliseconds: for that long
     /// no report was read, no conflict looked for and no status published.
     pub loop_longest_pause_ms: f64,
@@ -259,7 +266,10 @@ pub fn execute_trajectories(
     let _obstacles = net_session
         .declare_subscriber(obs_key.as_str())
         .callback(move |s| {
-            let _ = tx.send(Open::Obstacle(s.payload().to_bytes().into_owned()));
+            let _ = tx.send(Open::Obstacle(
+                s.payload().to_bytes().into_owned(),
+                Instant::now(),
+            ));
         })
         .wait()
         .map_err(|e| anyhow::anyhow!("cannot subscribe to {obs_key}: {e}"))?;
@@ -306,6 +316,7 @@ pub fn execute_trajectories(
         deliveries_ms: Vec::new(),
         decisions_ms: Vec::new(),
         dropped: 0,
+        guard: plausible::Guard::default(),
         longest_pause: Duration::ZERO,
         ground,
     };
@@ -342,6 +353,7 @@ pub fn execute_trajectories(
         obstacle_decision_ms: x.decisions_ms.clone(),
         update_delivery_ms: x.deliveries_ms.clone(),
         dropped: x.dropped,
+        implausible: x.guard.refusals.clone(),
         loop_longest_pause_ms: x.longest_pause.as_secs_f64() * 1000.0,
         ended,
     };
@@ -397,7 +409,7 @@ fn run_loop(
         }
         match rx.recv_timeout(Duration::from_millis(20)) {
             Ok(Open::Telemetry(bytes, received)) => react::telemetry(x, &bytes, received),
-            Ok(Open::Obstacle(bytes)) => react::obstacle_bytes(x, &bytes),
+            Ok(Open::Obstacle(bytes, arrived)) => react::obstacle_bytes(x, &bytes, arrived),
             Err(RecvTimeoutError::Timeout) => {}
             Err(RecvTimeoutError::Disconnected) => return "the network closed".into(),
         }

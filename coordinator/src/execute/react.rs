@@ -12,12 +12,14 @@
 use std::time::{Duration, Instant};
 
 use shoal_common::geometry::{segment_hits_sphere, Vec3};
+use shoal_common::limits;
 use shoal_common::scenario::{Obstacle, ObstacleKind};
 use shoal_common::wire::codec;
 use shoal_common::wire::open::{FleetStatus, Telemetry, OPEN_VERSION};
 
 use super::lead::{conflict_horizon_s, hold_retry_after};
-use super::log::{Record, EVENT_FAULT, EVENT_LOST};
+use super::log::{Record, EVENT_FAULT, EVENT_IMPLAUSIBLE, EVENT_LOST, EVENT_OBSTACLE_DROPPED};
+use super::plausible::{self, FixLimits, LastFix, Reason};
 use super::replan_queue;
 use super::Exec;
 
@@ -55,6 +57,11 @@ pub(super) fn telemetry(x: &mut Exec, bytes: &[u8], received_us: u64) {
             x,
             &format!("telemetry of {} with a non-finite state", t.vehicle),
         );
+    }
+    // Refused before it is logged: `replay` rebuilds the picture from the logged reports.
+    if let Err((reason, why)) = plausible_fix(x, i, &t, received_us) {
+        let detail = format!("{}'s report {}: {why}", t.vehicle, t.seq);
+        return refuse(x, EVENT_IMPLAUSIBLE, &t.vehicle, reason, detail);
     }
     let was_arrived = x.fleet.vehicles[i].arrived_s.is_some();
     let was_lost = x.fleet.vehicles[i].lost;
@@ -107,6 +114,57 @@ pub(super) fn telemetry(x: &mut Exec, bytes: &[u8], received_us: u64) {
     }
 }
 
+/// Whether report `t` of vehicle `i`, received at unix time `received_us`, can be true (see
+/// [`plausible::check_fix`]).
+fn plausible_fix(
+    x: &Exec,
+    i: usize,
+    t: &Telemetry,
+    received_us: u64,
+) -> Result<(), (Reason, String)> {
+    let o = x.options;
+    let limits = FixLimits::of(&x.scenario, i, o.telemetry_hz, o.time_scale, o.deviation_m);
+    let v = &x.fleet.vehicles[i];
+    let last = v.last.as_ref().map(|l| LastFix {
+        position: l.state.position,
+        t_s: l.state.t_s,
+        seq: l.seq,
+        wall_since_s: v.heard.map_or(0.0, |h| h.elapsed().as_secs_f64()),
+    });
+    // The mission clock when the report came (not when the loop got to it), as
+    // `MissionClock::now` counts it: from 0 at the epoch.
+    let epoch_us = x.mission_clock.epoch_unix_ms.saturating_mul(1000);
+    let now_s = ((received_us as f64 - epoch_us as f64) / 1e6 * o.time_scale).max(0.0);
+    plausible::check_fix(
+        t,
+        last,
+        &limits,
+        &x.scenario.bounds,
+        now_s,
+        x.guard.started.elapsed().as_secs_f64(),
+    )
+}
+
+/// Counts a refusal of `reason` for `who` and, at most once per [`plausible::EVENT_EVERY`]
+/// for `who` and `reason`, says so in an event of `kind`.
+fn refuse(x: &mut Exec, kind: &str, who: &str, reason: Reason, detail: String) {
+    if x.guard.refuse(who, reason, Instant::now()) {
+        let every = plausible::EVENT_EVERY.as_secs();
+        x.event(
+            kind,
+            if kind == EVENT_IMPLAUSIBLE {
+                vec![who.to_string()]
+            } else {
+                Vec::new()
+            },
+            format!(
+                "{detail}: dropped ({}); further ones within {every} s are only counted",
+                reason.name()
+            ),
+        );
+    }
+}
+
 fn drop_message(x: &mut Exec, detail: &str) {
     x.dropped += 1;
     if x.dropped == 1 {
@@ -116,8 +174,8 @@ fn drop_message(x: &mut Exec, detail: &str) {
     }
 }
 
-/// A new obstacle from the obstacles key.
-pub(super) fn obstacle_bytes(x: &mut Exec, bytes: &[u8]) {
+/// A new obstacle from the obstacles key, come at `arrived`.
+pub(super) fn obstacle_bytes(x: &mut Exec, bytes: &[u8], arrived: Instant) {
     let received = Instant::now();
     let o: Obstacle = match codec::decode_json(bytes) {
         Ok(o) => o,
@@ -137,6 +195,59 @@ pub(super) fn obstacle_bytes(x: &mut Exec, bytes: &[u8]) {
             ),
         );
     }
+    if let Err(why) = plausible::check_obstacle_scale(&o, &x.scenario.bounds) {
+        return refuse(
+            x,
+            EVENT_OBSTACLE_DROPPED,
+            "obstacles",
+            Reason::ObstacleOutOfScale,
+            why,
+        );
+    }
+    // A known id is dropped rather than replacing the obstacle: a client resending for
+    // reliability changes nothing, and the replans and the clearance figures (measured from the
+    // publication on, as `replay` recomputes them) stay those of the obstacle first published.
+    // A moved obstacle is published under a new id.
+    if x.scenario.obstacles.iter().any(|k| k.id == o.id) {
+        let why = format!("obstacle {:?}: the id is already known", o.id);
+        return refuse(
+            x,
+            EVENT_OBSTACLE_DROPPED,
+            "obstacles",
+            Reason::ObstacleDuplicate,
+            why,
+        );
+    }
+    if x.guard.published >= limits::MAX_PUBLISHED_OBSTACLES {
+        let why = format!(
+            "obstacle {:?}: {} obstacles were published already, the limit is {}",
+            o.id,
+            x.guard.published,
+            limits::MAX_PUBLISHED_OBSTACLES
+        );
+        return refuse(
+            x,
+            EVENT_OBSTACLE_DROPPED,
+            "obstacles",
+            Reason::ObstacleCap,
+            why,
+        );
+    }
+    if !x.guard.obstacles.take(arrived) {
+        let why = format!(
+            "obstacle {:?}: over the limit of {} obstacles a second",
+            o.id,
+            limits::MAX_OBSTACLES_PER_S
+        );
+        return refuse(
+            x,
+            EVENT_OBSTACLE_DROPPED,
+            "obstacles",
+            Reason::ObstacleRate,
+            why,
+        );
+    }
+    x.guard.published += 1;
     obstacle(x, o, received);
 }
 
