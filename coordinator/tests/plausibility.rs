@@ -72,9 +72,13 @@ fn stranger(endpoint: String) -> std::thread::JoinHandle<Sent> {
             let what = what.to_string();
             move |err: zenoh::Error| anyhow::anyhow!("{what}: {err}")
         };
-        let s = zenoh::open(session::client_config(&[endpoint], true)?)
-            .wait()
-            .map_err(e("open"))?;
+        let s = zenoh::open(session::client_config(
+            &[endpoint],
+            true,
+            &Default::default(),
+        )?)
+        .wait()
+        .map_err(e("open"))?;
         let orders = s
             .declare_subscriber(topics::to_agent(MISSION, "auv1")?)
             .wait()
@@ -155,6 +159,7 @@ fn a_forged_far_fix_and_a_replayed_hold_leave_the_mission_met_and_are_counted() 
         agents: AgentsMode::External,
         listen: vec![endpoint],
         routers: Vec::new(),
+        security: Default::default(),
         join_timeout: Duration::from_secs(30),
         round_timeout: Duration::from_secs(10),
         agent_bin: None,
