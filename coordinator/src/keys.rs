@@ -222,3 +222,76 @@ fn write(dir: &Path, name: &str, text: &str, private: bool) -> anyhow::Result<()
     f.write_all(text.as_bytes())
         .with_context(|| format!("cannot write {}", path.display()))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn args(out: &Path) -> KeysArgs {
+        KeysArgs {
+            out: out.to_path_buf(),
+            vehicles: vec!["auv1".into(), "auv2".into()],
+            scenario: None,
+            operators: vec!["operator".into()],
+            coordinator_hosts: vec!["localhost".into(), "127.0.0.1".into()],
+            path_in_config: Some(PathBuf::from("/keys")),
+            days: 30,
+        }
+    }
+
+    #[test]
+    fn every_member_gets_a_certificate_a_private_key_and_a_configuration_zenoh_reads(
+    ) -> anyhow::Result<()> {
+        let dir = tempfile::tempdir()?;
+        assert_eq!(command(&args(dir.path()))?, crate::EXIT_FEASIBLE);
+        for m in ["coordinator", "auv1", "auv2", "operator"] {
+            let pem = std::fs::read_to_string(dir.path().join(format!("{m}.pem")))?;
+            assert!(pem.starts_with("-----BEGIN CERTIFICATE-----"), "{m}");
+            let text = std::fs::read_to_string(dir.path().join(format!("{m}.json5")))?;
+            let config = zenoh::Config::from_json5(&text).map_err(|e| anyhow::anyhow!("{e}"))?;
+            let cert = config
+                .get_json("transport/link/tls/connect_certificate")
+                .map_err(|e| anyhow::anyhow!("{e}"))?;
+            assert_eq!(cert, format!("\"/keys/{m}.pem\""));
+            #[cfg(unix)]
+            {
+                use std::os::unix::fs::PermissionsExt as _;
+                let key = std::fs::metadata(dir.path().join(format!("{m}.key")))?;
+                assert_eq!(key.permissions().mode() & 0o777, 0o600, "{m}.key");
+            }
+        }
+        let coordinator = std::fs::read_to_string(dir.path().join("coordinator.json5"))?;
+        assert!(coordinator.contains("\"default_permission\": \"deny\""));
+        let vehicle = std::fs::read_to_string(dir.path().join("auv1.json5"))?;
+        assert!(!vehicle.contains("access_control"));
+        Ok(())
+    }
+
+    #[test]
+    fn a_second_run_never_overwrites_a_fleets_keys() -> anyhow::Result<()> {
+        let dir = tempfile::tempdir()?;
+        command(&args(dir.path()))?;
+        let ca = std::fs::read(dir.path().join("ca.key"))?;
+        let e = command(&args(dir.path())).err().map(|e| e.to_string());
+        assert!(e.is_some_and(|e| e.contains("already exists")));
+        assert_eq!(std::fs::read(dir.path().join("ca.key"))?, ca);
+        Ok(())
+    }
+
+    #[test]
+    fn a_reserved_repeated_or_bad_member_id_is_refused() {
+        let dir = std::path::Path::new("/nonexistent-shoal-keys");
+        for (vehicles, operators) in [
+            (vec!["coordinator"], vec![]),
+            (vec!["auv1", "auv1"], vec![]),
+            (vec!["auv1"], vec!["auv1"]),
+            (vec!["a/b"], vec![]),
+            (vec![], vec!["operator"]),
+        ] {
+            let mut a = args(dir);
+            a.vehicles = vehicles.iter().map(|s| s.to_string()).collect();
+            a.operators = operators.iter().map(|s| s.to_string()).collect();
+            assert!(command(&a).is_err(), "{vehicles:?} {operators:?}");
+        }
+    }
+}
