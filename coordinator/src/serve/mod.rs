@@ -5,20 +5,32 @@
 //! plan, then execute with one embedded agent per vehicle — on a router linked to this one, so
 //! their plan, telemetry, status and events appear on the open JSON keys
 //! (`shoal/<mission>/…`, see [`shoal_common::wire::open`]).
+//!
+//! Anyone who reaches the router can submit, so a submission is checked before it is queued
+//! ([`submission`]: sizes, rates, wall time, files under `--data-dir`, the mission id), the
+//! queue is bounded and takes each id once ([`queue`]), and missions still queued at exit are
+//! named in the log.
 
+use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::PathBuf;
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::mpsc;
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::Arc;
 use std::time::Duration;
 
+use anyhow::Context as _;
 use clap::Parser;
-use serde::{Deserialize, Serialize};
-use shoal_common::scenario::Scenario;
+use shoal_common::scenario::DataDir;
 use shoal_common::wire::{codec, session, topics};
 use zenoh::Wait;
 
 use crate::run_cmd::{run_command, RunArgs};
+
+mod queue;
+mod submission;
+
+use queue::Queue;
+use submission::{accept, check_size, Rules};
+pub use submission::{Receipt, Submission};
 
 /// `shoal-coordinator serve`.
 #[derive(Debug, Clone, clap::Args)]
@@ -37,79 +49,14 @@ pub struct ServeArgs {
     /// Serve this many missions, then exit (default: until Ctrl-C).
     #[arg(long)]
     pub missions: Option<usize>,
-}
-
-/// A mission submitted on `shoal/submit`.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct Submission {
-    /// 1.
-    pub version: u16,
-    /// The scenario file's text (TOML, as in `scenarios/`).
-    pub scenario_toml: String,
-    /// Mission id (default: from the scenario's name).
-    #[serde(default)]
-    pub mission: Option<String>,
-    /// Mission seconds per wall second (default 1).
-    #[serde(default)]
-    pub time_scale: Option<f64>,
-    /// Telemetry rate, Hz (default 2).
-    #[serde(default)]
-    pub telemetry_hz: Option<f64>,
-    /// Optimizer iterations (default: the scenario's).
-    #[serde(default)]
-    pub iterations: Option<usize>,
-    /// RNG seed (default: the scenario's).
-    #[serde(default)]
-    pub seed: Option<u64>,
-    /// Plan inside the coordinator instead of with the agents (default false).
-    #[serde(default)]
-    pub in_process: bool,
-}
-
-/// The reply to a submission.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct Receipt {
-    /// 1.
-    pub version: u16,
-    /// Taken (it runs after the missions before it).
-    pub accepted: bool,
-    /// The mission id: its keys are `shoal/<mission>/…`.
-    pub mission: Option<String>,
-    /// Why it was refused.
-    pub error: Option<String>,
-}
-
-/// Checks a submission's bytes; the mission id and the checked submission, or why not.
-fn accept(bytes: &[u8]) -> Result<(String, Submission), String> {
-    let s: Submission = codec::decode_json(bytes).map_err(|e| format!("not a submission: {e}"))?;
-    if s.version != 1 {
-        return Err(format!(
-            "submission version {} (this coordinator reads 1)",
-            s.version
-        ));
-    }
-    let scenario = Scenario::parse(
-        &s.scenario_toml,
-        std::path::Path::new("<submitted scenario>"),
-    )
-    .map_err(|e| e.to_string())?;
-    let mission = match &s.mission {
-        Some(m) => m.clone(),
-        None => crate::distributed::default_mission_id(&scenario),
-    };
-    topics::check_id("mission", &mission).map_err(|e| e.to_string())?;
-    for (field, v) in [
-        ("time_scale", s.time_scale),
-        ("telemetry_hz", s.telemetry_hz),
-    ] {
-        if let Some(v) = v {
-            if !(v.is_finite() && v > 0.0) {
-                return Err(format!("{field} = {v}: must be a positive number"));
-            }
-        }
-    }
-    Ok((mission, s))
+    /// The only directory whose files (seabed grids, current fields, heightmaps) a submitted
+    /// scenario may name. Without it, a submitted scenario naming any file is refused.
+    #[arg(long, env = "SHOAL_DATA_DIR")]
+    pub data_dir: Option<PathBuf>,
+    /// Longest wall time one mission may take (mission time / time scale), hours: a slower
+    /// submission is refused rather than holding the queue.
+    #[arg(long, env = "SHOAL_MAX_MISSION_HOURS", default_value_t = 6.0)]
+    pub max_mission_hours: f64,
 }
 
 #[derive(Parser)]
@@ -118,8 +65,49 @@ struct Wrapper {
     run: RunArgs,
 }
 
+/// The operator's rules from the flags.
+fn rules(args: &ServeArgs) -> anyhow::Result<Rules> {
+    let h = args.max_mission_hours;
+    if !(h.is_finite() && h > 0.0) {
+        anyhow::bail!("--max-mission-hours (SHOAL_MAX_MISSION_HOURS) = {h}: must be a positive number of hours");
+    }
+    let data_dir = match &args.data_dir {
+        Some(d) => Some(DataDir::open(d).with_context(|| {
+            format!(
+                "--data-dir (SHOAL_DATA_DIR) {}: not a usable directory",
+                d.display()
+            )
+        })?),
+        None => None,
+    };
+    Ok(Rules {
+        data_dir,
+        max_wall_s: h * 3600.0,
+    })
+}
+
+/// Checks one submission and queues it: the mission id, or why it was refused. Never
+/// panics: a bug in a check is a refusal, not a dead server.
+fn answer(
+    payload: Option<&zenoh::bytes::ZBytes>,
+    rules: &Rules,
+    queue: &Queue,
+) -> Result<String, String> {
+    // The size before copying or decoding anything.
+    check_size(payload.map_or(0, |p| p.len()))?;
+    let bytes = payload
+        .map(|p| p.to_bytes().into_owned())
+        .unwrap_or_default();
+    let checked = catch_unwind(AssertUnwindSafe(|| accept(&bytes, rules)));
+    let a = checked
+        .map_err(|_| "submission: could not be checked (the server logged why)".to_string())??;
+    queue.offer(a.mission.clone(), a.submission)?;
+    Ok(a.mission)
+}
+
 /// Serves until `shutdown` (or `--missions` missions).
 pub fn command(args: &ServeArgs, shutdown: Arc<AtomicBool>) -> anyhow::Result<i32> {
+    let rules = rules(args)?;
     let listen: Vec<String> = args
         .listen
         .iter()
@@ -129,35 +117,21 @@ pub fn command(args: &ServeArgs, shutdown: Arc<AtomicBool>) -> anyhow::Result<i3
     let router = zenoh::open(config)
         .wait()
         .map_err(|e| anyhow::anyhow!("cannot open a Zenoh router on {}: {e}", listen.join(", ")))?;
-    let (tx, rx) = mpsc::channel::<(String, Submission)>();
-    let refused = Arc::new(std::sync::atomic::AtomicU64::new(0));
-    let count = Arc::clone(&refused);
-    let _submit = router
+    let queue = Arc::new(Queue::new(args.out.clone()));
+    let refused = Arc::new(AtomicU64::new(0));
+    let (count, waiting) = (Arc::clone(&refused), Arc::clone(&queue));
+    let submit = router
         .declare_queryable(topics::SUBMIT)
         .callback(move |q| {
-            let bytes = q
-                .payload()
-                .map(|p| p.to_bytes().into_owned())
-                .unwrap_or_default();
-            let receipt = match accept(&bytes) {
-                Ok((mission, s)) => {
-                    let _ = tx.send((mission.clone(), s));
-                    Receipt {
-                        version: 1,
-                        accepted: true,
-                        mission: Some(mission),
-                        error: None,
-                    }
+            let receipt = match answer(q.payload(), &rules, &waiting) {
+                Ok(mission) => {
+                    tracing::info!("accepted mission {mission}");
+                    submission::accepted(&mission)
                 }
                 Err(why) => {
                     count.fetch_add(1, Ordering::Relaxed);
                     tracing::warn!("refused a submission: {why}");
-                    Receipt {
-                        version: 1,
-                        accepted: false,
-                        mission: None,
-                        error: Some(why),
-                    }
+                    submission::refused(why)
                 }
             };
             if let Ok(b) = codec::encode_json(&receipt) {
@@ -177,57 +151,32 @@ pub fn command(args: &ServeArgs, shutdown: Arc<AtomicBool>) -> anyhow::Result<i3
     );
     let mut served = 0usize;
     while !shutdown.load(Ordering::Relaxed) && args.missions.is_none_or(|n| served < n) {
-        let (mission, s) = match rx.recv_timeout(Duration::from_millis(200)) {
-            Ok(m) => m,
-            Err(mpsc::RecvTimeoutError::Timeout) => continue,
-            Err(mpsc::RecvTimeoutError::Disconnected) => break,
+        let Some((mission, s)) = queue.take(Duration::from_millis(200)) else {
+            continue;
         };
-        let dir = args.out.join(&mission);
-        std::fs::create_dir_all(&dir)
-            .map_err(|e| anyhow::anyhow!("cannot create {}: {e}", dir.display()))?;
-        let file = dir.join("scenario.toml");
-        std::fs::write(&file, &s.scenario_toml)
-            .map_err(|e| anyhow::anyhow!("cannot write {}: {e}", file.display()))?;
-        let mut argv: Vec<String> = vec!["run".into(), file.display().to_string()];
-        argv.extend([
-            "--out".into(),
-            dir.display().to_string(),
-            "--mission".into(),
-            mission.clone(),
-        ]);
-        argv.extend(["--router".into(), link.clone(), "--quiet".into()]);
-        if s.in_process {
-            argv.push("--in-process".into());
-        }
-        for (flag, v) in [
-            ("--time-scale", s.time_scale.map(|v| v.to_string())),
-            ("--telemetry-hz", s.telemetry_hz.map(|v| v.to_string())),
-            ("--iterations", s.iterations.map(|v| v.to_string())),
-            ("--seed", s.seed.map(|v| v.to_string())),
-        ] {
-            if let Some(v) = v {
-                argv.extend([flag.to_string(), v]);
-            }
-        }
         served += 1;
-        let run = match Wrapper::try_parse_from(&argv) {
-            Ok(w) => w.run,
-            Err(e) => {
-                tracing::error!("mission {mission}: {e}");
-                continue;
-            }
-        };
-        eprintln!(
-            "mission {mission}: planning and executing (files in {})",
-            dir.display()
-        );
-        match run_command(&run, Arc::clone(&shutdown)) {
-            Ok(code) => eprintln!("mission {mission}: ended with status {code}"),
-            Err(e) => eprintln!("mission {mission}: failed: {e:#}"),
+        let ran = catch_unwind(AssertUnwindSafe(|| {
+            run_one(args, &link, &mission, &s, &shutdown)
+        }));
+        match ran {
+            Ok(Ok(code)) => eprintln!("mission {mission}: ended with status {code}"),
+            Ok(Err(e)) => eprintln!("mission {mission}: failed: {e:#}"),
+            Err(_) => eprintln!("mission {mission}: failed: the run panicked"),
         }
+        queue.finished();
     }
+    // No more submissions, then say which were left.
+    drop(submit);
     if let Err(e) = router.close().wait() {
         tracing::warn!("closing the router: {e}");
+    }
+    let left = queue.drain();
+    if !left.is_empty() {
+        eprintln!(
+            "{} mission(s) still queued, not run: {}",
+            left.len(),
+            left.join(", ")
+        );
     }
     eprintln!(
         "served {served} mission(s); refused {} submission(s)",
@@ -236,36 +185,50 @@ pub fn command(args: &ServeArgs, shutdown: Arc<AtomicBool>) -> anyhow::Result<i3
     Ok(crate::EXIT_FEASIBLE)
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn submissions_are_checked_and_refusals_say_why() {
-        let scenario = std::fs::read_to_string(concat!(
-            env!("CARGO_MANIFEST_DIR"),
-            "/../scenarios/amp-pso-2.toml"
-        ))
-        .unwrap_or_default();
-        let ok = serde_json::json!({"version": 1, "scenario_toml": scenario, "mission": "m-1", "time_scale": 50.0});
-        let (m, s) = match accept(ok.to_string().as_bytes()) {
-            Ok(x) => x,
-            Err(e) => panic!("{e}"),
-        };
-        assert_eq!(m, "m-1");
-        assert_eq!(s.time_scale, Some(50.0));
-        let bad = |v: serde_json::Value| accept(v.to_string().as_bytes()).err().unwrap_or_default();
-        assert!(bad(serde_json::json!({"version": 2, "scenario_toml": ""})).contains("version 2"));
-        assert!(accept(b"not json")
-            .err()
-            .unwrap_or_default()
-            .contains("not a submission"));
-        let e = bad(serde_json::json!({"version": 1, "scenario_toml": "name = 3"}));
-        assert!(e.contains("<submitted scenario>"), "{e}");
-        let e = bad(serde_json::json!({"version": 1, "scenario_toml": scenario, "mission": "a/b"}));
-        assert!(e.contains("\"a/b\""), "{e}");
-        let e =
-            bad(serde_json::json!({"version": 1, "scenario_toml": scenario, "time_scale": -1.0}));
-        assert!(e.contains("time_scale = -1"), "{e}");
+/// Runs one accepted mission as `run` would, in `<out>/<mission>/` (which must not exist yet:
+/// it is never overwritten).
+fn run_one(
+    args: &ServeArgs,
+    link: &str,
+    mission: &str,
+    s: &Submission,
+    shutdown: &Arc<AtomicBool>,
+) -> anyhow::Result<i32> {
+    let dir = args.out.join(mission);
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("cannot create {}", args.out.display()))?;
+    std::fs::create_dir(&dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    let file = dir.join("scenario.toml");
+    std::fs::write(&file, &s.scenario_toml)
+        .with_context(|| format!("cannot write {}", file.display()))?;
+    // `--flag=value` throughout and the scenario after `--`: no value is read as a flag.
+    let mut argv: Vec<String> = vec![
+        "run".into(),
+        format!("--out={}", dir.display()),
+        format!("--mission={mission}"),
+        format!("--router={link}"),
+        "--quiet".into(),
+    ];
+    if s.in_process {
+        argv.push("--in-process".into());
     }
+    for (flag, v) in [
+        ("--time-scale", s.time_scale.map(|v| v.to_string())),
+        ("--telemetry-hz", s.telemetry_hz.map(|v| v.to_string())),
+        ("--iterations", s.iterations.map(|v| v.to_string())),
+        ("--seed", s.seed.map(|v| v.to_string())),
+    ] {
+        if let Some(v) = v {
+            argv.push(format!("{flag}={v}"));
+        }
+    }
+    argv.extend(["--".into(), file.display().to_string()]);
+    let run = Wrapper::try_parse_from(&argv)
+        .map_err(|e| anyhow::anyhow!("cannot build the run: {e}"))?
+        .run;
+    eprintln!(
+        "mission {mission}: planning and executing (files in {})",
+        dir.display()
+    );
+    run_command(&run, Arc::clone(shutdown))
 }
