@@ -86,7 +86,6 @@ fn hostile_submissions_are_refused_and_serve_stays_up_with_bounded_memory() -> T
         eprintln!("SKIPPED: no Python with eclipse-zenoh (set SHOAL_INTEROP_PYTHON; .ci/run does)");
         return Ok(());
     };
-    let started = Instant::now();
     let tmp = tempfile::tempdir()?;
     let (data, out, log) = (
         tmp.path().join("data"),
@@ -118,6 +117,7 @@ fn hostile_submissions_are_refused_and_serve_stays_up_with_bounded_memory() -> T
         ),
         "serve did not start"
     );
+    let started = Instant::now();
 
     // Sample serve's resident memory while it is attacked.
     let (max_rss, stop) = (
@@ -155,7 +155,10 @@ fn hostile_submissions_are_refused_and_serve_stays_up_with_bounded_memory() -> T
     let summary: serde_json::Value = serde_json::from_str(stdout.trim())
         .map_err(|e| format!("client summary {stdout:?}: {e}\n{stderr}"))?;
     let max_rss_kb = max_rss.load(Ordering::Relaxed);
-    eprintln!("corpus: {summary}; serve alive: {alive}; max RSS {max_rss_kb} kB");
+    eprintln!(
+        "corpus in {:.1} s: {summary}; serve alive: {alive}; max RSS {max_rss_kb} kB",
+        started.elapsed().as_secs_f64()
+    );
     assert!(c.status.success(), "{stderr}");
     assert!(alive, "serve died under the corpus");
     assert!(
