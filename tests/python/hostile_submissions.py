@@ -4,7 +4,7 @@ eclipse-zenoh package, 1.10.2) as a stranger on the network would.
     python hostile_submissions.py ENDPOINT DATA_DIR SCENARIO.toml [--scenario-limits]
                                   [--write DIR]
 
-Builds the corpus (about 60 submissions: malformed envelopes, out-of-range numbers, files
+Builds the corpus (about 70 submissions: malformed envelopes, out-of-range numbers, files
 outside the data directory, path-like mission ids, a duplicate id, a flood), prepares DATA_DIR
 (a good current grid, a symbolic link to /etc/passwd, a FIFO, an oversized sparse file), sends
 each submission on `shoal/submit` and checks its receipt against what the case expects.
