@@ -51,3 +51,8 @@ pub const MAX_PUBLISHED_OBSTACLES: usize = 256;
 
 /// Obstacles a client may publish per wall second on one mission; past it, dropped and counted.
 pub const MAX_OBSTACLES_PER_S: f64 = 5.0;
+
+/// Bytes of a data file (seabed grid, current field, coverage heightmap) a scenario submitted
+/// to `serve` may name: a 2,000 × 2,000 height grid in ESRI ASCII, at about ten bytes a
+/// node, is 40 MB; the shipped data files are under 1 MB.
+pub const MAX_DATA_FILE_BYTES: u64 = 64 << 20;

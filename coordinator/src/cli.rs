@@ -103,8 +103,8 @@ pub struct PlanArgs {
     #[arg(long, env = "SHOAL_AGENTS", value_enum, default_value_t = AgentsMode::Embedded)]
     pub agents: AgentsMode,
     /// Distributed mode: endpoint(s) the embedded Zenoh router listens on (comma-separated).
-    /// Default: tcp/127.0.0.1:0 (a free port) with embedded agents, tcp/0.0.0.0:7447 with
-    /// external ones.
+    /// Default: tcp/127.0.0.1:0 (a free port) with embedded agents, tcp/127.0.0.1:7447 with
+    /// external ones; listening beyond loopback needs authentication (or --insecure).
     #[arg(long, env = "SHOAL_LISTEN", value_delimiter = ',')]
     pub listen: Vec<String>,
     /// Distributed mode: other Zenoh routers to link to, e.g. another coordinator's endpoint, so
@@ -141,12 +141,12 @@ pub struct PlanArgs {
 /// `shoal-coordinator router`.
 #[derive(Debug, Clone, clap::Args)]
 pub struct RouterArgs {
-    /// Endpoint(s) to listen on (comma-separated).
+    /// Endpoint(s) to listen on (comma-separated); beyond loopback needs authentication.
     #[arg(
         long,
         env = "SHOAL_LISTEN",
         value_delimiter = ',',
-        default_value = "tcp/0.0.0.0:7447"
+        default_value = "tcp/127.0.0.1:7447"
     )]
     pub listen: Vec<String>,
     /// How members authenticate (a router beyond loopback needs it, or --insecure).

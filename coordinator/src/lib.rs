@@ -235,7 +235,7 @@ pub fn distributed_options(
     let listen = if args.listen.is_empty() {
         vec![match args.agents {
             distributed::AgentsMode::Embedded => "tcp/127.0.0.1:0".to_string(),
-            distributed::AgentsMode::External => "tcp/0.0.0.0:7447".to_string(),
+            distributed::AgentsMode::External => "tcp/127.0.0.1:7447".to_string(),
         }]
     } else {
         args.listen.clone()

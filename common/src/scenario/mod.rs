@@ -11,12 +11,14 @@ use serde::{Deserialize, Serialize};
 use crate::geometry::Vec3;
 
 mod coverage;
+mod files;
 mod inspection;
 mod ocean;
 mod optimizer;
 mod seabed;
 mod validate;
 pub use coverage::CoverageSettings;
+pub use files::{DataDir, FileRefusal, FILE_FIELDS, OUTSIDE_DATA_DIR};
 pub use inspection::{FirstPointMode, InspectionSettings};
 pub use ocean::{CurrentModel, Currents, EnergySettings};
 pub use optimizer::{Algorithm, DistributedSettings, OptimizerSettings};

@@ -18,11 +18,12 @@
 //! ```
 //!
 //! Mission and vehicle ids become key chunks, so they are restricted to letters, digits, `-`, `_`
-//! and `.`: no `/`, no wildcards, nothing empty.
+//! and `.`: no `/`, no wildcards, nothing empty. They also name directories (`<out>/<mission>/`),
+//! so they are single path components: no leading `.` (`.`, `..`, hidden names) and no `\`.
 
 /// Why an id cannot be used in a key expression.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
-#[error("{kind} id {id:?} is not usable on the network: use 1-64 letters, digits, '-', '_' or '.'")]
+#[error("{kind} id {id:?} is not usable on the network: use 1-64 letters, digits, '-', '_' or '.', not starting with '.'")]
 pub struct IdError {
     /// "mission" or "vehicle".
     pub kind: &'static str,
@@ -33,6 +34,7 @@ pub struct IdError {
 /// Checks that `id` can be one chunk of a key expression.
 pub fn check_id(kind: &'static str, id: &str) -> Result<(), IdError> {
     let ok = (1..=64).contains(&id.len())
+        && !id.starts_with('.')
         && id
             .bytes()
             .all(|b| b.is_ascii_alphanumeric() || matches!(b, b'-' | b'_' | b'.'));
@@ -241,7 +243,21 @@ mod tests {
 
     #[test]
     fn ids_that_would_change_a_key_are_refused() {
-        for bad in ["", "a/b", "*", "**", "a b", "$x", "auv?", &"x".repeat(65)] {
+        for bad in [
+            "",
+            "a/b",
+            "*",
+            "**",
+            "a b",
+            "$x",
+            "auv?",
+            &"x".repeat(65),
+            ".",
+            "..",
+            ".hidden",
+            "a\\b",
+            "../x",
+        ] {
             assert!(check_id("vehicle", bad).is_err(), "{bad:?}");
             assert!(to_agent("m", bad).is_err());
         }
@@ -250,5 +266,8 @@ mod tests {
             .map(|e| e.to_string())
             .unwrap_or_default();
         assert!(e.contains("mission id \"two missions\""), "{e}");
+        for good in ["a..b", "m.1", "x".repeat(64).as_str()] {
+            assert!(check_id("mission", good).is_ok(), "{good:?}");
+        }
     }
 }
