@@ -93,7 +93,12 @@ impl ReplanQueue {
             .map_or(Duration::ZERO, |u| {
                 u.asked.budget.saturating_sub(u.started.elapsed())
             });
-        rest + self.waiting.iter().take(ahead).map(|w| w.budget).sum()
+        rest + self
+            .waiting
+            .iter()
+            .take(ahead)
+            .map(|w| w.budget)
+            .sum::<Duration>()
     }
 
     /// Where a replan of a vehicle under way is queued: before every held vehicle's retry
