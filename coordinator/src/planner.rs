@@ -401,6 +401,7 @@ mod tests {
             penalty: (1.118, 0.0),
             total: (12.9948, 1.7347),
             evaluations: 38873,
+            interrupted: false,
         };
         assert_eq!(
             touch_up_notice(&s, &t, true),
@@ -420,6 +421,17 @@ mod tests {
             "touch-up: the swarm's best plan broke a limit; no vehicle's path could be improved \
              in 38873 evaluations; the violations listed remain (--no-touch-up gives the swarm's \
              own plan)"
+        );
+        // Cut short by Ctrl-C: said so, and the plan is what it kept.
+        let cut = TouchUp {
+            interrupted: true,
+            ..none
+        };
+        assert_eq!(
+            touch_up_notice(&s, &cut, false),
+            "touch-up: the swarm's best plan broke a limit; no vehicle's path could be improved \
+             in 38873 evaluations, cut short by the stop request; the violations listed remain \
+             (--no-touch-up gives the swarm's own plan)"
         );
     }
 }
