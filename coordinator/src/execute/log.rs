@@ -225,6 +225,7 @@ mod tests {
         assert!(e.contains("line 3") && e.contains("m.ndjson"), "{e}");
         // A line over the limit is named with its number before the rest of it is read.
         let limit = text.lines().map(str::len).max().unwrap_or(0) + 1;
+        std::fs::write(&path, &text)?;
         assert!(read_with_line_limit(&path, limit).is_ok());
         std::fs::write(&path, format!("{text}{}\n", "x".repeat(limit + 1)))?;
         let e = read_with_line_limit(&path, limit)
