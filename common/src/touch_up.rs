@@ -23,6 +23,14 @@
 //!
 //! Each try's result is kept when it lowers the fleet's fitness (the fresh one is weighed
 //! against the plan as the local one left it).
+//!
+//! A raised stop flag (Ctrl-C, SIGTERM) ends every swarm at its next iteration and the pass
+//! before its next vehicle: what was kept so far is returned, marked as interrupted. A
+//! 500-vehicle fleet otherwise kept the touch-up going for minutes after the user asked it to
+//! stop.
+
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
 
 use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
@@ -88,10 +96,24 @@ pub struct TouchUp {
     pub total: (f64, f64),
     /// Cost evaluations spent (of one vehicle or of the fleet).
     pub evaluations: u64,
+    /// The stop flag was raised before every vehicle in violation had its tries.
+    pub interrupted: bool,
 }
 
-/// Touches up fleet position `x`; `None` when its plan has no violation to clear.
-pub fn touch_up(model: &FleetModel, x: &[f64], settings: TouchUpSettings) -> Option<TouchUp> {
+/// Touches up fleet position `x`; `None` when its plan has no violation to clear. A raised
+/// `stop` ends it early with what it kept so far.
+pub fn touch_up(
+    model: &FleetModel,
+    x: &[f64],
+    settings: TouchUpSettings,
+    stop: Option<&Arc<AtomicBool>>,
+) -> Option<TouchUp> {
+    let stopped = || stop.is_some_and(|s| s.load(Ordering::Relaxed));
+    let executor = |iterations| Executor {
+        max_iterations: iterations,
+        stop: stop.cloned(),
+        ..Executor::default()
+    };
     let mut eval = model.evaluate(x);
     if eval.penalty <= 0.0 {
         return None;
@@ -101,9 +123,14 @@ pub fn touch_up(model: &FleetModel, x: &[f64], settings: TouchUpSettings) -> Opt
     let mut changed = Vec::new();
     let mut from_fresh = Vec::new();
     let mut evaluations = 1;
+    let mut interrupted = false;
     'rounds: for round in 0..settings.rounds {
         for v in 0..model.layout.vehicles {
             if eval.penalty <= 0.0 {
+                break 'rounds;
+            }
+            if stopped() {
+                interrupted = true;
                 break 'rounds;
             }
             let range = model.layout.chromosome(v);
@@ -119,7 +146,7 @@ pub fn touch_up(model: &FleetModel, x: &[f64], settings: TouchUpSettings) -> Opt
                 max_velocity_fraction: settings.max_velocity_fraction,
                 seed: stream_seed(settings.seed, 7_000_001 + (round * 1000 + v) as u64),
             };
-            let out = Executor::new(settings.iterations).run(&problem, &mut solver, |_| {});
+            let out = executor(settings.iterations).run(&problem, &mut solver, |_| {});
             evaluations += out.state.evaluations();
             let local = out.state.best_position().to_vec();
             let fresh =
@@ -132,8 +159,7 @@ pub fn touch_up(model: &FleetModel, x: &[f64], settings: TouchUpSettings) -> Opt
                             8_000_001 + (round * 1000 + v) as u64,
                         ))
                     };
-                    let f =
-                        Executor::new(settings.fresh_iterations).run(&problem, &mut solver, |_| {});
+                    let f = executor(settings.fresh_iterations).run(&problem, &mut solver, |_| {});
                     evaluations += f.state.evaluations();
                     f.state.best_position().to_vec()
                 });
@@ -162,6 +188,7 @@ pub fn touch_up(model: &FleetModel, x: &[f64], settings: TouchUpSettings) -> Opt
         penalty: (before.0, eval.penalty),
         total: (before.1, eval.total),
         evaluations,
+        interrupted: interrupted || stopped(),
     })
 }
 
@@ -310,7 +337,8 @@ mod tests {
         let before = model.evaluate(&x);
         assert!(before.penalty > 0.0, "the straight lines collide");
         let settings = TouchUpSettings::new(3, 0.1);
-        let t = touch_up(&model, &x, settings).unwrap_or_else(|| panic!("nothing to clear?"));
+        let t = touch_up(&model, &x, settings, None).unwrap_or_else(|| panic!("nothing to clear?"));
+        assert!(!t.interrupted);
         assert_eq!(t.penalty.0, before.penalty);
         assert_eq!(t.total.0, before.total);
         assert_eq!(t.penalty.1, 0.0, "the crossing is cleared: {t:?}");
@@ -335,9 +363,9 @@ mod tests {
             );
         }
         // The same seed, the same touch-up.
-        assert_eq!(touch_up(&model, &x, settings), Some(t.clone()));
+        assert_eq!(touch_up(&model, &x, settings, None), Some(t.clone()));
         // A plan with nothing to clear is left alone.
-        assert_eq!(touch_up(&model, &t.x, settings), None);
+        assert_eq!(touch_up(&model, &t.x, settings, None), None);
     }
 
     #[test]
@@ -352,7 +380,7 @@ mod tests {
             fresh_populations: 0,
             ..TouchUpSettings::new(5, 0.1)
         };
-        let t = touch_up(&model, &x, stuck).unwrap_or_else(|| panic!("nothing to clear?"));
+        let t = touch_up(&model, &x, stuck, None).unwrap_or_else(|| panic!("nothing to clear?"));
         assert!(t.changed.is_empty() && t.fresh.is_empty(), "{t:?}");
         assert_eq!(t.penalty.1, t.penalty.0);
         assert_eq!(t.x, x);
@@ -361,7 +389,7 @@ mod tests {
             fresh_iterations: 60,
             ..stuck
         };
-        let t = touch_up(&model, &x, fresh).unwrap_or_else(|| panic!("nothing to clear?"));
+        let t = touch_up(&model, &x, fresh, None).unwrap_or_else(|| panic!("nothing to clear?"));
         assert_eq!(
             t.penalty.1, 0.0,
             "the fresh search clears the crossing: {t:?}"
@@ -369,5 +397,23 @@ mod tests {
         assert!(!t.fresh.is_empty());
         assert!(t.fresh.iter().all(|v| t.changed.contains(v)));
         assert_eq!(model.evaluate(&t.x).total, t.total.1);
+    }
+
+    #[test]
+    fn a_raised_stop_flag_ends_the_touch_up_at_once_and_keeps_the_plan_it_had() {
+        // With the flag up before it starts, no vehicle gets a try: the plan comes back as it
+        // went in, marked as interrupted, after the one evaluation that found the violation.
+        let model = crossing();
+        let x = fixtures::straight_particle(&model);
+        let stop = Arc::new(AtomicBool::new(true));
+        let started = std::time::Instant::now();
+        let t = touch_up(&model, &x, TouchUpSettings::new(3, 0.1), Some(&stop))
+            .unwrap_or_else(|| panic!("nothing to clear?"));
+        assert!(started.elapsed() < std::time::Duration::from_secs(1));
+        assert!(t.interrupted);
+        assert!(t.changed.is_empty(), "{t:?}");
+        assert_eq!(t.x, x);
+        assert_eq!(t.evaluations, 1);
+        assert_eq!(t.penalty.0, t.penalty.1);
     }
 }

@@ -120,20 +120,27 @@ pub fn plan_in_process(
             return crate::tour_planner::plan(scenario, executor.stop.clone(), observe)
         }
     };
-    to_plan(scenario, &model, run, "in-process")
+    to_plan(scenario, &model, run, "in-process", executor.stop.as_ref())
 }
 
 /// The validated plan of a run: the fleet figures are recomputed from the trajectories. When
 /// the swarm's best breaks a limit and the settings allow it, the plan is first touched up
-/// ([`shoal_common::touch_up`]) and says so.
-pub fn to_plan(scenario: &Scenario, model: &FleetModel, run: RunResult, mode: &str) -> Plan {
+/// ([`shoal_common::touch_up`]) and says so. A raised `stop` skips the touch-up, or ends it
+/// with what it kept so far.
+pub fn to_plan(
+    scenario: &Scenario,
+    model: &FleetModel,
+    run: RunResult,
+    mode: &str,
+    stop: Option<&Arc<AtomicBool>>,
+) -> Plan {
     let o = &scenario.optimizer;
     let started = std::time::Instant::now();
-    let touched = o
-        .touch_up
+    let stopped = stop.is_some_and(|s| s.load(std::sync::atomic::Ordering::Relaxed));
+    let touched = (o.touch_up && !stopped)
         .then(|| {
             let settings = TouchUpSettings::new(o.seed, o.velocity_cap(SEED004_VELOCITY_CAP));
-            touch_up(model, &run.best_x, settings)
+            touch_up(model, &run.best_x, settings, stop)
         })
         .flatten();
     let touch_up_s = started.elapsed().as_secs_f64();
@@ -210,9 +217,14 @@ fn touch_up_notice(scenario: &Scenario, t: &TouchUp, cleared: bool) -> String {
         )
     };
     format!(
-        "touch-up: the swarm's best plan broke a limit; {what} in {} evaluations{} \
+        "touch-up: the swarm's best plan broke a limit; {what} in {} evaluations{}{} \
          (--no-touch-up gives the swarm's own plan)",
         t.evaluations,
+        if t.interrupted {
+            ", cut short by the stop request"
+        } else {
+            ""
+        },
         if cleared {
             ", which cleared every violation"
         } else {
@@ -389,6 +401,7 @@ mod tests {
             penalty: (1.118, 0.0),
             total: (12.9948, 1.7347),
             evaluations: 38873,
+            interrupted: false,
         };
         assert_eq!(
             touch_up_notice(&s, &t, true),
@@ -408,6 +421,17 @@ mod tests {
             "touch-up: the swarm's best plan broke a limit; no vehicle's path could be improved \
              in 38873 evaluations; the violations listed remain (--no-touch-up gives the swarm's \
              own plan)"
+        );
+        // Cut short by Ctrl-C: said so, and the plan is what it kept.
+        let cut = TouchUp {
+            interrupted: true,
+            ..none
+        };
+        assert_eq!(
+            touch_up_notice(&s, &cut, false),
+            "touch-up: the swarm's best plan broke a limit; no vehicle's path could be improved \
+             in 38873 evaluations, cut short by the stop request; the violations listed remain \
+             (--no-touch-up gives the swarm's own plan)"
         );
     }
 }

@@ -482,4 +482,23 @@ mod tests {
         assert!(drawn.contains("soft1"), "the hazard is not drawn");
         Ok(())
     }
+
+    #[test]
+    fn replaying_dev_zero_is_refused_at_the_line_limit_naming_line_1() {
+        // /dev/zero has no newline: the reader stops one byte past the limit instead of
+        // filling the memory (it used to abort at 4.3 GB).
+        let zero = Path::new("/dev/zero");
+        if !zero.exists() {
+            return;
+        }
+        let e = replay(zero)
+            .err()
+            .map(|e| format!("{e:#}"))
+            .unwrap_or_default();
+        assert!(
+            e.contains("/dev/zero line 1")
+                && e.contains(&shoal_common::limits::MAX_LOG_LINE_BYTES.to_string()),
+            "{e}"
+        );
+    }
 }

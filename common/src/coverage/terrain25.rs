@@ -51,8 +51,8 @@ pub enum Terrain25Error {
     Grid(#[from] TerrainError),
 }
 
-/// Largest map accepted (4000 × 4000 cells; the map keeps about 34 bytes per cell).
-pub const MAX_CELLS: usize = 16_000_000;
+/// Largest map accepted ([`crate::limits::MAX_MAP_CELLS`]; the map keeps about 34 bytes per cell).
+pub const MAX_CELLS: usize = crate::limits::MAX_MAP_CELLS;
 
 /// Where the minor undulation comes from.
 #[derive(Debug, Clone, PartialEq)]

@@ -4,10 +4,12 @@
 
 use serde::{Deserialize, Serialize};
 
+use super::sizes::{in_range, over};
 use super::{Bad, ScenarioError};
 use crate::coverage::params::CoverageParams;
 use crate::coverage::tracking::TrackingParams;
 use crate::coverage::{Terrain25Error, TerrainSpec, TraversalLimits};
+use crate::limits;
 
 /// `[coverage]`.
 #[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
@@ -47,8 +49,9 @@ impl Default for CoverageSettings {
 }
 
 impl CoverageSettings {
-    /// Checks every sub-table; errors name `coverage.<table>.<field>`.
-    pub fn validate(&self, bad: Bad) -> Result<(), ScenarioError> {
+    /// Checks every sub-table against the horizontal `area` `[x0, y0, x1, y1]` it covers (the
+    /// scenario's bounds); errors name `coverage.<table>.<field>`.
+    pub fn validate(&self, area: [f64; 4], bad: Bad) -> Result<(), ScenarioError> {
         let wrap = |table: &str, e: Terrain25Error| match e {
             Terrain25Error::InvalidSpec { field, what }
             | Terrain25Error::InvalidParam { field, what } => {
@@ -70,6 +73,124 @@ impl CoverageSettings {
                 self.vehicle_length_m.to_string(),
                 "must be a positive length in metres",
             ));
+        }
+        if self.heightmap.is_none() {
+            self.validate_map_cells(bad)?;
+        }
+        self.validate_width(area, bad)?;
+        self.validate_work(area, bad)?;
+        for (name, v) in [
+            ("speed_mps", self.tracking.speed_mps),
+            ("min_speed_mps", self.tracking.min_speed_mps),
+            ("max_speed_mps", self.tracking.max_speed_mps),
+        ] {
+            let field = format!("coverage.tracking.{name}");
+            in_range(bad, &field, v, limits::SPEED_MPS, "m/s (limits::SPEED_MPS)")?;
+        }
+        Ok(())
+    }
+
+    /// The synthetic terrain's cells (its size over its cell, each axis rounded up) within
+    /// [`limits::MAX_MAP_CELLS`], before the map is sampled.
+    fn validate_map_cells(&self, bad: Bad) -> Result<(), ScenarioError> {
+        let t = &self.terrain;
+        let cells = (t.size_m[0] / t.cell_m).ceil() * (t.size_m[1] / t.cell_m).ceil();
+        if cells > limits::MAX_MAP_CELLS as f64 {
+            return Err(bad(
+                "coverage.terrain.cell_m".into(),
+                t.cell_m.to_string(),
+                &format!(
+                    "makes a {} × {} m map of {cells:.3e} cells, over the limit {} (limits::MAX_MAP_CELLS)",
+                    t.size_m[0],
+                    t.size_m[1],
+                    limits::MAX_MAP_CELLS
+                ),
+            ));
+        }
+        Ok(())
+    }
+
+    /// The crawler's width: a real crawler's, narrower than the area, and inside the clearance
+    /// the planner keeps. The planner keeps `planner.safety_clearance_m` between the vehicle's
+    /// centre line and impassable ground whatever the width (the width only dilates the no-go
+    /// map): a clearance under half the width would plan the vehicle's side over that ground.
+    fn validate_width(&self, area: [f64; 4], bad: Bad) -> Result<(), ScenarioError> {
+        let w = self.limits.vehicle_width_m;
+        let field = "coverage.limits.vehicle_width_m";
+        if !(w > 0.0 && w <= limits::MAX_VEHICLE_WIDTH_M) {
+            return Err(bad(
+                field.into(),
+                w.to_string(),
+                &format!(
+                    "must be in (0, {}] m (limits::MAX_VEHICLE_WIDTH_M: the widest seabed crawler)",
+                    limits::MAX_VEHICLE_WIDTH_M
+                ),
+            ));
+        }
+        let narrower = (area[2] - area[0]).min(area[3] - area[1]);
+        if w >= narrower {
+            return Err(bad(
+                field.into(),
+                w.to_string(),
+                &format!("is not narrower than the area to cover ({narrower} m across)"),
+            ));
+        }
+        let clearance = self.planner.safety_clearance_m;
+        if clearance < w / 2.0 {
+            return Err(bad(
+                "coverage.planner.safety_clearance_m".into(),
+                clearance.to_string(),
+                &format!(
+                    "is less than half the vehicle's width ({field} = {w}): the planner keeps this clearance from the centre line, so the vehicle's side would be over impassable ground"
+                ),
+            ));
+        }
+        Ok(())
+    }
+
+    /// The planner's work: its check and rollback steps at least [`limits::MIN_CHECK_STEP_M`],
+    /// the samples it checks along its rows (area / row spacing / step) within
+    /// [`limits::MAX_COVERAGE_CHECKS`], and its search budgets within
+    /// [`limits::MAX_SEARCH_EXPANSIONS`].
+    fn validate_work(&self, area: [f64; 4], bad: Bad) -> Result<(), ScenarioError> {
+        let p = &self.planner;
+        for (name, v) in [
+            ("check_step_m", p.check_step_m),
+            ("rollback_step_m", p.rollback_step_m),
+        ] {
+            if v < limits::MIN_CHECK_STEP_M {
+                return Err(bad(
+                    format!("coverage.planner.{name}"),
+                    v.to_string(),
+                    &format!(
+                        "is under the limit {} m (limits::MIN_CHECK_STEP_M)",
+                        limits::MIN_CHECK_STEP_M
+                    ),
+                ));
+            }
+        }
+        let path_m = (area[2] - area[0]) * (area[3] - area[1]) / p.row_spacing();
+        let checks = path_m / p.check_step_m;
+        if checks.is_nan() || checks > limits::MAX_COVERAGE_CHECKS {
+            return Err(bad(
+                "coverage.planner.check_step_m".into(),
+                p.check_step_m.to_string(),
+                &format!(
+                    "with rows {} m apart (2 × min_turn_radius_m) asks for {checks:.3e} checks along about {path_m:.0} m of rows, over the limit {:e} (limits::MAX_COVERAGE_CHECKS)",
+                    p.row_spacing(),
+                    limits::MAX_COVERAGE_CHECKS
+                ),
+            ));
+        }
+        for (name, v) in [
+            ("transit_expansions", p.transit_expansions),
+            ("transit_budget", p.transit_budget),
+        ] {
+            if v > limits::MAX_SEARCH_EXPANSIONS {
+                let field = format!("coverage.planner.{name}");
+                let bound = limits::MAX_SEARCH_EXPANSIONS;
+                return Err(over(bad, &field, v, bound, "MAX_SEARCH_EXPANSIONS"));
+            }
         }
         Ok(())
     }

@@ -5,7 +5,9 @@
 
 use serde::{Deserialize, Serialize};
 
+use super::sizes::over;
 use super::{Bad, ObstacleKind, Scenario, ScenarioError, VehicleKind};
+use crate::limits;
 
 /// How the first inspection point of each cage is placed (the second mirrors it).
 #[derive(Debug, Clone, Copy, Serialize, Deserialize, PartialEq, Eq, Default)]
@@ -118,6 +120,37 @@ impl InspectionSettings {
             if v == 0 {
                 return Err(bad(name.into(), v.to_string(), "must be at least 1"));
             }
+        }
+        let (n, i) = (self.order_particles, self.order_iterations);
+        if n > limits::MAX_PARTICLES {
+            let name = "MAX_PARTICLES";
+            return Err(over(
+                bad,
+                "inspection.order_particles",
+                n,
+                limits::MAX_PARTICLES,
+                name,
+            ));
+        }
+        if i > limits::MAX_ITERATIONS {
+            let name = "MAX_ITERATIONS";
+            return Err(over(
+                bad,
+                "inspection.order_iterations",
+                i,
+                limits::MAX_ITERATIONS,
+                name,
+            ));
+        }
+        if (n as u128) * (i as u128) > limits::MAX_EVALUATIONS {
+            return Err(bad(
+                "inspection.order_iterations".into(),
+                i.to_string(),
+                &format!(
+                    "with {n} order_particles is over the limit {} evaluations (limits::MAX_EVALUATIONS)",
+                    limits::MAX_EVALUATIONS
+                ),
+            ));
         }
         for (i, v) in scenario.vehicles.iter().enumerate() {
             if v.kind != VehicleKind::Auv {

@@ -16,6 +16,7 @@ mod inspection;
 mod ocean;
 mod optimizer;
 mod seabed;
+mod sizes;
 mod validate;
 pub use coverage::CoverageSettings;
 pub use files::{DataDir, FileRefusal, FILE_FIELDS, OUTSIDE_DATA_DIR};
@@ -66,6 +67,50 @@ fn invalid_in(file: &Path) -> impl Fn(String, String, &str) -> ScenarioError + '
         value,
         reason: reason.to_string(),
     }
+}
+
+/// The text of the file at `path`, refused with [`std::io::ErrorKind::FileTooLarge`] past
+/// `limit` bytes (read through a `take`, so a device or a pipe without end stops there too).
+pub fn read_at_most(path: &Path, limit: u64) -> std::io::Result<String> {
+    use std::io::Read;
+    let mut bytes = Vec::new();
+    std::fs::File::open(path)?
+        .take(limit + 1)
+        .read_to_end(&mut bytes)?;
+    if bytes.len() as u64 > limit {
+        return Err(std::io::Error::new(
+            std::io::ErrorKind::FileTooLarge,
+            format!("larger than the limit of {limit} bytes"),
+        ));
+    }
+    String::from_utf8(bytes)
+        .map_err(|e| std::io::Error::new(std::io::ErrorKind::InvalidData, e.utf8_error()))
+}
+
+/// A data file a scenario names (`field`): a regular file of at most
+/// [`crate::limits::MAX_DATA_FILE_BYTES`]. A device such as `/dev/zero`, a pipe or a directory
+/// is refused before anything reads it.
+fn check_data_file(path: &Path, field: &str, bad: Bad) -> Result<(), ScenarioError> {
+    let shown = format!("{:?}", path.display().to_string());
+    let meta = match std::fs::metadata(path) {
+        Ok(m) => m,
+        Err(e) => return Err(bad(field.into(), shown, &format!("cannot be read: {e}"))),
+    };
+    if !meta.is_file() {
+        return Err(bad(field.into(), shown, "is not a regular file"));
+    }
+    let limit = crate::limits::MAX_DATA_FILE_BYTES;
+    if meta.len() > limit {
+        return Err(bad(
+            field.into(),
+            shown,
+            &format!(
+                "is {} bytes, over the limit {limit} (limits::MAX_DATA_FILE_BYTES)",
+                meta.len()
+            ),
+        ));
+    }
+    Ok(())
 }
 
 /// A whole mission: where, what is in the way, who goes where, and how to optimise.
@@ -218,12 +263,15 @@ pub struct Fleet {
 }
 
 impl Scenario {
-    /// Reads, parses and validates a scenario file.
+    /// Reads, parses and validates a scenario file. At most
+    /// [`crate::limits::MAX_SCENARIO_BYTES`] are read: a larger file (or `/dev/zero`) is refused
+    /// before it fills the memory.
     pub fn load(path: &Path) -> Result<Scenario, ScenarioError> {
-        let text = std::fs::read_to_string(path).map_err(|error| ScenarioError::Io {
+        let io = |error| ScenarioError::Io {
             file: path.to_path_buf(),
             error,
-        })?;
+        };
+        let text = read_at_most(path, crate::limits::MAX_SCENARIO_BYTES).map_err(io)?;
         Scenario::parse(&text, path)
     }
 
@@ -254,6 +302,17 @@ impl Scenario {
         }
         if let Some(currents) = &mut scenario.currents {
             currents.resolve(file.parent().unwrap_or(Path::new(".")), file, &bad)?;
+        }
+        if let Some(heightmap) = scenario
+            .coverage
+            .as_ref()
+            .and_then(|c| c.heightmap.as_ref())
+        {
+            // Read when the map is built; a file that is there now must be one to read.
+            let path = file.parent().unwrap_or(Path::new(".")).join(heightmap);
+            if path.exists() {
+                check_data_file(&path, "coverage.heightmap", &bad)?;
+            }
         }
         Ok(scenario)
     }

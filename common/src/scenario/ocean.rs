@@ -6,10 +6,12 @@ use std::sync::Arc;
 
 use serde::{Deserialize, Serialize};
 
+use super::sizes::{in_range, over};
 use super::{Bad, ScenarioError};
 use crate::current::{CurrentField, DepthDecayCurrent, StillWater};
 use crate::current_grid::GridCurrent;
 use crate::energy::Weights;
+use crate::limits;
 
 /// Which current model a scenario uses.
 #[derive(Debug, Clone, Copy, Serialize, Deserialize, PartialEq, Eq, Default)]
@@ -105,11 +107,15 @@ impl Currents {
                         "model = \"depth-decay\" needs the surface current [u, v] in m/s",
                     ));
                 };
-                if !surface.iter().all(|v| v.is_finite()) {
+                let speed = surface[0].hypot(surface[1]);
+                if !(speed.is_finite() && speed <= limits::MAX_CURRENT_MPS) {
                     return Err(bad(
                         "currents.surface_velocity_mps".into(),
                         format!("{surface:?}"),
-                        "must be finite m/s",
+                        &format!(
+                            "must be finite, at most {} m/s in all (limits::MAX_CURRENT_MPS)",
+                            limits::MAX_CURRENT_MPS
+                        ),
                     ));
                 }
             }
@@ -153,8 +159,17 @@ impl Currents {
         if !path.is_absolute() {
             *path = dir.join(&*path);
         }
+        super::check_data_file(path, "currents.file", bad)?;
         let grid = GridCurrent::load(path)
             .map_err(|e| bad("currents.file".into(), written, &e.to_string()))?;
+        let nodes = grid
+            .axes()
+            .iter()
+            .fold(1usize, |n, a| n.saturating_mul(a.count));
+        if nodes > limits::MAX_MAP_CELLS {
+            let bound = limits::MAX_MAP_CELLS;
+            return Err(over(bad, "currents.file", nodes, bound, "MAX_MAP_CELLS"));
+        }
         self.grid = Some(Arc::new(grid));
         Ok(())
     }
@@ -232,13 +247,8 @@ impl EnergySettings {
             ));
         }
         if let Some(v) = self.ground_speed_mps {
-            if !(v.is_finite() && v > 0.0) {
-                return Err(bad(
-                    "energy.ground_speed_mps".into(),
-                    v.to_string(),
-                    "must be a positive speed in m/s",
-                ));
-            }
+            let unit = "m/s (limits::SPEED_MPS)";
+            in_range(bad, "energy.ground_speed_mps", v, limits::SPEED_MPS, unit)?;
         }
         if !(1..=64).contains(&self.control_points) {
             return Err(bad(
@@ -247,11 +257,14 @@ impl EnergySettings {
                 "must be between 1 and 64",
             ));
         }
-        if !(3..=100_000).contains(&self.path_points) {
+        if !(3..=limits::MAX_PATH_SAMPLES).contains(&self.path_points) {
             return Err(bad(
                 "energy.path_points".into(),
                 self.path_points.to_string(),
-                "must be between 3 and 100000",
+                &format!(
+                    "must be between 3 and {} (limits::MAX_PATH_SAMPLES)",
+                    limits::MAX_PATH_SAMPLES
+                ),
             ));
         }
         for (name, values) in [

@@ -3,7 +3,9 @@
 
 use serde::{Deserialize, Serialize};
 
+use super::sizes::over;
 use super::{Bad, ScenarioError};
+use crate::limits::{MAX_ITERATIONS, MAX_PARTICLES, MAX_POPULATIONS, MAX_THREADS, MAX_WAYPOINTS};
 
 /// The optimizers `plan` can run.
 #[derive(Debug, Clone, Copy, Serialize, Deserialize, PartialEq, Eq, Default)]
@@ -238,6 +240,68 @@ impl OptimizerSettings {
         for (field, value) in positive {
             if value == 0 {
                 return Err(bad(field.into(), "0".into(), "must be at least 1"));
+            }
+        }
+        let bounded = [
+            (
+                "optimizer.populations",
+                o.populations,
+                MAX_POPULATIONS,
+                "MAX_POPULATIONS",
+            ),
+            (
+                "optimizer.particles",
+                o.particles,
+                MAX_PARTICLES,
+                "MAX_PARTICLES",
+            ),
+            (
+                "optimizer.leader_particles",
+                o.leader_particles,
+                MAX_PARTICLES,
+                "MAX_PARTICLES",
+            ),
+            (
+                "optimizer.iterations",
+                o.iterations,
+                MAX_ITERATIONS,
+                "MAX_ITERATIONS",
+            ),
+            (
+                "optimizer.waypoints",
+                o.waypoints,
+                MAX_WAYPOINTS,
+                "MAX_WAYPOINTS",
+            ),
+            (
+                "optimizer.exchange_every",
+                o.exchange_every,
+                MAX_ITERATIONS,
+                "MAX_ITERATIONS",
+            ),
+            ("optimizer.threads", o.threads, MAX_THREADS, "MAX_THREADS"),
+            (
+                "optimizer.distributed.agent_populations",
+                o.distributed.agent_populations,
+                MAX_POPULATIONS,
+                "MAX_POPULATIONS",
+            ),
+            (
+                "optimizer.distributed.exchange_every",
+                o.distributed.exchange_every,
+                MAX_ITERATIONS,
+                "MAX_ITERATIONS",
+            ),
+            (
+                "optimizer.distributed.context_every",
+                o.distributed.context_every,
+                MAX_ITERATIONS,
+                "MAX_ITERATIONS",
+            ),
+        ];
+        for (field, value, bound, name) in bounded {
+            if value > bound {
+                return Err(over(bad, field, value, bound, name));
             }
         }
         if let Some(k) = o.weights.iter().position(|w| !(w.is_finite() && *w >= 0.0)) {

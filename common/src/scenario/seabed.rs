@@ -5,7 +5,9 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
+use super::sizes::over;
 use super::{Bad, ScenarioError};
+use crate::limits;
 use crate::terrain::{BaseRelief, HeightGrid, Mountain, Terrain};
 
 /// The seabed: the analytic model of eq. (2) + (3), or a measured height grid from a file.
@@ -182,7 +184,13 @@ impl Seabed {
                 if !g.file.is_absolute() {
                     g.file = dir.join(&g.file);
                 }
+                super::check_data_file(&g.file, "seabed.grid.file", bad)?;
                 let grid = load_grid(g, file, bad)?;
+                let cells = grid.rows.saturating_mul(grid.cols);
+                if cells > limits::MAX_MAP_CELLS {
+                    let bound = limits::MAX_MAP_CELLS;
+                    return Err(over(bad, "seabed.grid.file", cells, bound, "MAX_MAP_CELLS"));
+                }
                 covers(&grid, area, &g.file, bad)?;
                 Terrain::Grid(grid)
             }
@@ -299,6 +307,10 @@ impl CrawlerSettings {
                 self.samples.to_string(),
                 "must be at least 4",
             ));
+        }
+        if self.samples > limits::MAX_PATH_SAMPLES {
+            let (n, bound) = (self.samples, limits::MAX_PATH_SAMPLES);
+            return Err(over(bad, "crawler.samples", n, bound, "MAX_PATH_SAMPLES"));
         }
         if !(self.mining_share >= 0.0 && self.mining_share < 1.0) {
             return Err(bad(

@@ -327,3 +327,118 @@ fn the_shipped_amp_pso_scenarios_are_seed_004_tables_2_to_4() -> Result<(), Scen
     }
     Ok(())
 }
+
+/// The message of a scenario that must not parse (empty when it parses).
+fn refusal(text: &str) -> String {
+    parse(text).err().map(|e| e.to_string()).unwrap_or_default()
+}
+
+#[test]
+fn a_billion_particles_is_refused_naming_file_field_value_and_limit() {
+    let text = GOOD.to_string() + "[optimizer]\nparticles = 1000000000\n";
+    assert_eq!(
+        refusal(&text),
+        "scenarios/x.toml: field `optimizer.particles` = 1000000000: is over the limit 10000 (limits::MAX_PARTICLES)"
+    );
+    for (line, field) in [
+        ("populations = 257", "optimizer.populations"),
+        ("iterations = 1000000000000", "optimizer.iterations"),
+        ("waypoints = 1000000", "optimizer.waypoints"),
+        ("threads = 100000", "optimizer.threads"),
+    ] {
+        let msg = refusal(&format!("{GOOD}[optimizer]\n{line}\n"));
+        assert!(
+            msg.contains(field) && msg.contains("over the limit"),
+            "{msg}"
+        );
+    }
+}
+
+#[test]
+fn budgets_within_their_own_limits_are_refused_when_their_product_is_absurd() {
+    // One vehicle: 10,000 particles × 1,000,000 iterations = 10^10 evaluations, exactly the
+    // limit, with the single-population PSO; AMP-PSO's 20 populations and 20 leader particles
+    // make it (20 × 10,000 + 20) × 10^6 = 200,020,000,000.
+    let pso = format!(
+        "{GOOD}[optimizer]\nalgorithm = \"pso\"\nparticles = 10000\niterations = 1000000\n"
+    );
+    assert_eq!(refusal(&pso), "");
+    let amp = pso.replace("\"pso\"", "\"amp-pso\"");
+    let msg = refusal(&amp);
+    assert!(
+        msg.contains("optimizer.iterations")
+            && msg.contains("200020000000 vehicle evaluations")
+            && msg.contains("MAX_EVALUATIONS"),
+        "{msg}"
+    );
+}
+
+#[test]
+fn speeds_outside_what_a_vehicle_can_do_are_refused() {
+    for (from, to) in [
+        ("speed_min_mps = 0.5", "speed_min_mps = 1e-300"),
+        ("speed_min_mps = 0.5", "speed_min_mps = 0.009"),
+        ("speed_max_mps = 1.5", "speed_max_mps = 20.5"),
+        ("speed_max_mps = 1.5", "speed_max_mps = 1e300"),
+    ] {
+        let msg = refusal(&GOOD.replace(from, to));
+        assert!(msg.contains("[0.01, 20] m/s"), "{to}: {msg}");
+    }
+    // The bounds themselves are speeds a vehicle may have.
+    let edge = GOOD
+        .replace("speed_min_mps = 0.5", "speed_min_mps = 0.01")
+        .replace("speed_max_mps = 1.5", "speed_max_mps = 20.0");
+    assert_eq!(refusal(&edge), "");
+}
+
+#[test]
+fn an_obstacle_or_a_separation_larger_than_the_box_is_refused() {
+    // The 100 m cube's diagonal is 173.2 m.
+    let msg = refusal(&GOOD.replace("radius_m = 10.0", "radius_m = 1e300"));
+    assert!(
+        msg.contains("obstacles[0].radius_m") && msg.contains("diagonal 173.2 m"),
+        "{msg}"
+    );
+    let msg = refusal(&GOOD.replace("d_min_m = 5.0", "d_min_m = 174.0"));
+    assert!(msg.contains("fleet.d_min_m"), "{msg}");
+    assert_eq!(
+        refusal(&GOOD.replace("d_min_m = 5.0", "d_min_m = 173.0")),
+        ""
+    );
+    let msg = refusal(&GOOD.replace("mission_time_s = 200.0", "mission_time_s = 1e12"));
+    assert!(msg.contains("fleet.mission_time_s") && msg.contains("MAX_MISSION_TIME_S"));
+}
+
+#[test]
+fn a_scenario_file_over_the_size_limit_or_without_end_is_refused_when_read(
+) -> Result<(), Box<dyn std::error::Error>> {
+    let dir = tempfile::tempdir()?;
+    let big = dir.path().join("big.toml");
+    let limit = crate::limits::MAX_SCENARIO_BYTES as usize;
+    // GOOD padded with a comment to one byte over the limit.
+    let padding = limit + 1 - GOOD.len() - 2;
+    std::fs::write(&big, format!("{GOOD}#{}\n", "x".repeat(padding)))?;
+    let msg = Scenario::load(&big)
+        .err()
+        .map(|e| e.to_string())
+        .unwrap_or_default();
+    assert!(
+        msg.contains("big.toml") && msg.contains(&format!("limit of {limit} bytes")),
+        "{msg}"
+    );
+    // One byte less is read (and is the good scenario).
+    std::fs::write(&big, format!("{GOOD}#{}\n", "x".repeat(padding - 1)))?;
+    assert!(Scenario::load(&big).is_ok());
+    let zero = Path::new("/dev/zero");
+    if zero.exists() {
+        let msg = Scenario::load(zero)
+            .err()
+            .map(|e| e.to_string())
+            .unwrap_or_default();
+        assert!(
+            msg.contains("/dev/zero") && msg.contains("limit of"),
+            "{msg}"
+        );
+    }
+    Ok(())
+}

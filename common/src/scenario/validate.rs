@@ -23,6 +23,7 @@ impl Scenario {
                 ));
             }
         }
+        self.validate_counts(&bad)?;
         let inside =
             |p: &[f64; 3]| (0..3).all(|a| p[a] >= self.bounds.min[a] && p[a] <= self.bounds.max[a]);
         for (i, o) in self.obstacles.iter().enumerate() {
@@ -48,6 +49,7 @@ impl Scenario {
                 ));
             }
         }
+        self.validate_extent(&bad)?;
         if self.vehicles.is_empty() {
             return Err(bad(
                 "vehicles".into(),
@@ -161,7 +163,9 @@ impl Scenario {
                 "must be a positive number of seconds",
             ));
         }
+        self.validate_physical(&bad)?;
         self.optimizer.validate(&bad)?;
+        self.validate_work(&bad)?;
         self.validate_crawlers(&bad)?;
         self.energy.validate(self.currents.as_ref(), &bad)?;
         let algorithm = self.optimizer.algorithm;
@@ -169,7 +173,8 @@ impl Scenario {
             inspection.validate(self, &bad)?;
         }
         if let Some(coverage) = &self.coverage {
-            coverage.validate(&bad)?;
+            let b = &self.bounds;
+            coverage.validate([b.min[0], b.min[1], b.max[0], b.max[1]], &bad)?;
         }
         if algorithm.is_tour_planner() && self.inspection.is_none() {
             return Err(bad(

@@ -144,7 +144,7 @@ pub fn plan_distributed(
     session.close();
     let (run, figures) = outcome?;
     let model = FleetModel::new(scenario);
-    let mut plan = to_plan(scenario, &model, run, "distributed");
+    let mut plan = to_plan(scenario, &model, run, "distributed", Some(stop));
     for d in &figures.degraded {
         plan.notices.push(format!(
             "{} was planned in degraded mode by the coordinator from exchange round {}: {}",

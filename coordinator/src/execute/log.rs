@@ -6,11 +6,12 @@
 //! order they happened, and `{"record": "end", …}` with the figures last.
 
 use std::fs::File;
-use std::io::{BufRead, BufReader, BufWriter, Write};
+use std::io::{BufRead, BufReader, BufWriter, Read, Write};
 use std::path::{Path, PathBuf};
 
 use anyhow::Context as _;
 use serde::{Deserialize, Serialize};
+use shoal_common::limits::MAX_LOG_LINE_BYTES;
 use shoal_common::scenario::Obstacle;
 use shoal_common::wire::open::{MissionEvent, PlanNotice, Telemetry};
 
@@ -122,25 +123,47 @@ pub struct Log {
 /// a last line without its newline that is not a whole record is left out instead (and named
 /// in [`Log::cut_short`]): that is what a run killed mid-write leaves, and the records before
 /// it still tell the mission.
+///
+/// A line longer than [`MAX_LOG_LINE_BYTES`] is an error too, found before more of it is read:
+/// no mission writes one, and a file without newlines (`/dev/zero`) would otherwise fill the
+/// memory.
 pub fn read(path: &Path) -> anyhow::Result<Log> {
+    read_with_line_limit(path, MAX_LOG_LINE_BYTES)
+}
+
+/// [`read`] with lines of at most `max_line` bytes.
+fn read_with_line_limit(path: &Path, max_line: usize) -> anyhow::Result<Log> {
     let file = File::open(path)
         .with_context(|| format!("cannot open the mission log {}", path.display()))?;
     let mut reader = BufReader::new(file);
     let mut records = Vec::new();
     let mut cut_short = None;
-    let mut line = String::new();
+    let mut bytes = Vec::new();
     for n in 1.. {
-        line.clear();
-        let read = reader
-            .read_line(&mut line)
+        bytes.clear();
+        let read = (&mut reader)
+            .take(max_line as u64 + 1)
+            .read_until(b'\n', &mut bytes)
             .with_context(|| format!("{}: cannot read line {n}", path.display()))?;
         if read == 0 {
             break;
         }
+        if bytes.len() > max_line {
+            anyhow::bail!(
+                "{} line {n}: longer than the limit of {max_line} bytes (limits::MAX_LOG_LINE_BYTES): not a mission log",
+                path.display()
+            );
+        }
+        let Ok(line) = std::str::from_utf8(&bytes) else {
+            anyhow::bail!(
+                "{} line {n}: not UTF-8 text: not a mission log",
+                path.display()
+            );
+        };
         if line.trim().is_empty() {
             continue;
         }
-        match serde_json::from_str::<Record>(&line) {
+        match serde_json::from_str::<Record>(line) {
             Ok(r) => records.push(r),
             Err(_) if !line.ends_with('\n') => cut_short = Some(n),
             Err(e) => anyhow::bail!("{} line {n}: not a mission-log record: {e}", path.display()),
@@ -207,6 +230,19 @@ mod tests {
         std::fs::write(&path, format!("{text}{{\"record\": \"nonsense\"}}\n"))?;
         let e = read(&path).err().map(|e| e.to_string()).unwrap_or_default();
         assert!(e.contains("line 3") && e.contains("m.ndjson"), "{e}");
+        // A line over the limit is named with its number before the rest of it is read.
+        let limit = text.lines().map(str::len).max().unwrap_or(0) + 1;
+        std::fs::write(&path, &text)?;
+        assert!(read_with_line_limit(&path, limit).is_ok());
+        std::fs::write(&path, format!("{text}{}\n", "x".repeat(limit + 1)))?;
+        let e = read_with_line_limit(&path, limit)
+            .err()
+            .map(|e| e.to_string())
+            .unwrap_or_default();
+        assert!(
+            e.contains("m.ndjson line 3") && e.contains(&format!("limit of {limit} bytes")),
+            "{e}"
+        );
         std::fs::write(&path, text.lines().nth(1).unwrap_or(""))?;
         let e = read(&path).err().map(|e| e.to_string()).unwrap_or_default();
         assert!(e.contains("starts with a \"start\" record"), "{e}");
