@@ -20,6 +20,20 @@ fn deadline(s: u64) -> Instant {
     Instant::now() + Duration::from_secs(s)
 }
 
+/// The Python interpreter, a fleet with scenario 2's keys in `<dir>/keys`, and a free TLS
+/// endpoint; `None` (after saying SKIPPED) without a Python that has eclipse-zenoh.
+fn secured_setup() -> Option<(String, Fleet, std::path::PathBuf, String)> {
+    let Some(py) = interop_python() else {
+        eprintln!("SKIPPED: no Python with eclipse-zenoh (set SHOAL_INTEROP_PYTHON; .ci/run does)");
+        return None;
+    };
+    let mut fleet = Fleet::new();
+    let keys = fleet.dir().join("keys");
+    make_keys(&mut fleet, &keys);
+    let endpoint = format!("tls/127.0.0.1:{}", free_port());
+    Some((py, fleet, keys, endpoint))
+}
+
 /// `keys` for scenario 2's vehicles and one operator, into `dir`.
 fn make_keys(fleet: &mut Fleet, dir: &Path) {
     let mut cmd = Command::new(coordinator());
@@ -57,14 +71,9 @@ fn python_client(py: &str, endpoint: &str, keys: &Path, mission: &str) -> Comman
 
 #[test]
 fn strangers_and_a_vehicle_forging_for_another_are_kept_out_and_the_mission_is_met() -> TestResult {
-    let Some(py) = interop_python() else {
-        eprintln!("SKIPPED: no Python with eclipse-zenoh (set SHOAL_INTEROP_PYTHON; .ci/run does)");
+    let Some((py, mut fleet, keys, endpoint)) = secured_setup() else {
         return Ok(());
     };
-    let mut fleet = Fleet::new();
-    let keys = fleet.dir().join("keys");
-    make_keys(&mut fleet, &keys);
-    let endpoint = format!("tls/127.0.0.1:{}", free_port());
     let out = fleet.dir().join("out");
     let mut run = coordinator_cmd(&keys, &["run"]);
     run.arg(scenario("amp-pso-2"))
@@ -111,14 +120,9 @@ fn strangers_and_a_vehicle_forging_for_another_are_kept_out_and_the_mission_is_m
 
 #[test]
 fn an_operator_submits_to_a_secured_serve_and_a_vehicle_cannot() -> TestResult {
-    let Some(py) = interop_python() else {
-        eprintln!("SKIPPED: no Python with eclipse-zenoh (set SHOAL_INTEROP_PYTHON; .ci/run does)");
+    let Some((py, mut fleet, keys, endpoint)) = secured_setup() else {
         return Ok(());
     };
-    let mut fleet = Fleet::new();
-    let keys = fleet.dir().join("keys");
-    make_keys(&mut fleet, &keys);
-    let endpoint = format!("tls/127.0.0.1:{}", free_port());
     let missions = fleet.dir().join("missions");
     let mut serve = coordinator_cmd(&keys, &["serve", "--missions", "1"]);
     serve.args(["--listen", &endpoint, "--out"]).arg(&missions);

@@ -18,22 +18,11 @@ use std::time::{Duration, Instant};
 
 use common::fleet::{endpoint, free_port};
 use common::process::{coordinator, root};
-use common::{scenario, without_shoal_env, TestResult};
+use common::{interop_python as python, scenario, without_shoal_env, TestResult};
 
 /// Largest resident set `serve` may reach while it is attacked (it idles at tens of MB; a
 /// submission reading /dev/zero took it to 4.2 GB).
 const MAX_RSS_KB: u64 = 1 << 20;
-
-fn python() -> Option<String> {
-    if let Ok(p) = std::env::var("SHOAL_INTEROP_PYTHON") {
-        return Some(p);
-    }
-    let ok = Command::new("python3")
-        .args(["-c", "import zenoh"])
-        .output()
-        .is_ok_and(|o| o.status.success());
-    ok.then(|| "python3".to_string())
-}
 
 /// A child killed on drop, whose stderr file is printed if the test fails.
 struct Guard {

@@ -13,7 +13,7 @@ use std::path::{Path, PathBuf};
 
 use zenoh::Config;
 
-use super::session::SessionError;
+use super::session::{set, SessionError};
 
 /// Largest Zenoh configuration file read (a generated one with a 100-vehicle ACL is ~60 kB).
 pub const MAX_CONFIG_FILE_BYTES: u64 = 1 << 20;
@@ -241,16 +241,6 @@ fn json(s: &str) -> String {
 
 fn set_path(config: &mut Config, key: &'static str, path: &Path) -> Result<(), SessionError> {
     set(config, key, &json(&path.to_string_lossy()))
-}
-
-fn set(config: &mut Config, key: &'static str, value: &str) -> Result<(), SessionError> {
-    config
-        .insert_json5(key, value)
-        .map_err(|e| SessionError::Setting {
-            key,
-            value: value.to_string(),
-            reason: e.to_string(),
-        })
 }
 
 #[cfg(test)]

@@ -145,7 +145,7 @@ fn base(mode: &str, security: &Security) -> Result<Config, SessionError> {
     Ok(config)
 }
 
-fn set(config: &mut Config, key: &'static str, value: &str) -> Result<(), SessionError> {
+pub(super) fn set(config: &mut Config, key: &'static str, value: &str) -> Result<(), SessionError> {
     config
         .insert_json5(key, value)
         .map_err(|e| SessionError::Setting {
