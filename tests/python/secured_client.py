@@ -138,9 +138,13 @@ def main() -> int:
         f"shoal/{m}/fleet": b"\x05\x00forged-context",
         f"shoal/{m}/obstacles": obstacle("forged-by-auv1", [0.0, 0.0, 0.0], 1e300),
     }
+    # On its own key the router lets it through: the coordinator must see that the report
+    # names another vehicle and drop it.
+    own_key_for_auv2 = telemetry(m, "auv2", [1900.0, 0.0, -50.0], 7)
     for _ in range(10):
         for key, payload in forged.items():
             vehicle.put(key, payload)
+        vehicle.put(f"shoal/{m}/telemetry/auv1", own_key_for_auv2)
         time.sleep(0.1)
     summary["vehicle_submit_replies"] = len(
         replies(vehicle, "shoal/submit", b'{"version":1}'))

@@ -110,6 +110,9 @@ fn strangers_and_a_vehicle_forging_for_another_are_kept_out_and_the_mission_is_m
         assert!(fleet.running(a), "an agent died:\n{}", fleet.stderr(a));
     }
     let report = common::read_json(&out.join("execution.json"))?;
+    // auv1's ten reports naming auv2 on auv1's own key (which access control allows).
+    let dropped = report["dropped"].as_u64().unwrap_or(0);
+    assert!(dropped >= 10, "dropped {dropped}: {report}");
     let min = report["figures"]["min_separation_m"]
         .as_f64()
         .unwrap_or(0.0);

@@ -78,7 +78,8 @@ pub struct ExecOptions {
 
 /// Raw input from the open-interface subscriptions (callbacks do no work themselves).
 enum Open {
-    Telemetry(Vec<u8>, u64),
+    /// Key, payload, receipt time (unix µs).
+    Telemetry(String, Vec<u8>, u64),
     /// An obstacle and when it came (the rate limit counts arrivals, not the loop's pace).
     Obstacle(Vec<u8>, Instant),
 }
@@ -256,6 +257,7 @@ pub fn execute_trajectories(
         .declare_subscriber(tel_key.as_str())
         .callback(move |s| {
             let _ = tx_t.send(Open::Telemetry(
+                s.key_expr().as_str().to_string(),
                 s.payload().to_bytes().into_owned(),
                 unix_us(),
             ));
@@ -408,7 +410,9 @@ fn run_loop(
             }
         }
         match rx.recv_timeout(Duration::from_millis(20)) {
-            Ok(Open::Telemetry(bytes, received)) => react::telemetry(x, &bytes, received),
+            Ok(Open::Telemetry(key, bytes, received)) => {
+                react::telemetry(x, &key, &bytes, received)
+            }
             Ok(Open::Obstacle(bytes, arrived)) => react::obstacle_bytes(x, &bytes, arrived),
             Err(RecvTimeoutError::Timeout) => {}
             Err(RecvTimeoutError::Disconnected) => return "the network closed".into(),

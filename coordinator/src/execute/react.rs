@@ -16,6 +16,7 @@ use shoal_common::limits;
 use shoal_common::scenario::{Obstacle, ObstacleKind};
 use shoal_common::wire::codec;
 use shoal_common::wire::open::{FleetStatus, Telemetry, OPEN_VERSION};
+use shoal_common::wire::topics;
 
 use super::lead::{conflict_horizon_s, hold_retry_after};
 use super::log::{Record, EVENT_FAULT, EVENT_IMPLAUSIBLE, EVENT_LOST, EVENT_OBSTACLE_DROPPED};
@@ -28,7 +29,10 @@ use super::Exec;
 const COOL_DOWN: Duration = Duration::from_secs(2);
 
 /// A report from the telemetry key.
-pub(super) fn telemetry(x: &mut Exec, bytes: &[u8], received_us: u64) {
+///
+/// The key's vehicle must be the report's: access control lets a vehicle publish only on its
+/// own key, so a report there naming another vehicle is a forgery, dropped and counted.
+pub(super) fn telemetry(x: &mut Exec, key: &str, bytes: &[u8], received_us: u64) {
     let t: Telemetry = match codec::decode_json(bytes) {
         Ok(t) => t,
         Err(e) => return drop_message(x, &format!("telemetry: {e}")),
@@ -40,6 +44,12 @@ pub(super) fn telemetry(x: &mut Exec, bytes: &[u8], received_us: u64) {
                 "telemetry of version {} for mission {:?}",
                 t.version, t.mission
             ),
+        );
+    }
+    if topics::vehicle_of_telemetry(key) != Some(t.vehicle.as_str()) {
+        return drop_message(
+            x,
+            &format!("telemetry on {key} names vehicle {:?}", t.vehicle),
         );
     }
     let Some(i) = x.fleet.index(&t.vehicle) else {
