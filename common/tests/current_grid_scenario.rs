@@ -82,8 +82,8 @@ fn a_missing_or_bad_grid_file_is_an_error_naming_currents_file() -> TestResult {
     assert!(
         msg.contains("s.toml")
             && msg.contains("currents.file")
-            && msg.contains("\"nowhere.csv\"")
-            && msg.contains("cannot read"),
+            && msg.contains("nowhere.csv\"")
+            && msg.contains("cannot be read"),
         "{msg}"
     );
     // A bad value in the grid is named with the grid's line.
