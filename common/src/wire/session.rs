@@ -427,4 +427,45 @@ mod tests {
         within("router close", router.close()).await??;
         Ok(())
     }
+
+    #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+    async fn with_a_user_dictionary_only_listed_users_with_their_password_connect() -> TestResult {
+        use crate::wire::security::UserPassword;
+        let dir = tempfile::tempdir()?;
+        let users = dir.path().join("users.txt");
+        std::fs::write(&users, "auv1:right-password\n")?;
+        let endpoint = free_endpoint()?;
+        let router = Security {
+            users_file: Some(users),
+            ..Security::default()
+        };
+        let router = router_config(from_ref(&endpoint), &[], &router)?;
+        let router = open("router open", router).await?;
+        let as_user = |user: &str, password: &str| Security {
+            user: Some(UserPassword {
+                user: user.into(),
+                password: password.into(),
+            }),
+            ..Security::default()
+        };
+        let listed = as_user("auv1", "right-password");
+        let client = client_config(from_ref(&endpoint), false, &listed)?;
+        let client = open("listed user", client).await?;
+        within("client close", client.close()).await??;
+        for (user, password) in [("auv1", "wrong"), ("auv9", "right-password")] {
+            let config = client_config(from_ref(&endpoint), false, &as_user(user, password))?;
+            let refused = open("unlisted user", config).await;
+            assert!(refused.is_err(), "{user}/{password} connected");
+        }
+        let anonymous = open(
+            "anonymous",
+            client_config(from_ref(&endpoint), false, &plain())?,
+        );
+        assert!(
+            anonymous.await.is_err(),
+            "a client without a password connected"
+        );
+        within("router close", router.close()).await??;
+        Ok(())
+    }
 }
