@@ -112,3 +112,21 @@ pub const MAX_VEHICLE_WIDTH_M: f64 = 50.0;
 /// Hybrid A* expansions of one coverage plan (`coverage.planner.transit_budget`, and each
 /// transit's `transit_expansions`): the default 300,000 is about a second; 10^8 is minutes.
 pub const MAX_SEARCH_EXPANSIONS: usize = 100_000_000;
+
+/// The text of the file at `path`, refused with [`std::io::ErrorKind::FileTooLarge`] past
+/// `limit` bytes (read through a `take`, so a device or a pipe without end stops there too).
+pub fn read_at_most(path: &std::path::Path, limit: u64) -> std::io::Result<String> {
+    use std::io::Read;
+    let mut bytes = Vec::new();
+    std::fs::File::open(path)?
+        .take(limit + 1)
+        .read_to_end(&mut bytes)?;
+    if bytes.len() as u64 > limit {
+        return Err(std::io::Error::new(
+            std::io::ErrorKind::FileTooLarge,
+            format!("larger than the limit of {limit} bytes"),
+        ));
+    }
+    String::from_utf8(bytes)
+        .map_err(|e| std::io::Error::new(std::io::ErrorKind::InvalidData, e.utf8_error()))
+}

@@ -69,24 +69,6 @@ fn invalid_in(file: &Path) -> impl Fn(String, String, &str) -> ScenarioError + '
     }
 }
 
-/// The text of the file at `path`, refused with [`std::io::ErrorKind::FileTooLarge`] past
-/// `limit` bytes (read through a `take`, so a device or a pipe without end stops there too).
-pub fn read_at_most(path: &Path, limit: u64) -> std::io::Result<String> {
-    use std::io::Read;
-    let mut bytes = Vec::new();
-    std::fs::File::open(path)?
-        .take(limit + 1)
-        .read_to_end(&mut bytes)?;
-    if bytes.len() as u64 > limit {
-        return Err(std::io::Error::new(
-            std::io::ErrorKind::FileTooLarge,
-            format!("larger than the limit of {limit} bytes"),
-        ));
-    }
-    String::from_utf8(bytes)
-        .map_err(|e| std::io::Error::new(std::io::ErrorKind::InvalidData, e.utf8_error()))
-}
-
 /// A data file a scenario names (`field`): a regular file of at most
 /// [`crate::limits::MAX_DATA_FILE_BYTES`]. A device such as `/dev/zero`, a pipe or a directory
 /// is refused before anything reads it.
@@ -271,7 +253,8 @@ impl Scenario {
             file: path.to_path_buf(),
             error,
         };
-        let text = read_at_most(path, crate::limits::MAX_SCENARIO_BYTES).map_err(io)?;
+        let text =
+            crate::limits::read_at_most(path, crate::limits::MAX_SCENARIO_BYTES).map_err(io)?;
         Scenario::parse(&text, path)
     }
 

@@ -1,7 +1,6 @@
 //! The Zenoh security flags every binary takes, declared once (as zenoh's examples share one
 //! `CommonArgs`) and flattened into each command that opens a session.
 
-use std::io::Read;
 use std::path::{Path, PathBuf};
 
 use super::security::{Security, TlsFiles, UserPassword};
@@ -104,16 +103,8 @@ fn read_password(path: &Path) -> Result<String, SessionError> {
         path: path.to_path_buf(),
         reason,
     };
-    let file = std::fs::File::open(path).map_err(|e| error(e.to_string()))?;
-    let mut text = String::new();
-    file.take(MAX_PASSWORD_BYTES + 1)
-        .read_to_string(&mut text)
-        .map_err(|e| error(e.to_string()))?;
-    if text.len() as u64 > MAX_PASSWORD_BYTES {
-        return Err(error(format!(
-            "a password file is at most {MAX_PASSWORD_BYTES} bytes"
-        )));
-    }
+    let text =
+        crate::limits::read_at_most(path, MAX_PASSWORD_BYTES).map_err(|e| error(e.to_string()))?;
     let password = text.trim_end_matches(['\n', '\r']).to_string();
     if password.is_empty() {
         return Err(error("the password file is empty".to_string()));

@@ -72,7 +72,8 @@ impl Security {
         let Some(path) = &self.config_file else {
             return Ok(Config::default());
         };
-        let text = read_bounded(path)?;
+        let text = crate::limits::read_at_most(path, MAX_CONFIG_FILE_BYTES)
+            .map_err(|e| config_file_error(path, &e.to_string()))?;
         Config::from_json5(&text).map_err(|e| config_file_error(path, &e.to_string()))
     }
 
@@ -209,23 +210,6 @@ pub(super) fn check_tls_ready(
             ),
         }),
     }
-}
-
-fn read_bounded(path: &Path) -> Result<String, SessionError> {
-    use std::io::Read;
-    let file = std::fs::File::open(path).map_err(|e| config_file_error(path, &e.to_string()))?;
-    let mut text = String::new();
-    let read = file
-        .take(MAX_CONFIG_FILE_BYTES + 1)
-        .read_to_string(&mut text)
-        .map_err(|e| config_file_error(path, &e.to_string()))?;
-    if read as u64 > MAX_CONFIG_FILE_BYTES {
-        return Err(config_file_error(
-            path,
-            &format!("larger than {MAX_CONFIG_FILE_BYTES} bytes"),
-        ));
-    }
-    Ok(text)
 }
 
 fn config_file_error(path: &Path, reason: &str) -> SessionError {
