@@ -1,4 +1,4 @@
-//! A reference shortest admissible crawler path by grid search (issue 5: the yardstick IPSO's
+//! A reference shortest admissible crawler path by grid search (the yardstick IPSO's
 //! smoothed length is measured against, and a planner baseline in its own right).
 //!
 //! Dijkstra on a square grid of `cell` metres over the area, with 32 move directions (every

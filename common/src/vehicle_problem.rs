@@ -1,5 +1,5 @@
 //! One vehicle's chromosome scored against the fixed, timed trajectories of the other vehicles:
-//! the problem a vehicle agent's follower populations solve in distributed AMP-PSO (issue 3),
+//! the problem a vehicle agent's follower populations solve in distributed AMP-PSO,
 //! where each agent optimises its own chromosome and the coordinator sends it the fleet's
 //! current best plan as context.
 //!

@@ -1,4 +1,4 @@
-//! The execution's reactions end to end (issue 8, item 3), on hand-built trajectories the
+//! The execution's reactions end to end, on hand-built trajectories the
 //! planner would never give, so each reaction is certain to be needed: two vehicles timed to
 //! meet head-on mid-mission (a predicted loss of separation), and a hairpin sharper than the
 //! simulated vehicle's turning radius (a deviation beyond the tolerance). The agents are

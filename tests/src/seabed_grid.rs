@@ -1,4 +1,4 @@
-//! The checker's own reading of a measured seabed (`[seabed.grid]`, issue 5): an ESRI ASCII grid
+//! The checker's own reading of a measured seabed (`[seabed.grid]`): an ESRI ASCII grid
 //! (`.asc`) or a CSV of heights (`.csv`), both written north row first, bilinear between the
 //! nodes and clamped to the edge outside them, as the README's scenario format describes. It
 //! shares no code with the planner's reader, so a misplaced node or a flipped row shows up as a

@@ -1,4 +1,4 @@
-//! Executing a plan end to end (issue 8): `shoal-coordinator run` plans scenario 2, one
+//! Executing a plan end to end: `shoal-coordinator run` plans scenario 2, one
 //! embedded agent per AUV drives a simulated vehicle along its trajectory at 100× real time, an
 //! obstacle published on auv2's path mid-mission makes the coordinator replan auv2, `status`
 //! reads the live picture over Zenoh, and `replay` recomputes the same figures from the log.

@@ -1,4 +1,4 @@
-//! One execution in an agent (issue 8): the vehicle drives its timed trajectory through its
+//! One execution in an agent: the vehicle drives its timed trajectory through its
 //! [`VehicleLink`], and the agent reports its state at the telemetry rate. Replans (`Update`),
 //! holds and the stop arrive on a channel; reports leave through a closure, so this loop knows
 //! nothing of Zenoh.

@@ -1,4 +1,4 @@
-//! Executing a plan (issue 8): what a vehicle reports while it drives its timed trajectory, a
+//! Executing a plan: what a vehicle reports while it drives its timed trajectory, a
 //! kinematic simulator of the vehicle kinds ([`sim`]), and the coordinator's live fleet picture
 //! computed from the latest reports and the plans ([`picture`]).
 //!

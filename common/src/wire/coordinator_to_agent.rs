@@ -47,7 +47,7 @@ pub enum CoordinatorToAgent {
         /// Why, in plain words.
         reason: String,
     },
-    /// Drive `vehicle` along its timed trajectory (issue 8); repeated until its telemetry comes.
+    /// Drive `vehicle` along its timed trajectory; repeated until its telemetry comes.
     /// Mission time `t` runs as `(unix_now − epoch) × time_scale`, so the whole fleet shares one
     /// clock (agents on other machines need synchronised clocks, e.g. NTP).
     Execute {

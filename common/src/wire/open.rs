@@ -1,4 +1,4 @@
-//! The open interface (issue 8): what Shoal publishes and accepts as JSON, so a Python
+//! The open interface: what Shoal publishes and accepts as JSON, so a Python
 //! `eclipse-zenoh` client or a ground-station bridge needs no Rust. Keys are built in
 //! [`super::topics`]; the JSON codec is [`super::codec::encode_json`] / [`super::codec::decode_json`].
 //!

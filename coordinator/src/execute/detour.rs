@@ -1,4 +1,4 @@
-//! A coarse way round for a replan's warm start (issue 8): when a new obstacle closes the
+//! A coarse way round for a replan's warm start: when a new obstacle closes the
 //! passage the current plan used, the plan's remainder — even with its waypoints pushed out of
 //! the obstacle — leaves the swarm stuck against it, and a 300 ms swarm does not find the long
 //! way round by itself. A* on a coarse 3-D grid over the scenario's bounds finds that way; the

@@ -1,4 +1,4 @@
-//! Executing a plan (`shoal-coordinator run`, issue 8): every agent drives its vehicle along its
+//! Executing a plan (`shoal-coordinator run`): every agent drives its vehicle along its
 //! trajectory through its vehicle link and reports telemetry; the coordinator keeps the live
 //! fleet picture ([`fleet`]), publishes it on the open JSON keys, logs everything ([`log`]) and
 //! reacts (`react`): a predicted loss of separation, a deviation beyond the tolerance, a

@@ -1,4 +1,4 @@
-//! What the coordinator does with reports and with what it sees (issue 8, item 3): a predicted
+//! What the coordinator does with reports and with what it sees: a predicted
 //! loss of separation, a cross-track error beyond the tolerance, a vehicle silent too long or a
 //! new obstacle on a vehicle's remaining path makes it replan that vehicle (see
 //! [`super::replan`]; the replan runs off the loop, [`super::replan_queue`]); a replan that is

@@ -1,4 +1,4 @@
-//! Repairing the rest of an inspection tour while the fleet drives (issue 8). A tour's path is
+//! Repairing the rest of an inspection tour while the fleet drives. A tour's path is
 //! not "any way to the goal": it must still pass every remaining inspection point in order, so
 //! the point-to-point replan of [`super::replan`] would be wrong for it. The same holds for an
 //! energy plan (seed 001), whose path points were chosen for the seabed, the AUV's turning

@@ -1,4 +1,4 @@
-//! Replanning the rest of one vehicle's mission while the fleet drives (issue 8): from the
+//! Replanning the rest of one vehicle's mission while the fleet drives: from the
 //! position it will have when the update reaches it, to its goal, for the fleet's arrival time,
 //! with the other vehicles as moving obstacles (their trajectories as the coordinator predicts
 //! them) and any new obstacle in the scenario.
