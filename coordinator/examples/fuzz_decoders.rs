@@ -103,6 +103,7 @@ fn targets() -> Vec<Target> {
         revision: 2,
         sent_unix_us: 1_700_000_000_000_000,
         state: state(),
+        command: None,
     };
     let status = FleetStatus {
         version: OPEN_VERSION,

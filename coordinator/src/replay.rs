@@ -334,6 +334,7 @@ mod tests {
                     status: VehicleStatus::Underway,
                     arrived_s: None,
                 },
+                command: None,
             },
         }
     }

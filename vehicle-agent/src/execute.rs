@@ -8,7 +8,9 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::{Receiver, RecvTimeoutError};
 use std::time::{Duration, Instant};
 
-use shoal_common::execution::{unix_us, MissionClock, VehicleStatus};
+use shoal_common::execution::{
+    unix_us, CommandReport, CommandState, MissionClock, VehicleCommand, VehicleStatus,
+};
 use shoal_common::scenario::Scenario;
 use shoal_common::trajectory::Trajectory;
 use shoal_common::wire::coordinator_to_agent::CoordinatorToAgent;
@@ -84,8 +86,196 @@ impl Order {
     }
 }
 
+/// How long a stop waits for the vehicle to confirm it (reporting meanwhile) before the
+/// execution ends anyway.
+pub const STOP_WAIT: Duration = Duration::from_secs(10);
+/// The same for the hold an agent gives its vehicle when it shuts down.
+pub const SHUTDOWN_WAIT: Duration = Duration::from_secs(3);
+
+/// One execution under way: the order, the link, and what has been reported.
+struct Driver<'a> {
+    order: Order,
+    link: &'a mut dyn VehicleLink,
+    publish: &'a dyn Fn(&Telemetry),
+    /// Next report number.
+    seq: u64,
+    /// Revision of the plan the vehicle confirmed, and the one sent to it, if newer.
+    revision: u32,
+    pending_revision: Option<u32>,
+    /// The latest command and what the vehicle made of it, carried in every report.
+    command: Option<CommandReport>,
+    /// When the next periodic report is due.
+    next: Instant,
+    /// Whether the vehicle last reported itself arrived.
+    arrived: bool,
+}
+
+impl Driver<'_> {
+    /// Gives `command` to the vehicle (`plan` for an upload); the error if it could not even
+    /// be given.
+    fn give(&mut self, command: VehicleCommand, plan: Option<&Trajectory>) -> Result<(), String> {
+        let now = self.order.clock.now();
+        let given = match (command, plan) {
+            (VehicleCommand::Upload, Some(plan)) => self.link.upload(plan),
+            (VehicleCommand::Stop, _) => self.link.stop(),
+            _ => self.link.hold(now),
+        };
+        given.map_err(|e| e.to_string())?;
+        self.command = Some(CommandReport {
+            command,
+            state: CommandState::Pending,
+            detail: "sent".into(),
+            given_s: now,
+        });
+        Ok(())
+    }
+
+    /// Takes what the vehicle made of the commands; reports at once when that changed.
+    fn collect(&mut self) {
+        let mut changed = false;
+        for outcome in self.link.outcomes() {
+            let Some(report) = self
+                .command
+                .as_mut()
+                .filter(|c| c.command == outcome.command)
+            else {
+                continue; // of a command given before the latest one
+            };
+            if outcome.command == VehicleCommand::Upload && outcome.state == CommandState::Confirmed
+            {
+                self.revision = self.pending_revision.take().unwrap_or(self.revision);
+            }
+            let mission = &self.order.mission;
+            tracing::info!(
+                "mission {mission}: {:?} {:?}: {}",
+                outcome.command,
+                outcome.state,
+                outcome.detail
+            );
+            (report.state, report.detail) = (outcome.state, outcome.detail);
+            changed = true;
+        }
+        if changed {
+            self.report();
+        }
+    }
+
+    /// Reports the vehicle's state now (nothing if the link has no state yet).
+    fn report(&mut self) {
+        match self.link.state(self.order.clock.now()) {
+            Ok(state) => {
+                self.arrived = state.status == VehicleStatus::Arrived;
+                (self.publish)(&Telemetry {
+                    version: OPEN_VERSION,
+                    mission: self.order.mission.clone(),
+                    vehicle: self.order.vehicle.clone(),
+                    seq: self.seq,
+                    revision: self.revision,
+                    sent_unix_us: unix_us(),
+                    state,
+                    command: self.command.clone(),
+                });
+                self.seq += 1;
+            }
+            Err(e) => tracing::warn!("mission {}: no state: {e}", self.order.mission),
+        }
+    }
+
+    /// Reports if a report is due; returns how long until the next one.
+    fn tick(&mut self) -> Duration {
+        self.collect();
+        let now = Instant::now();
+        if now >= self.next {
+            self.next += self.order.period;
+            if self.next < now {
+                self.next = now + self.order.period; // fell behind: do not burst
+            }
+            self.report();
+        }
+        self.next.saturating_duration_since(Instant::now())
+    }
+
+    /// Goes on reporting until the latest command is confirmed or given up, or `wait` passes;
+    /// says which.
+    fn settle(&mut self, wait: Duration) -> String {
+        let deadline = Instant::now() + wait;
+        loop {
+            let pause = self.tick();
+            match &self.command {
+                Some(c) if matches!(c.state, CommandState::Confirmed) => return "confirmed".into(),
+                Some(c) if matches!(c.state, CommandState::GaveUp) => {
+                    return format!("NOT confirmed: {}", c.detail)
+                }
+                _ if Instant::now() >= deadline => {
+                    return format!("not confirmed in {:.0} s", wait.as_secs_f64())
+                }
+                _ => std::thread::sleep(pause.min(Duration::from_millis(20))),
+            }
+        }
+    }
+
+    /// Acts on one message of the coordinator; `Some(outcome)` ends the execution.
+    fn obey(&mut self, message: CoordinatorToAgent) -> Option<String> {
+        let mission = self.order.mission.clone();
+        match message {
+            CoordinatorToAgent::Update {
+                revision: r,
+                trajectory: t,
+                ..
+            } if r > self.revision && self.pending_revision.is_none_or(|p| r > p) => {
+                match t.checked() {
+                    Ok(plan) => match self.give(VehicleCommand::Upload, Some(&plan)) {
+                        Ok(()) => self.pending_revision = Some(r),
+                        Err(e) => tracing::warn!("mission {mission}: revision {r}: {e}"),
+                    },
+                    Err(why) => tracing::warn!("mission {mission}: dropped an update: {why}"),
+                }
+            }
+            CoordinatorToAgent::Hold { reason, .. } => {
+                tracing::warn!("mission {mission}: hold: {reason}");
+                if let Err(e) = self.give(VehicleCommand::Hold, None) {
+                    tracing::warn!("mission {mission}: hold not given: {e}");
+                }
+                self.report();
+            }
+            CoordinatorToAgent::Stop { reason, .. } => {
+                let given = self.give(VehicleCommand::Stop, None);
+                let stopped = match given {
+                    Ok(()) => self.settle(STOP_WAIT),
+                    Err(e) => format!("not given: {e}"),
+                };
+                return Some(format!("stopped: {reason}{}", suffix(&stopped)));
+            }
+            _ => {}
+        }
+        None
+    }
+
+    /// Holds the vehicle as the agent leaves, waiting a little for it to confirm.
+    fn leave(&mut self) -> String {
+        let held = match self.give(VehicleCommand::Hold, None) {
+            Ok(()) => self.settle(SHUTDOWN_WAIT),
+            Err(e) => format!("not given: {e}"),
+        };
+        format!(
+            "the agent is shutting down: vehicle told to hold{}",
+            suffix(&held)
+        )
+    }
+}
+
+/// Nothing for a confirmed command, else what became of it.
+fn suffix(result: &str) -> String {
+    match result {
+        "confirmed" => String::new(),
+        other => format!(" ({other})"),
+    }
+}
+
 /// Drives the vehicle until the coordinator stops the mission (or `stop`, or the coordinator
-/// stays silent for `idle` after the vehicle arrived). `publish` sends one report.
+/// stays silent for `idle` after the vehicle arrived). `publish` sends one report. No command
+/// to the vehicle holds the reports up: each is given at once and its outcome is collected as
+/// it comes, and carried in every report from then on.
 pub fn run(
     order: Order,
     link: &mut dyn VehicleLink,
@@ -94,9 +284,19 @@ pub fn run(
     stop: &AtomicBool,
     idle: Duration,
 ) -> MissionReport {
-    let mut revision = 0u32;
-    let mut seq = 0u64;
-    if let Err(e) = link.upload(&order.plan) {
+    let mut d = Driver {
+        next: Instant::now(),
+        order,
+        link,
+        publish,
+        seq: 0,
+        revision: 0,
+        pending_revision: None,
+        command: None,
+        arrived: false,
+    };
+    let plan = d.order.plan.clone();
+    if let Err(e) = d.give(VehicleCommand::Upload, Some(&plan)) {
         return MissionReport {
             iterations: 0,
             elites_sent: 0,
@@ -105,93 +305,35 @@ pub fn run(
     }
     tracing::info!(
         "mission {}: {} drives {} samples through {} ({}× real time)",
-        order.mission,
-        order.vehicle,
-        order.plan.times.len(),
-        link.name(),
-        order.clock.scale
+        d.order.mission,
+        d.order.vehicle,
+        d.order.plan.times.len(),
+        d.link.name(),
+        d.order.clock.scale
     );
-    let mut next = Instant::now();
     let mut heard = Instant::now();
     let outcome = loop {
         if stop.load(Ordering::Relaxed) {
-            let _ = link.hold(order.clock.now());
-            break "the agent is shutting down: vehicle told to hold".to_string();
+            break d.leave();
         }
-        let now = Instant::now();
-        if now >= next {
-            next += order.period;
-            if next < now {
-                next = now + order.period; // fell behind: do not burst
-            }
-            match link.state(order.clock.now()) {
-                Ok(state) => {
-                    let arrived = state.status == VehicleStatus::Arrived;
-                    publish(&Telemetry {
-                        version: OPEN_VERSION,
-                        mission: order.mission.clone(),
-                        vehicle: order.vehicle.clone(),
-                        seq,
-                        revision,
-                        sent_unix_us: unix_us(),
-                        state,
-                    });
-                    seq += 1;
-                    if arrived && heard.elapsed() > idle {
-                        break format!(
-                            "arrived; the coordinator was silent for {:.0} s",
-                            idle.as_secs_f64()
-                        );
-                    }
-                }
-                Err(e) => tracing::warn!("mission {}: no state: {e}", order.mission),
-            }
+        let wait = d.tick();
+        if d.arrived && heard.elapsed() > idle {
+            let silent = idle.as_secs_f64();
+            break format!("arrived; the coordinator was silent for {silent:.0} s");
         }
-        let wait = next.saturating_duration_since(Instant::now());
         match inbox.recv_timeout(wait.min(Duration::from_millis(100))) {
             Ok(m) => {
                 heard = Instant::now();
-                match m {
-                    CoordinatorToAgent::Update {
-                        revision: r,
-                        trajectory: t,
-                        ..
-                    } if r > revision => match t.checked() {
-                        Ok(plan) => match link.upload(&plan) {
-                            Ok(()) => {
-                                revision = r;
-                                tracing::info!("mission {}: revision {r} loaded", order.mission);
-                            }
-                            Err(e) => {
-                                tracing::warn!("mission {}: revision {r}: {e}", order.mission)
-                            }
-                        },
-                        Err(why) => {
-                            tracing::warn!("mission {}: dropped an update: {why}", order.mission)
-                        }
-                    },
-                    CoordinatorToAgent::Hold { reason, .. } => {
-                        tracing::warn!("mission {}: hold: {reason}", order.mission);
-                        if let Err(e) = link.hold(order.clock.now()) {
-                            tracing::warn!("mission {}: hold failed: {e}", order.mission);
-                        }
-                    }
-                    CoordinatorToAgent::Stop { reason, .. } => {
-                        let _ = link.stop();
-                        break format!("stopped: {reason}");
-                    }
-                    _ => {}
+                if let Some(end) = d.obey(m) {
+                    break end;
                 }
             }
             Err(RecvTimeoutError::Timeout) => {}
-            Err(RecvTimeoutError::Disconnected) => {
-                let _ = link.hold(order.clock.now());
-                break "the agent is shutting down: vehicle told to hold".to_string();
-            }
+            Err(RecvTimeoutError::Disconnected) => break d.leave(),
         }
     };
     MissionReport {
-        iterations: seq as u32,
+        iterations: d.seq as u32,
         elites_sent: 0,
         outcome,
     }
@@ -200,7 +342,7 @@ pub fn run(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::link::LinkError;
+    use crate::link::{LinkError, LinkOutcome};
     use shoal_common::execution::VehicleState;
     use shoal_common::geometry::Vec3;
     use std::sync::mpsc;
@@ -210,6 +352,7 @@ mod tests {
     #[derive(Clone, Default)]
     struct Recorder {
         calls: Arc<Mutex<Vec<String>>>,
+        confirmed: Arc<Mutex<usize>>,
     }
 
     impl VehicleLink for Recorder {
@@ -249,6 +392,27 @@ mod tests {
                 .map_err(|e| LinkError::Io(e.to_string()))?
                 .push("stop".into());
             Ok(())
+        }
+        /// Every command confirmed at once, as a simulator does.
+        fn outcomes(&mut self) -> Vec<LinkOutcome> {
+            let calls = self.calls.lock().map(|c| c.clone()).unwrap_or_default();
+            let mut seen = self.confirmed.lock().map(|n| *n).unwrap_or(0);
+            let done = calls[seen.min(calls.len())..]
+                .iter()
+                .map(|c| {
+                    let command = match c.as_str() {
+                        "hold" => VehicleCommand::Hold,
+                        "stop" => VehicleCommand::Stop,
+                        _ => VehicleCommand::Upload,
+                    };
+                    LinkOutcome::confirmed(command, c.clone())
+                })
+                .collect();
+            seen = calls.len();
+            if let Ok(mut n) = self.confirmed.lock() {
+                *n = seen;
+            }
+            done
         }
     }
 

@@ -69,7 +69,8 @@ pub struct AgentArgs {
     #[arg(long, env = "SHOAL_MAVLINK_ADDRESS", value_parser = link::check_mavlink_address)]
     pub mavlink_address: Option<String>,
     /// `mavlink` link: geodetic origin of the scenario frame, `LAT,LON,ALT` (degrees, degrees,
-    /// metres above mean sea level of scenario point (0, 0, 0)).
+    /// metres above mean sea level of scenario point (0, 0, 0)). Optional when the scenario
+    /// has an `[origin]`; when both are given, a mission whose origin differs is refused.
     #[arg(
         long,
         env = "SHOAL_MAVLINK_ORIGIN",
@@ -85,6 +86,13 @@ pub struct AgentArgs {
         value_parser = link::parse_mavlink_target
     )]
     pub mavlink_target: Option<(u8, u8)>,
+    /// `mavlink` link: the vehicle's autopilot family, which decides the mission layout and
+    /// how it is made to hold (`auto`: from its HEARTBEAT).
+    #[arg(long, env = "SHOAL_MAVLINK_AUTOPILOT", value_enum, default_value_t = link::mavlink::AutopilotChoice::Auto)]
+    pub mavlink_autopilot: link::mavlink::AutopilotChoice,
+    /// `mavlink` link: do not upload the scenario's bounds and hard obstacles as a geofence.
+    #[arg(long, env = "SHOAL_MAVLINK_NO_FENCE")]
+    pub mavlink_no_fence: bool,
 }
 
 impl AgentArgs {
@@ -100,16 +108,14 @@ impl AgentArgs {
         link::LinkSettings {
             kind: self.link,
             position_noise_m: self.position_noise,
-            mavlink: match (&self.mavlink_address, self.mavlink_origin) {
-                (Some(address), Some(origin)) => {
-                    let mut m = link::MavlinkSettings::new(address, origin);
-                    if let Some((system, component)) = self.mavlink_target {
-                        (m.target_system, m.target_component) = (system, component);
-                    }
-                    Some(m)
+            mavlink: self.mavlink_address.as_ref().map(|address| {
+                let mut m = link::MavlinkSettings::new(address, self.mavlink_origin);
+                if let Some((system, component)) = self.mavlink_target {
+                    (m.target_system, m.target_component) = (system, component);
                 }
-                _ => None,
-            },
+                (m.autopilot, m.fence) = (self.mavlink_autopilot, !self.mavlink_no_fence);
+                m
+            }),
         }
     }
 }
@@ -138,13 +144,8 @@ pub fn run(args: AgentArgs, shutdown: Arc<AtomicBool>) -> anyhow::Result<()> {
             args.position_noise
         );
     }
-    if args.link == link::LinkKind::Mavlink
-        && (args.mavlink_address.is_none() || args.mavlink_origin.is_none())
-    {
-        anyhow::bail!(
-            "--link mavlink needs --mavlink-address (SHOAL_MAVLINK_ADDRESS) and \
-             --mavlink-origin (SHOAL_MAVLINK_ORIGIN)"
-        );
+    if args.link == link::LinkKind::Mavlink && args.mavlink_address.is_none() {
+        anyhow::bail!("--link mavlink needs --mavlink-address (SHOAL_MAVLINK_ADDRESS)");
     }
     network::serve(&args, &shutdown)
 }

@@ -17,10 +17,10 @@ use std::time::{Duration, Instant};
 use clap::Parser;
 use mavlink::dialects::common::{self as mav, MavCmd, MavMessage as M};
 use mavlink::{Connectable, MavConnection, MavHeader, UdpConfig, UdpMode};
-use shoal_agent::link::mavlink::{mission_items, MavlinkLink};
-use shoal_agent::link::{GeoOrigin, LinkError, MavlinkSettings, VehicleLink};
+use shoal_agent::link::mavlink::{mission_items, AutopilotChoice, MavlinkLink, Profile};
+use shoal_agent::link::{GeoOrigin, LinkError, LinkOutcome, MavlinkSettings, VehicleLink};
 use shoal_agent::AgentArgs;
-use shoal_common::execution::VehicleStatus;
+use shoal_common::execution::{CommandState, VehicleCommand, VehicleStatus};
 use shoal_common::geometry::Vec3;
 use shoal_common::trajectory::Trajectory;
 
@@ -51,10 +51,42 @@ fn plan() -> Trajectory {
     }
 }
 
+/// A generic autopilot (these vehicles send no HEARTBEAT before a mission) at `port`.
 fn settings(port: u16, timeout_ms: u64, retries: u32) -> MavlinkSettings {
-    let mut s = MavlinkSettings::new(format!("udpout:127.0.0.1:{port}"), ORIGIN);
+    let mut s = MavlinkSettings::new(format!("udpout:127.0.0.1:{port}"), Some(ORIGIN));
     (s.timeout, s.retries) = (Duration::from_millis(timeout_ms), retries);
+    s.autopilot = AutopilotChoice::Generic;
     s
+}
+
+/// The link to the vehicle at `port`, without a geofence.
+fn connect(settings: &MavlinkSettings) -> Result<MavlinkLink, LinkError> {
+    MavlinkLink::connect(settings, ORIGIN, None)
+}
+
+/// Collects outcomes until `command`'s final one (10 s at most); returns them all.
+fn settle(link: &mut MavlinkLink, command: VehicleCommand) -> Result<Vec<LinkOutcome>, String> {
+    let (deadline, mut seen) = (Instant::now() + Duration::from_secs(10), Vec::new());
+    loop {
+        seen.extend(link.outcomes());
+        if seen.iter().any(|o| o.command == command && o.is_final()) {
+            return Ok(seen);
+        }
+        if Instant::now() > deadline {
+            return Err(format!("no final outcome of {command:?}: {seen:?}"));
+        }
+        std::thread::sleep(Duration::from_millis(10));
+    }
+}
+
+/// The final state of `command` and its detail.
+fn final_of(outcomes: &[LinkOutcome], command: VehicleCommand) -> (CommandState, String) {
+    outcomes
+        .iter()
+        .rfind(|o| o.command == command && o.is_final())
+        .map_or((CommandState::Pending, String::new()), |o| {
+            (o.state, o.detail.clone())
+        })
 }
 
 /// How the mock vehicle misbehaves.
@@ -236,12 +268,17 @@ fn position_at(p: [f64; 3], v_ned_cm: [i16; 3], hdg_cdeg: u16) -> mav::GLOBAL_PO
 #[test]
 fn upload_survives_lost_messages_then_position_arrival_and_hold_come_through() -> TestResult {
     let mock = Mock::start(Behaviour::Lossy)?;
-    let mut link = MavlinkLink::connect(&settings(mock.port, 200, 5))?.with_surface(Some(0.0));
+    let mut link = connect(&settings(mock.port, 200, 5))?.with_surface(Some(0.0));
     let early = link.state(0.0);
     assert!(matches!(early, Err(LinkError::Timeout(_))), "{early:?}");
 
     let started = Instant::now();
     link.upload(&plan())?;
+    let upload = settle(&mut link, VehicleCommand::Upload)?;
+    assert_eq!(
+        final_of(&upload, VehicleCommand::Upload).0,
+        CommandState::Confirmed
+    );
     assert!(
         started.elapsed() >= Duration::from_millis(400),
         "two timeouts before the retries"
@@ -252,7 +289,7 @@ fn upload_survives_lost_messages_then_position_arrival_and_hold_come_through() -
             b.counts, 2,
             "MISSION_COUNT sent again after the first was not answered"
         );
-        let want = mission_items(&plan(), &ORIGIN, None, (1, 1));
+        let want = mission_items(&plan(), &ORIGIN, None, (1, 1), Profile::Generic).items;
         assert_eq!(b.items.len(), 4);
         for (got, want) in b.items.iter().zip(&want) {
             assert_eq!(
@@ -297,6 +334,11 @@ fn upload_survives_lost_messages_then_position_arrival_and_hold_come_through() -
     assert!(s.arrived_s.is_some_and(|t| t <= 42.0));
 
     link.hold(0.0)?;
+    let held = settle(&mut link, VehicleCommand::Hold)?;
+    assert_eq!(
+        final_of(&held, VehicleCommand::Hold).0,
+        CommandState::Confirmed
+    );
     assert_eq!(link.state(43.0)?.status, VehicleStatus::Holding);
     assert_eq!(
         mock.board().commands.last(),
@@ -309,13 +351,16 @@ fn upload_survives_lost_messages_then_position_arrival_and_hold_come_through() -
 #[test]
 fn a_silent_vehicle_times_out_after_the_retries() -> TestResult {
     let mock = Mock::start(Behaviour::Silent)?;
-    let mut link = MavlinkLink::connect(&settings(mock.port, 100, 2))?;
+    let mut link = connect(&settings(mock.port, 100, 2))?;
     let started = Instant::now();
-    match link.upload(&plan()) {
-        Err(LinkError::Timeout(why)) => assert!(why.contains("MISSION_REQUEST 0"), "{why}"),
-        other => panic!("expected a timeout, got {other:?}"),
-    }
+    link.upload(&plan())?;
+    let upload = settle(&mut link, VehicleCommand::Upload)?;
     let took = started.elapsed();
+    let (state, why) = final_of(&upload, VehicleCommand::Upload);
+    assert!(
+        state == CommandState::GaveUp && why.contains("MISSION_REQUEST 0"),
+        "{why}"
+    );
     assert!(
         took >= Duration::from_millis(300) && took < Duration::from_secs(2),
         "{took:?}"
@@ -325,27 +370,50 @@ fn a_silent_vehicle_times_out_after_the_retries() -> TestResult {
         3,
         "the first MISSION_COUNT and two resends"
     );
-    assert!(matches!(link.hold(0.0), Err(LinkError::Timeout(_))));
+    // The hold: unanswered, reported within a second, and no fallback without a position.
+    let asked = Instant::now();
+    link.hold(0.0)?;
+    let held = settle(&mut link, VehicleCommand::Hold)?;
+    let failed = held.iter().position(|o| o.state == CommandState::Failed);
+    assert!(failed.is_some(), "{held:?}");
+    let (state, why) = final_of(&held, VehicleCommand::Hold);
+    assert!(
+        state == CommandState::GaveUp && why.contains("no position"),
+        "{why}"
+    );
+    assert!(
+        asked.elapsed() < Duration::from_secs(2),
+        "{:?}",
+        asked.elapsed()
+    );
+    assert_eq!(
+        link.state(1.0).ok().map(|s| s.status),
+        None,
+        "no fix, no state"
+    );
     Ok(())
 }
 
 #[test]
 fn a_refused_mission_is_refused() -> TestResult {
     let mock = Mock::start(Behaviour::Refuses)?;
-    let mut link = MavlinkLink::connect(&settings(mock.port, 200, 5))?;
-    match link.upload(&plan()) {
-        Err(LinkError::Refused(why)) => assert!(why.contains("MAV_MISSION_ERROR"), "{why}"),
-        other => panic!("expected a refusal, got {other:?}"),
-    }
+    let mut link = connect(&settings(mock.port, 200, 5))?;
+    link.upload(&plan())?;
+    let upload = settle(&mut link, VehicleCommand::Upload)?;
+    let (state, why) = final_of(&upload, VehicleCommand::Upload);
+    assert!(
+        state == CommandState::GaveUp && why.contains("MAV_MISSION_ERROR"),
+        "{why}"
+    );
     Ok(())
 }
 
 #[test]
 fn a_listening_link_skips_garbage_and_strangers() -> TestResult {
     let port = free_port()?;
-    let mut link = MavlinkLink::connect(&MavlinkSettings::new(
+    let mut link = connect(&MavlinkSettings::new(
         format!("udpin:127.0.0.1:{port}"),
-        ORIGIN,
+        Some(ORIGIN),
     ))?;
     let raw = UdpSocket::bind("127.0.0.1:0")?;
     raw.send_to(
@@ -387,7 +455,8 @@ fn the_agent_flags_build_the_settings_and_bad_values_name_the_flag() -> TestResu
         "--mavlink-target",
         "2,1",
     ]))?;
-    let mut want = MavlinkSettings::new("udpout:127.0.0.1:14550", GeoOrigin::new(43.1, 5.9, -2.0));
+    let origin = Some(GeoOrigin::new(43.1, 5.9, -2.0));
+    let mut want = MavlinkSettings::new("udpout:127.0.0.1:14550", origin);
     (want.target_system, want.target_component) = (2, 1);
     assert_eq!(args.link_settings().mavlink, Some(want));
     for (flag, bad) in [
@@ -468,7 +537,7 @@ fn pymavlink_as_the_vehicle_takes_the_mission_reports_arrival_and_stops() -> Tes
     let first = lines.recv_timeout(Duration::from_secs(15))?;
     assert!(first.contains("listening"), "{first}");
 
-    let mut link = MavlinkLink::connect(&settings(port, 500, 5))?;
+    let mut link = connect(&settings(port, 500, 5))?;
     link.upload(&plan())?;
     let s = wait_state(&mut link, |s| s.status == VehicleStatus::Arrived)?;
     assert!(
@@ -480,6 +549,11 @@ fn pymavlink_as_the_vehicle_takes_the_mission_reports_arrival_and_stops() -> Tes
         "heading 90° from north is east: {s:?}"
     );
     link.stop()?;
+    let stopped = settle(&mut link, VehicleCommand::Stop)?;
+    assert_eq!(
+        final_of(&stopped, VehicleCommand::Stop).0,
+        CommandState::Confirmed
+    );
     assert_eq!(link.state(50.0)?.status, VehicleStatus::Stopped);
 
     let deadline = Instant::now() + Duration::from_secs(10);
@@ -495,7 +569,7 @@ fn pymavlink_as_the_vehicle_takes_the_mission_reports_arrival_and_stops() -> Tes
     let out: Vec<String> = lines.iter().collect(); // up to the end of its stdout
     assert!(status.success(), "peer: {status}; stdout: {out:#?}");
     let items: Vec<&String> = out.iter().filter(|l| l.contains("\"item\"")).collect();
-    let want = mission_items(&plan(), &ORIGIN, None, (1, 1));
+    let want = mission_items(&plan(), &ORIGIN, None, (1, 1), Profile::Generic).items;
     assert_eq!(items.len(), want.len(), "{out:#?}");
     for (line, w) in items.iter().zip(&want) {
         let got = ["seq", "command", "x", "y", "z", "param2"].map(|k| field(line, k));

@@ -59,6 +59,57 @@ pub enum VehicleStatus {
     Fault,
 }
 
+/// A command an agent passes to its vehicle.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum VehicleCommand {
+    /// Load a (re)planned trajectory and start it.
+    Upload,
+    /// Hold where it is until the next upload.
+    Hold,
+    /// Stop: the mission is over for it.
+    Stop,
+}
+
+impl VehicleCommand {
+    /// Lower-case name, as in event kinds (`hold_failed`).
+    pub fn name(self) -> &'static str {
+        match self {
+            VehicleCommand::Upload => "upload",
+            VehicleCommand::Hold => "hold",
+            VehicleCommand::Stop => "stop",
+        }
+    }
+}
+
+/// Where a command stands, as far as the vehicle has confirmed it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum CommandState {
+    /// Sent; the vehicle has not answered yet.
+    Pending,
+    /// The vehicle confirmed it (directly or through a fallback: `detail` says how).
+    Confirmed,
+    /// The vehicle refused it or did not answer; a fallback is under way (`detail` says which).
+    Failed,
+    /// Refused or unanswered, and so was every fallback: the vehicle goes on as before.
+    GaveUp,
+}
+
+/// The latest command of an agent and what its vehicle made of it: carried in every
+/// telemetry report, so that a lost report does not lose a refused hold.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CommandReport {
+    /// Which command.
+    pub command: VehicleCommand,
+    /// Where it stands.
+    pub state: CommandState,
+    /// In plain words: what was sent, what the vehicle answered, which fallback.
+    pub detail: String,
+    /// Mission time the command was given, seconds (tells two holds apart).
+    pub given_s: f64,
+}
+
 /// One state report of a vehicle (the telemetry it sends), in the scenario frame.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct VehicleState {

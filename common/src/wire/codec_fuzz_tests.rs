@@ -115,6 +115,7 @@ fn telemetry() -> impl Strategy<Value = Telemetry> {
             revision: 3,
             sent_unix_us: 1_700_000_000_000_000,
             state,
+            command: None,
         },
     )
 }

@@ -15,7 +15,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::execution::picture::{Conflict, Progress};
-use crate::execution::VehicleState;
+use crate::execution::{CommandReport, VehicleState};
 
 /// Version of the JSON payloads.
 pub const OPEN_VERSION: u16 = 1;
@@ -37,6 +37,10 @@ pub struct Telemetry {
     pub sent_unix_us: u64,
     /// The state.
     pub state: VehicleState,
+    /// The agent's latest hold, stop or upload and what the vehicle made of it (absent before
+    /// the first, and from older agents).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub command: Option<CommandReport>,
 }
 
 /// One vehicle in the live fleet picture.
@@ -104,7 +108,8 @@ pub struct MissionEvent {
     /// Mission time, seconds.
     pub t_s: f64,
     /// What kind: `conflict_predicted`, `deviation`, `vehicle_lost`, `obstacle`, `replanned`,
-    /// `hold`, `arrived`, `mission_end`, `implausible_report` (a report refused: a jump, out of
+    /// `hold`, `hold_failed` / `stop_failed` / `upload_failed` (the vehicle refused or did not
+    /// answer; the detail names the fallback), `hold_confirmed`, `arrived`, `mission_end`, `implausible_report` (a report refused: a jump, out of
     /// bounds, numbered far ahead, off the clock), `obstacle_dropped` (a published obstacle
     /// refused: out of scale, a known id, over the cap or the rate), …
     pub kind: String,

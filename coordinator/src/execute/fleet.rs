@@ -219,13 +219,13 @@ impl Fleet {
 
     /// Each vehicle's predicted trajectory from `now` over `horizon_s`: along its plan from its
     /// latest fix, from the fix's time (from where its plan has it, before its first report); a
-    /// lost or faulted vehicle stays where it was last seen, a holding one where it stopped
-    /// ([`Tracked::standing`]).
+    /// lost or faulted vehicle stays where it was last seen, one that confirmed a hold where it
+    /// stopped ([`Tracked::standing`]).
     pub fn predictions_over(&self, now: f64, horizon_s: f64) -> Vec<Trajectory> {
         self.vehicles
             .iter()
             .map(|v| {
-                if v.lost || v.holding || v.fault_s.is_some() {
+                if v.lost || v.hold_confirmed() || v.fault_s.is_some() {
                     let p = v.standing();
                     return Trajectory {
                         times: vec![now, now + horizon_s],

@@ -43,6 +43,7 @@ fn report(vehicle: &str, seq: u64, t: f64, p: [f64; 3], status: VehicleStatus) -
             status,
             arrived_s: (status == VehicleStatus::Arrived).then_some(100.0),
         },
+        command: None,
     }
 }
 
@@ -414,8 +415,8 @@ fn a_vehicle_told_to_hold_between_fixes_drove_its_plan_to_the_stop() {
 }
 
 /// A vehicle told to hold after a fix under way drove on until the hold came: it is pictured
-/// where its plan had it then (and predicted to stand there), not at that fix, until a fix
-/// taken after the hold places it. Lost, it stays at its last fix.
+/// where its plan had it then, not at that fix, until a fix taken after the hold places it
+/// (and, the hold confirmed, predicts it standing there). Lost, it stays at its last fix.
 #[test]
 fn a_vehicle_told_to_hold_is_pictured_where_its_plan_had_it_at_the_hold() {
     let ids = vec!["a".to_string()];
@@ -429,19 +430,25 @@ fn a_vehicle_told_to_hold_is_pictured_where_its_plan_had_it_at_the_hold() {
     f.vehicles[0].held_since_s = Some(45.0);
     let at = f.vehicles[0].standing();
     assert!((at - Vec3::new(45.0, 0.0, 0.0)).norm() < 1e-6, "{at:?}");
+    // Until the vehicle confirms the hold, it is predicted to keep going.
     let p = &f.predictions(50.0)[0];
-    for t in [50.0, 80.0, 110.0] {
-        assert!((p.position_at(t) - at).norm() < 1e-9, "{t}: {p:?}");
-    }
+    assert!(
+        (p.position_at(80.0) - Vec3::new(80.0, 0.0, 0.0)).norm() < 1e-6,
+        "{p:?}"
+    );
     let resume = f.vehicles[0].resume_s().unwrap_or(f64::NAN);
     assert!((resume - 45.0).abs() < 1e-6, "{resume}");
-    // Its first holding fix, a little short of that, places it.
+    // Its first holding fix, a little short of that, places it, standing.
     f.report(
         report("a", 1, 60.0, [44.0, 0.5, 0.0], VehicleStatus::Holding),
         2,
     );
     let at = f.vehicles[0].standing();
     assert!((at - Vec3::new(44.0, 0.5, 0.0)).norm() < 1e-9, "{at:?}");
+    let p = &f.predictions(60.0)[0];
+    for t in [60.0, 80.0, 110.0] {
+        assert!((p.position_at(t) - at).norm() < 1e-9, "{t}: {p:?}");
+    }
     // A lost vehicle is not known to have driven on.
     let mut g = Fleet::new(&ids, &[straight(0.0)], 50.0, 60.0);
     g.report(
@@ -491,4 +498,36 @@ fn a_fix_on_the_way_back_by_the_same_point_is_placed_on_the_way_back() {
         .fix_progress()
         .unwrap_or_else(|| panic!("no fix"));
     assert!((again.plan_time_s - 150.0).abs() < 1e-9, "{again:?}");
+}
+
+/// A vehicle told to hold is predicted to keep going along its plan until a report of its own
+/// says it holds: a real vehicle may not have heard, or refused.
+#[test]
+fn a_hold_counts_in_the_prediction_only_once_the_vehicle_confirms_it() {
+    let ids = vec!["a".to_string()];
+    let mut f = Fleet::new(&ids, &[straight(0.0)], 50.0, 60.0);
+    f.report(
+        report("a", 0, 10.0, [10.0, 0.0, 0.0], VehicleStatus::Underway),
+        1,
+    );
+    f.vehicles[0].holding = true;
+    f.vehicles[0].held_since_s = Some(10.0);
+    let ahead = |f: &Fleet| f.predictions_over(10.0, 40.0)[0].position_at(50.0).x;
+    // Told, not confirmed: 40 s on at 1 m/s.
+    assert!((ahead(&f) - 50.0).abs() < 1e-6, "{}", ahead(&f));
+    f.report(
+        report("a", 1, 11.0, [11.0, 0.0, 0.0], VehicleStatus::Underway),
+        2,
+    );
+    assert!(!f.vehicles[0].hold_confirmed());
+    f.report(
+        report("a", 2, 12.0, [11.5, 0.0, 0.0], VehicleStatus::Holding),
+        3,
+    );
+    assert!(f.vehicles[0].hold_confirmed());
+    assert!(
+        (ahead(&f) - 11.5).abs() < 1e-6,
+        "stands where it stopped: {}",
+        ahead(&f)
+    );
 }

@@ -6,6 +6,7 @@
 //! ([`replan`]; an inspection tour or an energy plan is repaired instead, `repair`) or, when
 //! no safe replan comes in time, command a hold.
 
+mod confirmations;
 mod detour;
 pub mod fleet;
 mod ground;

@@ -44,6 +44,7 @@ fn report(seq: u64, t_s: f64, position: [f64; 3]) -> Telemetry {
             status: VehicleStatus::Underway,
             arrived_s: None,
         },
+        command: None,
     }
 }
 

@@ -11,6 +11,7 @@
 
 use std::time::{Duration, Instant};
 
+use shoal_common::execution::CommandReport;
 use shoal_common::geometry::{segment_hits_sphere, Vec3};
 use shoal_common::limits;
 use shoal_common::scenario::{Obstacle, ObstacleKind};
@@ -18,6 +19,7 @@ use shoal_common::wire::codec;
 use shoal_common::wire::open::{FleetStatus, Telemetry, OPEN_VERSION};
 use shoal_common::wire::topics;
 
+use super::confirmations;
 use super::lead::{conflict_horizon_s, hold_retry_after};
 use super::log::{Record, EVENT_FAULT, EVENT_IMPLAUSIBLE, EVENT_LOST, EVENT_OBSTACLE_DROPPED};
 use super::plausible::{self, FixLimits, LastFix, Reason};
@@ -77,6 +79,11 @@ pub(super) fn telemetry(x: &mut Exec, key: &str, bytes: &[u8], received_us: u64)
     let was_lost = x.fleet.vehicles[i].lost;
     let was_faulted = x.fleet.vehicles[i].fault_s.is_some();
     let revision = t.revision;
+    let command_before = x.fleet.vehicles[i]
+        .last
+        .as_ref()
+        .and_then(|l| l.command.clone());
+    let command_now = t.command.clone();
     x.log.write(&Record::Telemetry {
         received_unix_us: received_us,
         telemetry: t.clone(),
@@ -91,6 +98,7 @@ pub(super) fn telemetry(x: &mut Exec, key: &str, bytes: &[u8], received_us: u64)
         }
     }
     let id = x.fleet.vehicles[i].id.clone();
+    command_event(x, &id, command_before.as_ref(), command_now.as_ref());
     if was_lost {
         x.event(
             "vehicle_back",
@@ -121,6 +129,19 @@ pub(super) fn telemetry(x: &mut Exec, key: &str, bytes: &[u8], received_us: u64)
                 format!("{id} arrived at t = {t:.1} s"),
             );
         }
+    }
+}
+
+/// What the vehicle made of its latest command, as an event when that changed (see
+/// [`confirmations::change`]).
+fn command_event(
+    x: &mut Exec,
+    id: &str,
+    before: Option<&CommandReport>,
+    now: Option<&CommandReport>,
+) {
+    if let Some((kind, detail)) = confirmations::change(id, before, now) {
+        x.event(&kind, vec![id.to_string()], detail);
     }
 }
 

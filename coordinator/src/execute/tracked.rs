@@ -66,6 +66,18 @@ pub struct Tracked {
 }
 
 impl Tracked {
+    /// Whether it holds as the vehicle itself confirmed: told to hold, and its latest report
+    /// says it holds (or stopped). A vehicle that has not confirmed a hold is predicted to keep
+    /// going: a real one may not have heard, or refused.
+    pub fn hold_confirmed(&self) -> bool {
+        let still = [VehicleStatus::Holding, VehicleStatus::Stopped];
+        self.holding
+            && self
+                .last
+                .as_ref()
+                .is_some_and(|t| still.contains(&t.state.status))
+    }
+
     /// Where on its plan a holding vehicle stopped, as a plan time: the nearest point of the
     /// plan to where it is, searched around the time it was told to hold (its plan went on
     /// without it). `None` when it is not holding.

@@ -37,6 +37,8 @@ pub fn agent(vehicle: &str, endpoint: &str) -> Agent {
         mavlink_address: None,
         mavlink_origin: None,
         mavlink_target: None,
+        mavlink_autopilot: shoal_agent::link::mavlink::AutopilotChoice::Auto,
+        mavlink_no_fence: false,
     };
     let flag = Arc::clone(&stop);
     Agent {

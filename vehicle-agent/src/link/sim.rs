@@ -7,16 +7,18 @@ use std::sync::Arc;
 
 use shoal_common::coverage::fleet::FleetCoverage;
 use shoal_common::execution::sim::{SimModel, SimSettings, Simulator};
-use shoal_common::execution::VehicleState;
+use shoal_common::execution::{VehicleCommand, VehicleState};
 use shoal_common::scenario::{Scenario, VehicleKind};
 use shoal_common::trajectory::Trajectory;
 
-use super::{LinkError, VehicleLink};
+use super::{LinkError, LinkOutcome, VehicleLink};
 
 /// A simulated vehicle.
 pub struct SimLink {
     sim: Simulator,
     kind: VehicleKind,
+    /// Commands done and not yet collected: a simulator confirms each at once.
+    outcomes: Vec<LinkOutcome>,
 }
 
 impl SimLink {
@@ -79,6 +81,7 @@ impl SimLink {
         Ok(SimLink {
             sim: Simulator::new(vehicle, model, settings),
             kind: vehicle.kind,
+            outcomes: Vec::new(),
         })
     }
 }
@@ -109,6 +112,8 @@ impl VehicleLink for SimLink {
             )));
         }
         self.sim.load(plan.clone());
+        let done = LinkOutcome::confirmed(VehicleCommand::Upload, "simulated: loaded");
+        self.outcomes.push(done);
         Ok(())
     }
 
@@ -120,12 +125,20 @@ impl VehicleLink for SimLink {
     fn hold(&mut self, now: f64) -> Result<(), LinkError> {
         self.sim.advance_to(now);
         self.sim.hold();
+        let done = LinkOutcome::confirmed(VehicleCommand::Hold, "simulated: holds");
+        self.outcomes.push(done);
         Ok(())
     }
 
     fn stop(&mut self) -> Result<(), LinkError> {
         self.sim.stop();
+        let done = LinkOutcome::confirmed(VehicleCommand::Stop, "simulated: stopped");
+        self.outcomes.push(done);
         Ok(())
+    }
+
+    fn outcomes(&mut self) -> Vec<LinkOutcome> {
+        std::mem::take(&mut self.outcomes)
     }
 }
 
