@@ -3,9 +3,7 @@
 //! the telemetry, the fleet status (a query) and the events from their JSON keys
 //! (`tests/python/submit_and_watch.py`).
 //!
-//! The interpreter is `$SHOAL_INTEROP_PYTHON` (CI sets it to a venv with eclipse-zenoh 1.10.2:
-//! then a missing package is a failure); without it, `python3` is used if it can import
-//! `zenoh`, and the test says SKIPPED otherwise.
+//! The interpreter comes from [`shoal_interop::python`] (a venv with the pinned packages).
 
 mod common;
 
@@ -18,10 +16,7 @@ use common::{interop_python as python, scenario, without_shoal_env, TestResult};
 
 #[test]
 fn a_python_client_submits_scenario_2_and_reads_plan_telemetry_and_status() -> TestResult {
-    let Some(py) = python() else {
-        eprintln!("SKIPPED: no Python with eclipse-zenoh (set SHOAL_INTEROP_PYTHON; .ci/run does)");
-        return Ok(());
-    };
+    let py = python()?;
     let mut fleet = Fleet::new();
     let port = free_port();
     let mut serve = Command::new(coordinator());

@@ -4,8 +4,7 @@
 //! is valid), no reply may quote `/etc/passwd`, `serve` must stay up with its resident memory
 //! bounded, and at exit it must name the missions it never ran.
 //!
-//! The interpreter is `$SHOAL_INTEROP_PYTHON` (CI sets it to a venv with eclipse-zenoh 1.10.2);
-//! without it, `python3` is used if it can import `zenoh`, and the test says SKIPPED otherwise.
+//! The interpreter comes from [`shoal_interop::python`] (a venv with the pinned packages).
 
 mod common;
 
@@ -71,10 +70,7 @@ fn wait_for(path: &Path, needle: &str, deadline: Instant) -> bool {
 
 #[test]
 fn hostile_submissions_are_refused_and_serve_stays_up_with_bounded_memory() -> TestResult {
-    let Some(py) = python() else {
-        eprintln!("SKIPPED: no Python with eclipse-zenoh (set SHOAL_INTEROP_PYTHON; .ci/run does)");
-        return Ok(());
-    };
+    let py = python()?;
     let tmp = tempfile::tempdir()?;
     let (data, out, log) = (
         tmp.path().join("data"),

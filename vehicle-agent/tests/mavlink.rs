@@ -2,9 +2,7 @@
 //! crate (it drops messages so the retries must work, refuses, or stays silent), and pymavlink
 //! as an independent peer (`tests/python/mavlink_peer.py`).
 //!
-//! The peer's interpreter is `$SHOAL_INTEROP_PYTHON` (CI sets it to a venv with
-//! pymavlink==2.4.50: then a missing package is a failure); without it, `python3` is used if it
-//! can import `pymavlink`, and the test says SKIPPED otherwise.
+//! The peer's interpreter comes from [`shoal_interop::python`] (a venv with the pinned packages).
 
 use std::io::{BufRead, BufReader};
 use std::net::UdpSocket;
@@ -481,18 +479,6 @@ fn the_agent_flags_build_the_settings_and_bad_values_name_the_flag() -> TestResu
     Ok(())
 }
 
-/// The interpreter for the pymavlink peer, if there is one.
-fn python() -> Option<String> {
-    if let Ok(p) = std::env::var("SHOAL_INTEROP_PYTHON") {
-        return Some(p);
-    }
-    let ok = Command::new("python3")
-        .args(["-c", "import pymavlink"])
-        .output();
-    ok.is_ok_and(|o| o.status.success())
-        .then(|| "python3".to_string())
-}
-
 /// Kills the peer if the test ends early.
 struct Peer(Child);
 
@@ -511,10 +497,7 @@ fn field(line: &str, key: &str) -> Option<f64> {
 
 #[test]
 fn pymavlink_as_the_vehicle_takes_the_mission_reports_arrival_and_stops() -> TestResult {
-    let Some(py) = python() else {
-        eprintln!("SKIPPED: no Python with pymavlink (set SHOAL_INTEROP_PYTHON; .ci/run does)");
-        return Ok(());
-    };
+    let py = shoal_interop::python()?;
     let port = free_port()?;
     let script = concat!(
         env!("CARGO_MANIFEST_DIR"),

@@ -37,18 +37,10 @@ pub const CAGES_FLEET_QUICK: [&str; 6] = [
     "ldiw-pso",
 ];
 
-/// The Python interpreter of the interop tests: `$SHOAL_INTEROP_PYTHON` (CI sets it to a venv
-/// with eclipse-zenoh 1.10.2: then a missing package is a failure); without it, `python3` if it
-/// can import `zenoh`; `None` otherwise (the test says SKIPPED).
-pub fn interop_python() -> Option<String> {
-    if let Ok(p) = std::env::var("SHOAL_INTEROP_PYTHON") {
-        return Some(p);
-    }
-    let ok = Command::new("python3")
-        .args(["-c", "import zenoh"])
-        .output()
-        .is_ok_and(|o| o.status.success());
-    ok.then(|| "python3".to_string())
+/// The Python interpreter of the interop tests ([`shoal_interop::python`]: `$SHOAL_INTEROP_PYTHON`,
+/// else a venv with the pinned packages made on first use); an error fails the test.
+pub fn interop_python() -> Result<String, String> {
+    shoal_interop::python()
 }
 
 /// The JSON file at `path` (a `plan.json`, `execution.json`, …); an error names the file.
