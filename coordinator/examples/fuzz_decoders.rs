@@ -117,6 +117,7 @@ fn targets() -> Vec<Target> {
             revision: 2,
             silent_s: 0.4,
             lost: false,
+            command: None,
         }],
         current_min_separation_m: Some(120.0),
         current_pair: Some(["auv1".into(), "auv2".into()]),

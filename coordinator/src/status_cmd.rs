@@ -3,6 +3,7 @@
 
 use std::time::Duration;
 
+use shoal_common::execution::CommandState;
 use shoal_common::wire::open::FleetStatus;
 use shoal_common::wire::topics::{self, OpenKey};
 use shoal_common::wire::{codec, session};
@@ -128,6 +129,14 @@ pub fn table(s: &FleetStatus) -> String {
             None => ([None; 3], "–".into()),
         };
         let status = if v.lost { "LOST".to_string() } else { status };
+        // A command the vehicle did not take: its status says what it does instead.
+        let failed = v.command.as_ref().filter(|c| {
+            matches!(c.state, CommandState::Failed | CommandState::GaveUp)
+        });
+        let status = match failed {
+            Some(c) => format!("{status} ({} failed)", c.command.name()),
+            None => status,
+        };
         let done = v
             .progress
             .map_or("–".into(), |p| format!("{:.0}%", 100.0 * p.fraction));
@@ -176,6 +185,7 @@ mod tests {
             revision: 0,
             silent_s: 0.0,
             lost: false,
+            command: None,
         };
         let state = VehicleState {
             t_s: 10.0,
@@ -219,5 +229,16 @@ mod tests {
             ["auv1", "100", "201", "-30", "25%", "1.3", "400", "underway", "0"]
         );
         assert_eq!(cells(3), ["auv2", "–", "–", "–", "–", "–", "–", "–", "0"]);
+        // A hold the vehicle refused shows beside what it does.
+        let mut refused = status.clone();
+        refused.vehicles[0].command = Some(shoal_common::execution::CommandReport {
+            command: shoal_common::execution::VehicleCommand::Hold,
+            state: CommandState::Failed,
+            detail: "DENIED".into(),
+            given_s: 9.0,
+        });
+        let text = table(&refused);
+        let line = text.lines().nth(2).unwrap_or_default();
+        assert!(line.contains("underway (hold failed)"), "{text}");
     }
 }

@@ -155,6 +155,7 @@ fn fleet_status(t: &Telemetry) -> FleetStatus {
             revision: t.revision,
             silent_s: 0.5,
             lost: false,
+            command: None,
         }],
         current_min_separation_m: None,
         current_pair: None,

@@ -56,6 +56,9 @@ pub struct VehicleStatusRow {
     pub revision: u32,
     /// Seconds (wall) since its last report.
     pub silent_s: f64,
+    /// Its latest hold, stop or upload and what the vehicle made of it, as it reported.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub command: Option<CommandReport>,
     /// Lost: silent longer than the mission allows.
     pub lost: bool,
 }

@@ -280,6 +280,7 @@ impl Fleet {
                     revision: v.revision,
                     silent_s: v.heard.map_or(f64::INFINITY, |h| h.elapsed().as_secs_f64()),
                     lost: v.lost,
+                    command: v.last.as_ref().and_then(|t| t.command.clone()),
                 })
                 .collect(),
             current_min_separation_m: current.map(|c| c.2),
