@@ -130,9 +130,10 @@ pub fn table(s: &FleetStatus) -> String {
         };
         let status = if v.lost { "LOST".to_string() } else { status };
         // A command the vehicle did not take: its status says what it does instead.
-        let failed = v.command.as_ref().filter(|c| {
-            matches!(c.state, CommandState::Failed | CommandState::GaveUp)
-        });
+        let failed = v
+            .command
+            .as_ref()
+            .filter(|c| matches!(c.state, CommandState::Failed | CommandState::GaveUp));
         let status = match failed {
             Some(c) => format!("{status} ({} failed)", c.command.name()),
             None => status,

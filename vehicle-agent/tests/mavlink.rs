@@ -15,7 +15,7 @@ use std::time::{Duration, Instant};
 use clap::Parser;
 use mavlink::dialects::common::{self as mav, MavCmd, MavMessage as M};
 use mavlink::{Connectable, MavConnection, MavHeader, UdpConfig, UdpMode};
-use shoal_agent::link::mavlink::{mission_items, AutopilotChoice, MavlinkLink, Profile};
+use shoal_agent::link::mavlink::{mission_items, AutopilotChoice, MavlinkLink, Placement, Profile};
 use shoal_agent::link::{GeoOrigin, LinkError, LinkOutcome, MavlinkSettings, VehicleLink};
 use shoal_agent::AgentArgs;
 use shoal_common::execution::{CommandState, VehicleCommand, VehicleStatus};
@@ -59,7 +59,7 @@ fn settings(port: u16, timeout_ms: u64, retries: u32) -> MavlinkSettings {
 
 /// The link to the vehicle at `port`, without a geofence.
 fn connect(settings: &MavlinkSettings) -> Result<MavlinkLink, LinkError> {
-    MavlinkLink::connect(settings, ORIGIN, None)
+    MavlinkLink::connect(settings, Placement::at(ORIGIN))
 }
 
 /// Collects outcomes until `command`'s final one (10 s at most); returns them all.
@@ -266,7 +266,9 @@ fn position_at(p: [f64; 3], v_ned_cm: [i16; 3], hdg_cdeg: u16) -> mav::GLOBAL_PO
 #[test]
 fn upload_survives_lost_messages_then_position_arrival_and_hold_come_through() -> TestResult {
     let mock = Mock::start(Behaviour::Lossy)?;
-    let mut link = connect(&settings(mock.port, 200, 5))?.with_surface(Some(0.0));
+    let mut place = Placement::at(ORIGIN);
+    place.surface_z = Some(0.0);
+    let mut link = MavlinkLink::connect(&settings(mock.port, 200, 5), place)?;
     let early = link.state(0.0);
     assert!(matches!(early, Err(LinkError::Timeout(_))), "{early:?}");
 
@@ -287,7 +289,7 @@ fn upload_survives_lost_messages_then_position_arrival_and_hold_come_through() -
             b.counts, 2,
             "MISSION_COUNT sent again after the first was not answered"
         );
-        let want = mission_items(&plan(), &ORIGIN, None, (1, 1), Profile::Generic).items;
+        let want = mission_items(&plan(), &ORIGIN, None, (1, 1), (Profile::Generic, 0.0)).items;
         assert_eq!(b.items.len(), 4);
         for (got, want) in b.items.iter().zip(&want) {
             assert_eq!(
@@ -552,7 +554,7 @@ fn pymavlink_as_the_vehicle_takes_the_mission_reports_arrival_and_stops() -> Tes
     let out: Vec<String> = lines.iter().collect(); // up to the end of its stdout
     assert!(status.success(), "peer: {status}; stdout: {out:#?}");
     let items: Vec<&String> = out.iter().filter(|l| l.contains("\"item\"")).collect();
-    let want = mission_items(&plan(), &ORIGIN, None, (1, 1), Profile::Generic).items;
+    let want = mission_items(&plan(), &ORIGIN, None, (1, 1), (Profile::Generic, 0.0)).items;
     assert_eq!(items.len(), want.len(), "{out:#?}");
     for (line, w) in items.iter().zip(&want) {
         let got = ["seq", "command", "x", "y", "z", "param2"].map(|k| field(line, k));

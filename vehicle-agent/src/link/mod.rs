@@ -295,9 +295,12 @@ pub fn open(
                 bounds: scenario.bounds.clone(),
                 obstacles: scenario.obstacles.clone(),
             });
-            Ok(Box::new(
-                mavlink::MavlinkLink::connect(settings, origin, fence)?.with_surface(surface),
-            ))
+            let place = mavlink::Placement {
+                origin,
+                fence,
+                surface_z: surface,
+            };
+            Ok(Box::new(mavlink::MavlinkLink::connect(settings, place)?))
         }
     }
 }

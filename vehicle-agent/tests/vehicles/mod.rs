@@ -6,9 +6,7 @@
 //!   (`tests/python/ardupilot_vehicle.py`).
 //!
 //! Both move in real time along the mission they are given (`tests/python/vehicle_kinematics.py`).
-//! The interpreter is `$SHOAL_INTEROP_PYTHON` (CI sets it to a venv with mavsdk==4.1.0 and
-//! pymavlink==2.4.50: then a missing package is a failure); without it, `python3` is used if it
-//! imports the vehicle's package, and [`Vehicle::spawn`] says SKIPPED and returns `None`.
+//! The interpreter comes from [`shoal_interop::python`] (a venv with the pinned packages).
 //!
 //! A test is a few lines: spawn a vehicle at a plan's start, connect a link to it, upload, then
 //! [`follow`] the link's states and read the vehicle's own account ([`Vehicle::wait_for`],
@@ -26,9 +24,9 @@ use std::sync::{Arc, Mutex, PoisonError};
 use std::time::{Duration, Instant};
 
 use serde_json::Value;
-use shoal_agent::link::mavlink::MavlinkLink;
-use shoal_agent::link::{GeoOrigin, MavlinkSettings, VehicleLink};
-use shoal_common::execution::VehicleState;
+use shoal_agent::link::mavlink::{MavlinkLink, Placement};
+use shoal_agent::link::{GeoOrigin, LinkOutcome, MavlinkSettings, VehicleLink};
+use shoal_common::execution::{VehicleCommand, VehicleState};
 use shoal_common::trajectory::Trajectory;
 
 pub type TestResult = Result<(), Box<dyn Error>>;
@@ -62,17 +60,6 @@ impl Kind {
     }
 }
 
-/// The interpreter for `kind`, if there is one.
-pub fn python(kind: Kind) -> Option<String> {
-    if let Ok(p) = std::env::var("SHOAL_INTEROP_PYTHON") {
-        return Some(p);
-    }
-    let import = format!("import {}", kind.package());
-    let ok = Command::new("python3").args(["-c", &import]).output();
-    ok.is_ok_and(|o| o.status.success())
-        .then(|| "python3".to_string())
-}
-
 /// A free UDP port on loopback (bound, read, released).
 pub fn free_port() -> Result<u16, std::io::Error> {
     Ok(UdpSocket::bind("127.0.0.1:0")?.local_addr()?.port())
@@ -99,15 +86,9 @@ pub struct Vehicle {
 
 impl Vehicle {
     /// Starts `kind` on a free port with `args` (after the port), and waits for its `listening`
-    /// line; `None` (and SKIPPED on stderr) when no Python can run it.
-    pub fn spawn(kind: Kind, args: &[&str]) -> Result<Option<Vehicle>, Box<dyn Error>> {
-        let Some(py) = python(kind) else {
-            eprintln!(
-                "SKIPPED: no Python with {} (set SHOAL_INTEROP_PYTHON; .ci/run does)",
-                kind.package()
-            );
-            return Ok(None);
-        };
+    /// line.
+    pub fn spawn(kind: Kind, args: &[&str]) -> Result<Vehicle, Box<dyn Error>> {
+        let py = shoal_interop::python()?;
         let port = free_port()?;
         let script = format!(
             "{}/../tests/python/{}",
@@ -153,13 +134,14 @@ impl Vehicle {
             stderr: log,
         };
         vehicle.wait_for("listening", Duration::from_secs(20))?;
-        Ok(Some(vehicle))
+        Ok(vehicle)
     }
 
     /// Link settings for this vehicle: `udpout:` to its port, [`ORIGIN`], replies awaited
     /// `timeout_ms` and resent `retries` times.
     pub fn settings(&self, timeout_ms: u64, retries: u32) -> MavlinkSettings {
-        let mut s = MavlinkSettings::new(format!("udpout:127.0.0.1:{}", self.port), ORIGIN);
+        let address = format!("udpout:127.0.0.1:{}", self.port);
+        let mut s = MavlinkSettings::new(address, Some(ORIGIN));
         (s.timeout, s.retries) = (Duration::from_millis(timeout_ms), retries);
         s
     }
@@ -258,10 +240,21 @@ pub fn num(event: &Value, key: &str) -> Option<f64> {
     event.get(key).and_then(Value::as_f64)
 }
 
-/// Connects a link to `vehicle` and waits (5 s) for its first position.
+/// Connects a link to `vehicle` (at [`ORIGIN`], no geofence) and waits (5 s) for its first
+/// position.
 pub fn connect(vehicle: &Vehicle, timeout_ms: u64, retries: u32) -> Result<MavlinkLink, String> {
-    let mut link =
-        MavlinkLink::connect(&vehicle.settings(timeout_ms, retries)).map_err(|e| e.to_string())?;
+    connect_placed(vehicle, timeout_ms, retries, Placement::at(ORIGIN))
+}
+
+/// [`connect`] for a mission placed as `place` says.
+pub fn connect_placed(
+    vehicle: &Vehicle,
+    timeout_ms: u64,
+    retries: u32,
+    place: Placement,
+) -> Result<MavlinkLink, String> {
+    let settings = vehicle.settings(timeout_ms, retries);
+    let mut link = MavlinkLink::connect(&settings, place).map_err(|e| e.to_string())?;
     let deadline = Instant::now() + Duration::from_secs(5);
     while link.state(0.0).is_err() {
         if Instant::now() > deadline {
@@ -316,4 +309,28 @@ pub fn worst_error(plan: &Trajectory, states: &[VehicleState]) -> Option<(f64, V
 /// The distance between two scenario points, metres.
 pub fn distance(a: [f64; 3], b: [f64; 3]) -> f64 {
     (0..3).map(|i| (a[i] - b[i]).powi(2)).sum::<f64>().sqrt()
+}
+
+/// Collects the link's outcomes until `command`'s final one (10 s at most): every outcome with
+/// the seconds after `asked` it was collected at.
+pub fn settle(
+    link: &mut MavlinkLink,
+    command: VehicleCommand,
+    asked: Instant,
+) -> Result<Vec<(f64, LinkOutcome)>, String> {
+    let mut seen = Vec::new();
+    loop {
+        let now = asked.elapsed().as_secs_f64();
+        seen.extend(link.outcomes().into_iter().map(|o| (now, o)));
+        if seen
+            .iter()
+            .any(|(_, o)| o.command == command && o.is_final())
+        {
+            return Ok(seen);
+        }
+        if now > 10.0 {
+            return Err(format!("no final outcome of {command:?}: {seen:?}"));
+        }
+        std::thread::sleep(Duration::from_millis(10));
+    }
 }

@@ -95,6 +95,9 @@ pub struct Commander {
     pub fence_taken: Option<bool>,
     /// The vehicle's autopilot family, once known.
     pub profile: Option<Profile>,
+    /// The scenario's surface, AMSL metres (an AUV's), where an ArduPilot home is taken to be
+    /// until the vehicle's own position says.
+    pub surface_amsl: Option<f64>,
 }
 
 impl Commander {
@@ -145,6 +148,18 @@ impl Commander {
             }
             std::thread::sleep(READ_TICK);
         }
+    }
+
+    /// The altitude of home, AMSL metres, for relative frames: the vehicle's own (its
+    /// GLOBAL_POSITION_INT carries both its AMSL and its above-home altitude), else the
+    /// scenario's surface, else sea level.
+    fn home_amsl(&self) -> f64 {
+        let latest = self.shared.latest();
+        let own = latest
+            .global
+            .as_ref()
+            .map(|g| f64::from(g.alt - g.relative_alt) / 1e3);
+        own.or(self.surface_amsl).unwrap_or(0.0)
     }
 
     fn target(&self) -> (u8, u8) {
@@ -355,7 +370,8 @@ impl Commander {
 
     fn upload(&mut self, generation: u64, plan: &Trajectory, after_t: Option<f64>) {
         let profile = self.profile(HEARTBEAT_WAIT);
-        let items = items::mission_items(plan, &self.origin, after_t, self.target(), profile);
+        let frame = (profile, self.home_amsl());
+        let items = items::mission_items(plan, &self.origin, after_t, self.target(), frame);
         let sent = self
             .send_fence(plan, generation)
             .and_then(|()| self.send_mission(&items, generation));
@@ -424,7 +440,7 @@ impl Commander {
                 Effect::None,
             );
         };
-        let items = items::fallback_items(here, self.target(), profile);
+        let items = items::fallback_items(here, self.target(), (profile, self.home_amsl()));
         match self.send_mission(&items, generation) {
             Ok(detail) => {
                 let [lat, lon, alt] = here;

@@ -73,6 +73,23 @@ impl Profile {
         }
     }
 
+    /// The frame of a waypoint at AMSL altitude `amsl`, and its altitude in it. ArduSub runs
+    /// waypoints only relative to home (its home is at the surface, so depths are negative:
+    /// "BAD NAV AltFrame" otherwise, `Sub::start_command`), hence
+    /// MAV_FRAME_GLOBAL_RELATIVE_ALT_INT above `home_amsl` for ArduPilot; the others take
+    /// MAV_FRAME_GLOBAL_INT, AMSL — deprecated (2024) for its synonym MAV_FRAME_GLOBAL, but the
+    /// one every autopilot in the field reads as "int lat/lon, AMSL altitude".
+    pub fn altitude(self, amsl: f64, home_amsl: f64) -> (MavFrame, f64) {
+        #[allow(deprecated)]
+        match self {
+            Profile::ArduPilot(_) => (
+                MavFrame::MAV_FRAME_GLOBAL_RELATIVE_ALT_INT,
+                amsl - home_amsl,
+            ),
+            _ => (MavFrame::MAV_FRAME_GLOBAL_INT, amsl),
+        }
+    }
+
     /// Sequence number of the first item that is ours (ArduPilot keeps home at 0).
     pub fn first_item(self) -> u16 {
         u16::from(matches!(self, Profile::ArduPilot(_)))
@@ -130,13 +147,14 @@ pub struct HoldStep {
     pub params: [f32; 7],
 }
 
-/// A NAV_WAYPOINT at lat, lon (degrees) and AMSL altitude (metres), held `hold_s` seconds.
-fn waypoint(lat: f64, lon: f64, alt: f64, hold_s: f32) -> mav::MISSION_ITEM_INT_DATA {
+/// A NAV_WAYPOINT at lat, lon (degrees) and an altitude in `frame` (metres), held `hold_s`.
+fn waypoint(
+    lat: f64,
+    lon: f64,
+    (frame, alt): (MavFrame, f64),
+    hold_s: f32,
+) -> mav::MISSION_ITEM_INT_DATA {
     let mut wp = mav::MISSION_ITEM_INT_DATA::default();
-    // MAV_FRAME_GLOBAL_INT is deprecated (2024) for its synonym MAV_FRAME_GLOBAL, but it is the
-    // one every autopilot in the field reads as "int lat/lon, AMSL altitude".
-    #[allow(deprecated)]
-    let frame = MavFrame::MAV_FRAME_GLOBAL_INT;
     (wp.command, wp.frame) = (MavCmd::MAV_CMD_NAV_WAYPOINT, frame);
     (wp.param1, wp.param4) = (hold_s, f32::NAN); // yaw NaN: the vehicle's choice
     (wp.x, wp.y, wp.z) = (e7(lat), e7(lon), alt as f32);
@@ -193,20 +211,20 @@ impl Items {
     }
 }
 
-/// The mission items of `plan` for vehicle `target` (system, component) under `profile`: the
-/// legs ending after mission time `after_t` (all without it), so that a replan does not send
-/// the vehicle back to the plan's start; a plan of one sample (or whose legs are all over) is
-/// one waypoint.
+/// The mission items of `plan` for vehicle `target` (system, component) under `profile`
+/// (`home_amsl`: the home altitude of relative frames): the legs ending after mission time
+/// `after_t` (all without it), so that a replan does not send the vehicle back to the plan's
+/// start; a plan of one sample (or whose legs are all over) is one waypoint.
 pub fn mission_items(
     plan: &Trajectory,
     origin: &GeoOrigin,
     after_t: Option<f64>,
     target: (u8, u8),
-    profile: Profile,
+    (profile, home_amsl): (Profile, f64),
 ) -> Items {
     let at = |p: [f64; 3], hold_s: f32| {
         let [lat, lon, alt] = origin.to_geodetic(p);
-        waypoint(lat, lon, alt, hold_s)
+        waypoint(lat, lon, profile.altitude(alt, home_amsl), hold_s)
     };
     let mut items = Vec::new();
     if let (Profile::ArduPilot(_), Some(p)) = (profile, plan.points.first()) {
@@ -237,8 +255,13 @@ pub fn mission_items(
 /// The fallback that every MissionRaw implementation accepts when a hold is refused or
 /// unanswered: a mission whose only waypoint is where the vehicle is (lat, lon in degrees,
 /// AMSL altitude in metres), held for [`FALLBACK_HOLD_S`].
-pub fn fallback_items(here: [f64; 3], target: (u8, u8), profile: Profile) -> Items {
+pub fn fallback_items(
+    here: [f64; 3],
+    target: (u8, u8),
+    (profile, home_amsl): (Profile, f64),
+) -> Items {
     let [lat, lon, alt] = here;
+    let alt = profile.altitude(alt, home_amsl);
     let mut items = Vec::new();
     if matches!(profile, Profile::ArduPilot(_)) {
         items.push(waypoint(lat, lon, alt, 0.0)); // home's place

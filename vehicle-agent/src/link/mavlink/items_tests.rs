@@ -26,7 +26,7 @@ fn plan() -> Trajectory {
 
 #[test]
 fn each_leg_is_its_horizontal_speed_then_its_waypoint() {
-    let m = mission_items(&plan(), &ORIGIN, None, (7, 1), Profile::Generic);
+    let m = mission_items(&plan(), &ORIGIN, None, (7, 1), (Profile::Generic, 0.0));
     let commands: Vec<_> = m.items.iter().map(|i| i.command).collect();
     assert_eq!(commands, [SPEED, WP, SPEED, WP, SPEED, WP]);
     assert_eq!((m.first, m.last()), (0, 5));
@@ -56,8 +56,14 @@ fn each_leg_is_its_horizontal_speed_then_its_waypoint() {
 
 #[test]
 fn a_replan_keeps_only_the_legs_still_ahead() {
-    let all = mission_items(&plan(), &ORIGIN, None, (7, 1), Profile::Generic);
-    let later = mission_items(&plan(), &ORIGIN, Some(150.0), (7, 1), Profile::Generic);
+    let all = mission_items(&plan(), &ORIGIN, None, (7, 1), (Profile::Generic, 0.0));
+    let later = mission_items(
+        &plan(),
+        &ORIGIN,
+        Some(150.0),
+        (7, 1),
+        (Profile::Generic, 0.0),
+    );
     assert_eq!(later.items.len(), 4);
     let (a, b) = (&later.items[0], &later.items[1]);
     assert_eq!((a.seq, a.current, a.command), (0, 1, SPEED));
@@ -70,8 +76,8 @@ fn a_replan_keeps_only_the_legs_still_ahead() {
 #[test]
 fn ardupilot_gets_a_home_placeholder_and_the_first_speed_at_item_one() {
     let ardusub = Profile::ArduPilot(MavType::MAV_TYPE_SUBMARINE);
-    let m = mission_items(&plan(), &ORIGIN, None, (1, 1), ardusub);
-    let generic = mission_items(&plan(), &ORIGIN, None, (1, 1), Profile::Generic);
+    let m = mission_items(&plan(), &ORIGIN, None, (1, 1), (ardusub, 0.0));
+    let generic = mission_items(&plan(), &ORIGIN, None, (1, 1), (Profile::Generic, 0.0));
     assert_eq!(m.items.len(), generic.items.len() + 1);
     assert_eq!(
         (m.first, m.items[0].command, m.items[0].current),
@@ -80,6 +86,18 @@ fn ardupilot_gets_a_home_placeholder_and_the_first_speed_at_item_one() {
     // Item 1 is the first leg's speed, marked current: overwriting item 0 loses nothing.
     assert_eq!((m.items[1].command, m.items[1].current), (SPEED, 1));
     assert!(close(f64::from(m.items[1].param2), 1.5, 1e-6));
+    // Relative to home (ArduSub refuses AMSL waypoints), at the AMSL altitudes less home's.
+    #[allow(deprecated)]
+    let (relative, amsl) = (
+        MavFrame::MAV_FRAME_GLOBAL_RELATIVE_ALT_INT,
+        MavFrame::MAV_FRAME_GLOBAL_INT,
+    );
+    let high_home = mission_items(&plan(), &ORIGIN, None, (1, 1), (ardusub, 5.0));
+    assert_eq!(
+        (high_home.items[2].frame, high_home.items[2].z),
+        (relative, -15.0)
+    );
+    assert_eq!((generic.items[1].frame, generic.items[1].z), (amsl, -10.0));
     assert!(m
         .items
         .iter()
@@ -121,7 +139,7 @@ fn the_hold_ladder_follows_the_autopilot() {
 
 #[test]
 fn the_fallback_is_one_long_hold_where_the_vehicle_is() {
-    let m = fallback_items([43.01, 5.02, -25.0], (1, 1), Profile::Generic);
+    let m = fallback_items([43.01, 5.02, -25.0], (1, 1), (Profile::Generic, 0.0));
     assert_eq!((m.items.len(), m.first), (1, 0));
     let wp = &m.items[0];
     assert_eq!(
@@ -129,15 +147,16 @@ fn the_fallback_is_one_long_hold_where_the_vehicle_is() {
         (WP, 430_100_000, 50_200_000, -25.0)
     );
     assert_eq!(wp.param1, FALLBACK_HOLD_S);
-    let sub = fallback_items(
-        [43.01, 5.02, -25.0],
-        (1, 1),
-        Profile::ArduPilot(MavType::MAV_TYPE_SUBMARINE),
-    );
+    // ArduSub: behind home's placeholder, relative to a home 2 m above sea level.
+    let ardusub = Profile::ArduPilot(MavType::MAV_TYPE_SUBMARINE);
+    let sub = fallback_items([43.01, 5.02, -25.0], (1, 1), (ardusub, 2.0));
     assert_eq!(
         (sub.items.len(), sub.first, sub.items[1].param1),
         (2, 1, FALLBACK_HOLD_S)
     );
+    #[allow(deprecated)]
+    let relative = MavFrame::MAV_FRAME_GLOBAL_RELATIVE_ALT_INT;
+    assert_eq!((sub.items[1].frame, sub.items[1].z), (relative, -27.0));
 }
 
 fn obstacle(id: &str, kind: ObstacleKind, centre: [f64; 3], radius_m: f64) -> Obstacle {

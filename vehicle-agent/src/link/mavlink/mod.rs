@@ -13,8 +13,8 @@
 //! confirmed: Underway once it accepted a mission, Holding once it acknowledged a hold (or took
 //! the fallback mission that ends where it is), never what was merely asked. Arrival is
 //! whichever comes first of MISSION_ITEM_REACHED of the last item, MISSION_CURRENT saying the
-//! mission is complete (or on its last item with the vehicle at the goal), and the position
-//! standing at the goal — one lost UDP datagram cannot lose it.
+//! mission is complete (or past its last item), and the vehicle standing at the goal — one
+//! lost UDP datagram cannot lose it.
 //!
 //! Autopilot differences (item 0, hold commands, speed types, geofence) are in [`items`].
 
@@ -34,7 +34,8 @@ use shoal_common::execution::{VehicleCommand, VehicleState, VehicleStatus};
 use shoal_common::trajectory::Trajectory;
 
 use super::{GeoOrigin, LinkError, LinkOutcome, MavlinkSettings, VehicleLink};
-use commander::{Commander, Done, Effect, FenceSource, Job};
+pub use commander::FenceSource;
+use commander::{Commander, Done, Effect, Job};
 use reader::{Shared, READ_TICK};
 
 pub use items::{fence_items, mission_items, AutopilotChoice, Profile};
@@ -48,6 +49,29 @@ const STANDING_MPS: f64 = 0.3;
 fn wrap_deg(a: f64) -> f64 {
     let h = a.rem_euclid(360.0);
     h - if h > 180.0 { 360.0 } else { 0.0 }
+}
+
+/// Where a mission is on Earth, and what the vehicle should know of it.
+#[derive(Debug, Clone)]
+pub struct Placement {
+    /// The geodetic origin of the scenario frame.
+    pub origin: GeoOrigin,
+    /// The geofence uploaded with each mission as an onboard safety net, if any.
+    pub fence: Option<FenceSource>,
+    /// An AUV's surface (`bounds.max[2]`): depth is reported below it, and an ArduPilot
+    /// vehicle's home is taken there until its own position says where home is.
+    pub surface_z: Option<f64>,
+}
+
+impl Placement {
+    /// At `origin`, with no geofence and no surface.
+    pub fn at(origin: GeoOrigin) -> Placement {
+        Placement {
+            origin,
+            fence: None,
+            surface_z: None,
+        }
+    }
 }
 
 /// The mission the vehicle confirmed, as arrival detection needs it.
@@ -79,13 +103,13 @@ pub struct MavlinkLink {
 
 impl MavlinkLink {
     /// Opens the connection and starts the reader and commander threads (no vehicle needs to
-    /// answer yet). `origin` places the scenario frame; `fence`, if any, is uploaded with each
-    /// mission as an onboard safety net.
-    pub fn connect(
-        settings: &MavlinkSettings,
-        origin: GeoOrigin,
-        fence: Option<FenceSource>,
-    ) -> Result<MavlinkLink, LinkError> {
+    /// answer yet), for a mission placed as `place` says.
+    pub fn connect(settings: &MavlinkSettings, place: Placement) -> Result<MavlinkLink, LinkError> {
+        let Placement {
+            origin,
+            fence,
+            surface_z,
+        } = place;
         let io = |e: std::io::Error| LinkError::Io(format!("{}: {e}", settings.address));
         let udp = match ConnectionAddress::parse_address(&settings.address) {
             Ok(ConnectionAddress::Udp(udp)) => udp,
@@ -121,6 +145,7 @@ impl MavlinkLink {
             fence,
             fence_taken: None,
             profile: None,
+            surface_amsl: surface_z.map(|z| origin.alt_m + z),
         };
         let commander = std::thread::Builder::new()
             .name("mavlink-commander".into())
@@ -135,7 +160,7 @@ impl MavlinkLink {
             confirmed: VehicleStatus::Idle,
             mission: None,
             outcomes: Vec::new(),
-            surface_z: None,
+            surface_z,
             last_now: None,
             arrived_s: None,
             heading_deg: 0.0,
@@ -145,12 +170,6 @@ impl MavlinkLink {
         let mut link = link;
         link.threads.push(commander);
         Ok(link)
-    }
-
-    /// Reports `depth_m = surface_z − z` (an AUV below the scenario's surface, `bounds.max[2]`).
-    pub fn with_surface(mut self, surface_z: Option<f64>) -> MavlinkLink {
-        self.surface_z = surface_z;
-        self
     }
 
     /// Messages skipped: malformed frames, messages from other systems, and replies that fit
@@ -205,9 +224,11 @@ impl MavlinkLink {
             .sum::<f64>()
             .sqrt();
         let at_goal = gap <= self.settings.arrival_radius_m;
-        let current = latest.current.is_some_and(|(seq, complete, at)| {
-            after(at) && (complete || (seq == mission.last_item && at_goal))
-        });
+        // Past the last item (MAVSDK's MissionRawServer counts on to the item count), or the
+        // mission state says complete (MAVLink 2 extension).
+        let current = latest
+            .current
+            .is_some_and(|(seq, complete, at)| after(at) && (complete || seq > mission.last_item));
         let speed = v.iter().map(|x| x * x).sum::<f64>().sqrt();
         let standing =
             at_goal && speed < STANDING_MPS && mission.at.elapsed() > Duration::from_secs(1);
