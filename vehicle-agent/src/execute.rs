@@ -130,9 +130,9 @@ impl Driver<'_> {
         Ok(())
     }
 
-    /// Takes what the vehicle made of the commands; reports at once when that changed.
+    /// Takes what the vehicle made of the commands, reporting each change at once (a refusal
+    /// and the fallback's confirmation a few milliseconds later are two reports).
     fn collect(&mut self) {
-        let mut changed = false;
         for outcome in self.link.outcomes() {
             let Some(report) = self
                 .command
@@ -153,9 +153,6 @@ impl Driver<'_> {
                 outcome.detail
             );
             (report.state, report.detail) = (outcome.state, outcome.detail);
-            changed = true;
-        }
-        if changed {
             self.report();
         }
     }
@@ -321,7 +318,7 @@ pub fn run(
             let silent = idle.as_secs_f64();
             break format!("arrived; the coordinator was silent for {silent:.0} s");
         }
-        match inbox.recv_timeout(wait.min(Duration::from_millis(100))) {
+        match inbox.recv_timeout(wait.min(Duration::from_millis(50))) {
             Ok(m) => {
                 heard = Instant::now();
                 if let Some(end) = d.obey(m) {

@@ -461,3 +461,84 @@ fn the_vehicles_kinematics_pass_their_self_test() -> TestResult {
     assert!(out.status.success() && text.contains("ok"), "{text}");
     Ok(())
 }
+
+/// The agent's whole execution loop against MAVSDK ignoring the pause: its reports never stop
+/// (the coordinator declares a vehicle lost after 3 s of silence), the hold's failure is in a
+/// report within 1 s of the order, and a later report says the fallback holds the vehicle.
+#[test]
+fn the_agent_reports_an_ignored_hold_within_a_second_and_never_goes_silent() -> TestResult {
+    use shoal_agent::execute::{self, Order};
+    use shoal_common::wire::coordinator_to_agent::CoordinatorToAgent;
+    use shoal_common::wire::open::Telemetry;
+    use shoal_common::wire::WireTrajectory;
+    use std::sync::atomic::AtomicBool;
+    use std::sync::{mpsc, Mutex};
+
+    let plan = short_plan();
+    let vehicle = at_start(Kind::Mavsdk, &plan, &["--hold", "ignore"])?;
+    let mut link = connect(&vehicle, 400, 2)?;
+    let scenario = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../scenarios/amp-pso-1.toml"
+    ))?;
+    let wire = WireTrajectory::new("auv1", &plan);
+    let epoch = shoal_common::execution::unix_us() / 1000;
+    let order = Order::new("m", "auv1", &scenario, &wire, epoch, 1.0, 5.0, 1)?;
+    let (tx, inbox) = mpsc::channel();
+    let reports = Mutex::new(Vec::<(Instant, Telemetry)>::new());
+    let publish = |t: &Telemetry| {
+        if let Ok(mut r) = reports.lock() {
+            r.push((Instant::now(), t.clone()));
+        }
+    };
+    let (stop, idle) = (AtomicBool::new(false), Duration::from_secs(60));
+    let ordered = std::thread::scope(|s| {
+        let feeder = s.spawn(move || {
+            std::thread::sleep(Duration::from_secs(6));
+            let at = Instant::now();
+            let hold = CoordinatorToAgent::Hold {
+                mission: "m".into(),
+                vehicle: "auv1".into(),
+                reason: "test".into(),
+            };
+            let _ = tx.send(hold);
+            std::thread::sleep(Duration::from_secs(4));
+            let end = CoordinatorToAgent::Stop {
+                mission: "m".into(),
+                reason: "test over".into(),
+            };
+            let _ = tx.send(end);
+            at
+        });
+        let report = execute::run(order, &mut link, &inbox, &publish, &stop, idle);
+        eprintln!("execution: {}", report.outcome);
+        feeder.join()
+    });
+    let ordered = ordered.map_err(|_| "the feeder panicked")?;
+    let reports = reports.into_inner().map_err(|e| e.to_string())?;
+    let gaps = reports.windows(2).map(|w| (w[1].0 - w[0].0).as_secs_f64());
+    let worst = gaps.fold(0.0, f64::max);
+    assert!(worst < 1.0, "a report gap of {worst:.2} s");
+    let failed_at = reports.iter().find_map(|(at, t)| {
+        let c = t.command.as_ref()?;
+        (c.command == VehicleCommand::Hold && c.state == CommandState::Failed).then_some(*at)
+    });
+    let failed_after = failed_at.map(|at| (at - ordered).as_secs_f64());
+    assert!(
+        failed_after.is_some_and(|s| s < 1.0),
+        "hold failure reported after {failed_after:?} s"
+    );
+    let held = reports.iter().any(|(_, t)| {
+        t.state.status == VehicleStatus::Holding
+            && t.command
+                .as_ref()
+                .is_some_and(|c| c.state == CommandState::Confirmed)
+    });
+    assert!(held, "no report of the fallback holding the vehicle");
+    eprintln!(
+        "agent: {} reports, worst gap {worst:.2} s, hold failure reported {:.2} s after the order",
+        reports.len(),
+        failed_after.unwrap_or(f64::NAN)
+    );
+    Ok(())
+}

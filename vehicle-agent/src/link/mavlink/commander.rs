@@ -22,7 +22,7 @@ use super::reader::{Conn, Shared, READ_TICK};
 const HEARTBEAT_WAIT: Duration = Duration::from_secs(3);
 /// How long each hold step waits for its COMMAND_ACK: short, so that a refused or unanswered
 /// hold is known (and reported) within a second, two tries included.
-pub const HOLD_WAIT: Duration = Duration::from_millis(400);
+pub const HOLD_WAIT: Duration = Duration::from_millis(300);
 /// Tries of each hold step.
 const HOLD_TRIES: u32 = 2;
 
@@ -445,7 +445,8 @@ impl Commander {
             Ok(detail) => {
                 let [lat, lon, alt] = here;
                 let how = format!(
-                    "by a mission ending where it is ({lat:.7}, {lon:.7}, {alt:.1} m): {detail}"
+                    "by a mission ending where it is ({lat:.7}, {lon:.7}, {alt:.1} m): {detail}; after {}",
+                    failures.join("; ")
                 );
                 self.report(command, CommandState::Confirmed, how, Effect::Still(status))
             }
