@@ -79,7 +79,8 @@ impl GeoOrigin {
     /// The first out-of-range value: its field name (as in a scenario's `[origin]` table), the
     /// value and why it is refused.
     pub(crate) fn first_bad(&self) -> Option<(&'static str, f64, String)> {
-        if !(self.lat_deg.abs() <= MAX_ABS_LAT_DEG) {
+        // Written as ranges so that NaN is refused too.
+        if !(-MAX_ABS_LAT_DEG..=MAX_ABS_LAT_DEG).contains(&self.lat_deg) {
             return Some((
                 "lat_deg",
                 self.lat_deg,
@@ -88,7 +89,7 @@ impl GeoOrigin {
                 ),
             ));
         }
-        if !(self.lon_deg.abs() <= 180.0) {
+        if !(-180.0..=180.0).contains(&self.lon_deg) {
             return Some((
                 "lon_deg",
                 self.lon_deg,
