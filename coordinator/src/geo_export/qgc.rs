@@ -49,12 +49,14 @@ pub struct VehicleFile {
     pub unfenced: Vec<String>,
 }
 
-/// One `.plan` per vehicle of the plan, in plan order.
+/// One `.plan` per vehicle of the plan, in plan order (a vehicle without a trajectory has no
+/// mission: [`super::check`] refuses such a plan).
 pub fn vehicle_files(input: &ExportInput) -> Vec<VehicleFile> {
     input
         .plan
         .vehicles
         .iter()
+        .filter(|v| !v.trajectory.is_empty())
         .map(|v| vehicle_file(input, v))
         .collect()
 }
