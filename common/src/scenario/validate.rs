@@ -226,8 +226,7 @@ impl Scenario {
             return Err(bad(format!("origin.{field}"), value.to_string(), &reason));
         }
         let altitudes = crate::geo::ALT_RANGE_M;
-        for (i, name) in [(0, "min"), (1, "max")] {
-            let z = [self.bounds.min[2], self.bounds.max[2]][i];
+        for (name, z) in [("min", self.bounds.min[2]), ("max", self.bounds.max[2])] {
             let alt = o.alt_m + z;
             if !altitudes.contains(&alt) {
                 return Err(bad(
