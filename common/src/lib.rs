@@ -14,6 +14,7 @@ pub mod execution;
 #[cfg(test)]
 mod fixtures;
 pub mod fleet;
+pub mod geo;
 pub mod geometry;
 pub mod gridsearch;
 pub mod health;

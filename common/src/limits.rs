@@ -47,6 +47,10 @@ pub const MAX_QUEUED_MISSIONS: usize = 8;
 /// waypoints write 26 MB; the start record holds the scenario (at most 4 MB).
 pub const MAX_LOG_LINE_BYTES: usize = 64 << 20;
 
+/// Bytes of a `plan.json` read back by `export`: the trajectories take about 100 bytes per
+/// waypoint, so 256 vehicles of 1,000 waypoints are 26 MB, with room for the figures.
+pub const MAX_PLAN_BYTES: u64 = 64 << 20;
+
 /// Obstacles published on a running mission's obstacles key (each one can cost a replan of
 /// every vehicle); past it, further ones are dropped and counted.
 pub const MAX_PUBLISHED_OBSTACLES: usize = 256;

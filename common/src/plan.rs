@@ -384,6 +384,10 @@ pub struct Plan {
     /// Distributed runs only: how the mission went over the network.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub distributed: Option<DistributedFigures>,
+    /// The scenario's `[origin]`, which ties the trajectories' metres to WGS-84 (map exports,
+    /// MAVLink vehicles); absent when the scenario has none.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub origin: Option<crate::geo::GeoOrigin>,
 }
 
 /// What a distributed run adds to `plan.json`.

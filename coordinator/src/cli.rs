@@ -23,6 +23,9 @@ pub struct Cli {
 pub enum Command {
     /// Plan a scenario and write plan.json and plan.svg.
     Plan(PlanArgs),
+    /// Write a plan for maps (GeoJSON) or QGroundControl (.plan per vehicle), on WGS-84 through
+    /// the scenario's [origin].
+    Export(crate::export::ExportArgs),
     /// Compare the optimizers over several seeds (markdown table on stdout).
     Compare(crate::compare::CompareArgs),
     /// Write a random fleet scenario of any size (for scaling runs).

@@ -156,6 +156,7 @@ pub fn to_plan(scenario: &Scenario, problem: &EnergyProblem, run: RunResult) -> 
         fleet: assessment.fleet,
         convergence: run.convergence,
         distributed: None,
+        origin: scenario.origin,
     }
 }
 
@@ -192,5 +193,6 @@ pub(crate) fn unplannable(scenario: &Scenario, why: String) -> Plan {
         },
         convergence: Vec::new(),
         distributed: None,
+        origin: scenario.origin,
     }
 }

@@ -16,7 +16,9 @@ pub mod crawler_table;
 pub mod distributed;
 pub mod energy_planner;
 pub mod execute;
+pub mod export;
 pub mod generate;
+pub mod geo_export;
 pub mod keys;
 pub mod planner;
 pub mod replay;
@@ -64,6 +66,7 @@ pub fn default_log_filter(command: &Command) -> &'static str {
 pub fn run(command: Command, shutdown: Arc<AtomicBool>) -> anyhow::Result<i32> {
     match command {
         Command::Plan(args) => plan_command(&args, shutdown),
+        Command::Export(args) => export::command(&args),
         Command::Compare(args) => compare_command(&args, &shutdown),
         Command::BenchFunctions(args) => bench_functions::command(&args, &shutdown),
         Command::BenchEnergy(args) => bench_energy::command(&args, &shutdown),

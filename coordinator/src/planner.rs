@@ -183,6 +183,7 @@ pub fn to_plan(
         fleet: assessment.fleet,
         convergence: run.convergence,
         distributed: None,
+        origin: scenario.origin,
     }
 }
 

@@ -518,6 +518,7 @@ goal = [1000.0, 0.0, 50.0]
             fleet: a.fleet,
             convergence,
             distributed: None,
+            origin: s.origin,
         }
     }
 

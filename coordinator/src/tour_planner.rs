@@ -186,6 +186,7 @@ pub fn assemble(
         fleet: assessment.fleet,
         convergence: fleet_convergence(tours),
         distributed: None,
+        origin: scenario.origin,
     }
 }
 

@@ -106,6 +106,11 @@ pub struct Scenario {
     pub description: String,
     /// The box every waypoint must stay in; z is up and `max[2]` is the sea surface.
     pub bounds: Bounds,
+    /// Where the scenario is on the Earth: the WGS-84 position of its point (0, 0, 0), whose
+    /// `alt_m` is the altitude above mean sea level of z = 0. Absent: the scenario is only in
+    /// local metres (plans still work; map exports and MAVLink vehicles need an origin).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub origin: Option<crate::geo::GeoOrigin>,
     /// Spheres to avoid (hard) or to spend little time in (soft).
     #[serde(default)]
     pub obstacles: Vec<Obstacle>,

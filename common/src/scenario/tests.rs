@@ -442,3 +442,71 @@ fn a_scenario_file_over_the_size_limit_or_without_end_is_refused_when_read(
     }
     Ok(())
 }
+
+/// `[origin]` ties the scenario to WGS-84; it survives the TOML the coordinator sends its agents.
+#[test]
+fn an_origin_is_read_checked_and_written_back() -> Result<(), ScenarioError> {
+    let with = |origin: &str| GOOD.replace("[[obstacles]]", &format!("{origin}\n[[obstacles]]"));
+    let s = parse(&with(
+        "[origin]\nlat_deg = 31.5\nlon_deg = -22.0\nalt_m = -100.0",
+    ))?;
+    assert_eq!(
+        s.origin,
+        Some(crate::geo::GeoOrigin::new(31.5, -22.0, -100.0))
+    );
+    let Ok(text) = toml::to_string(&s) else {
+        panic!("the scenario does not serialise");
+    };
+    assert_eq!(parse(&text)?, s);
+    assert_eq!(parse(GOOD)?.origin, None);
+    let cases = [
+        (
+            "[origin]\nlat_deg = 95.0\nlon_deg = 0.0\nalt_m = 0.0",
+            "field `origin.lat_deg` = 95: must be a latitude in [-89, 89] degrees",
+        ),
+        (
+            "[origin]\nlat_deg = 0.0\nlon_deg = 181.0\nalt_m = 0.0",
+            "field `origin.lon_deg` = 181: must be a longitude in [-180, 180] degrees",
+        ),
+        (
+            "[origin]\nlat_deg = 0.0\nlon_deg = 0.0\nalt_m = 8950.0",
+            "field `origin.alt_m` = 8950: puts bounds.max[2] = 100 at 9050 m above mean sea level",
+        ),
+        (
+            "[origin]\nlat_deg = 0.0\nlon_deg = 0.0\nalt_m = 0.0\ndepth = 1.0",
+            "unknown field `depth`",
+        ),
+    ];
+    for (origin, expected) in cases {
+        let msg = parse(&with(origin))
+            .err()
+            .map(|e| e.to_string())
+            .unwrap_or_default();
+        assert!(msg.starts_with("scenarios/x.toml: "), "{msg}");
+        assert!(msg.contains(expected), "{origin}: {msg}");
+    }
+    // 200 km of box east of an origin at 89°N reaches over the pole, 111 km away.
+    let wide = with("[origin]\nlat_deg = 89.0\nlon_deg = 0.0\nalt_m = -100.0").replace(
+        "max = [100.0, 100.0, 100.0]",
+        "max = [200000.0, 100.0, 100.0]",
+    );
+    let msg = parse(&wide)
+        .err()
+        .map(|e| e.to_string())
+        .unwrap_or_default();
+    assert!(msg.contains("field `origin.lat_deg` = 89: the scenario box reaches 200000 m from the origin, over the pole 110574 m away"), "{msg}");
+    Ok(())
+}
+
+/// Scenario 3 is placed at sea with its surface, z = 2000 m, at 0 m above mean sea level.
+#[test]
+fn scenario_3_lies_at_sea_with_its_surface_at_sea_level() -> Result<(), ScenarioError> {
+    let file = concat!(env!("CARGO_MANIFEST_DIR"), "/../scenarios/amp-pso-3.toml");
+    let s = Scenario::load(Path::new(file))?;
+    let Some(o) = s.origin else {
+        panic!("{file} has no [origin]");
+    };
+    assert_eq!(o.alt_m + s.bounds.max[2], 0.0);
+    assert!(o.check().is_ok());
+    Ok(())
+}

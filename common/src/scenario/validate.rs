@@ -24,6 +24,7 @@ impl Scenario {
             }
         }
         self.validate_counts(&bad)?;
+        self.validate_origin(&bad)?;
         let inside =
             |p: &[f64; 3]| (0..3).all(|a| p[a] >= self.bounds.min[a] && p[a] <= self.bounds.max[a]);
         for (i, o) in self.obstacles.iter().enumerate() {
@@ -209,6 +210,49 @@ impl Scenario {
                 "optimizer.algorithm".into(),
                 format!("{:?}", algorithm.as_str()),
                 "plans paths from a start to a goal, but this scenario has an [inspection] table: plan its tours with de-pso, ldiw-pso or lcpso",
+            ));
+        }
+        Ok(())
+    }
+
+    /// The `[origin]`: a position a tangent plane can hang from ([`crate::geo::GeoOrigin::check`]),
+    /// a box whose floor and top are altitudes on the Earth, and a box clear of the pole (where
+    /// east and north turn over).
+    fn validate_origin(&self, bad: Bad) -> Result<(), ScenarioError> {
+        let Some(o) = &self.origin else {
+            return Ok(());
+        };
+        if let Some((field, value, reason)) = o.first_bad() {
+            return Err(bad(format!("origin.{field}"), value.to_string(), &reason));
+        }
+        let altitudes = crate::geo::ALT_RANGE_M;
+        for (name, z) in [("min", self.bounds.min[2]), ("max", self.bounds.max[2])] {
+            let alt = o.alt_m + z;
+            if !altitudes.contains(&alt) {
+                return Err(bad(
+                    "origin.alt_m".into(),
+                    o.alt_m.to_string(),
+                    &format!(
+                        "puts bounds.{name}[2] = {z} at {alt} m above mean sea level, outside [{}, {}] m (below the deepest sea floor or above the highest summit)",
+                        altitudes.start(),
+                        altitudes.end()
+                    ),
+                ));
+            }
+        }
+        // The meridian distance to the nearer pole, at least (a degree of latitude is 110 574 m
+        // at the equator and longer towards the poles).
+        let to_pole = (90.0 - o.lat_deg.abs()) * 110_574.0;
+        let b = &self.bounds;
+        let reach = [b.min[0], b.max[0]]
+            .iter()
+            .flat_map(|x| [b.min[1], b.max[1]].map(|y| x.hypot(y)))
+            .fold(0.0, f64::max);
+        if reach >= to_pole {
+            return Err(bad(
+                "origin.lat_deg".into(),
+                o.lat_deg.to_string(),
+                &format!("the scenario box reaches {reach:.0} m from the origin, over the pole {to_pole:.0} m away"),
             ));
         }
         Ok(())

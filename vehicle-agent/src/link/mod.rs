@@ -180,68 +180,7 @@ pub fn mission_origin(
     }
 }
 
-/// Geodetic position of scenario point (0, 0, 0); [`mavlink`] converts between the two frames.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct GeoOrigin {
-    /// Latitude, degrees north.
-    pub lat_deg: f64,
-    /// Longitude, degrees east.
-    pub lon_deg: f64,
-    /// Altitude above mean sea level, metres.
-    pub alt_m: f64,
-}
-
-impl GeoOrigin {
-    /// The origin at `lat_deg`, `lon_deg` (degrees), `alt_m` (metres above mean sea level).
-    pub const fn new(lat_deg: f64, lon_deg: f64, alt_m: f64) -> GeoOrigin {
-        GeoOrigin {
-            lat_deg,
-            lon_deg,
-            alt_m,
-        }
-    }
-}
-
-impl GeoOrigin {
-    /// Scenario point `p` (x east, y north, z up) as [lat °, lon °, alt m].
-    pub fn to_geodetic(&self, p: [f64; 3]) -> [f64; 3] {
-        let r = 6_371_000.0;
-        let east = r * self.lat_deg.to_radians().cos();
-        let lat = self.lat_deg + (p[1] / r).to_degrees();
-        let lon = self.lon_deg + (p[0] / east).to_degrees();
-        [lat, lon, self.alt_m + p[2]]
-    }
-
-    /// WGS-84 lat °, lon °, alt m as a scenario point (x east, y north, z up).
-    pub fn to_local(&self, lat_deg: f64, lon_deg: f64, alt_m: f64) -> [f64; 3] {
-        let r = 6_371_000.0;
-        let east = r * self.lat_deg.to_radians().cos();
-        let x = (lon_deg - self.lon_deg).to_radians() * east;
-        [
-            x,
-            (lat_deg - self.lat_deg).to_radians() * r,
-            alt_m - self.alt_m,
-        ]
-    }
-}
-
-impl std::str::FromStr for GeoOrigin {
-    type Err = String;
-    /// `LAT,LON,ALT`: a latitude within 89° of the equator (the flat-earth approximation
-    /// divides by cos(lat)), a longitude in [−180, 180], a finite altitude.
-    fn from_str(s: &str) -> Result<GeoOrigin, String> {
-        let v: Vec<f64> = s.split(',').filter_map(|p| p.trim().parse().ok()).collect();
-        match v[..] {
-            [lat, lon, alt] if lat.abs() <= 89.0 && lon.abs() <= 180.0 && alt.is_finite() => {
-                Ok(GeoOrigin::new(lat, lon, alt))
-            }
-            _ => Err(format!(
-                "{s:?} is not LAT,LON,ALT (latitude in [-89, 89] and longitude in \
-                 [-180, 180] degrees, altitude in metres)"
-            )),
-        }
-    }
-}
+pub use shoal_common::geo::GeoOrigin;
 
 /// Reads `SYS,COMP`: the vehicle's MAVLink system id (not 0) and component id.
 pub fn parse_mavlink_target(s: &str) -> Result<(u8, u8), String> {
@@ -284,7 +223,7 @@ pub fn open(
                 .mavlink
                 .as_ref()
                 .ok_or_else(|| LinkError::Io("the mavlink link needs --mavlink-address".into()))?;
-            let origin = mission_origin(settings.origin, scenario_origin(scenario))?;
+            let origin = mission_origin(settings.origin, scenario.origin)?;
             // An AUV's depth is measured from the scenario's surface, as the simulator does.
             let surface = scenario
                 .vehicles
@@ -303,11 +242,6 @@ pub fn open(
             Ok(Box::new(mavlink::MavlinkLink::connect(settings, place)?))
         }
     }
-}
-
-/// The scenario's own geodetic origin.
-fn scenario_origin(_scenario: &Scenario) -> Option<GeoOrigin> {
-    None
 }
 
 #[cfg(test)]
