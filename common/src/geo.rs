@@ -1,6 +1,6 @@
 //! The scenario frame on the Earth: a scenario's local metres (x east, y north, z up) tied to
-//! WGS-84 latitude, longitude and height by the local east-north-up (ENU) tangent plane at a
-//! geodetic origin, the scenario point (0, 0, 0).
+//! WGS-84 latitude and longitude by the local east-north-up (ENU) tangent plane at a geodetic
+//! origin, the scenario point (0, 0, 0), and z tied to altitude: `alt = origin alt + z`.
 //!
 //! The conversion is exact on the WGS-84 ellipsoid (NIMA TR8350.2: a = 6 378 137 m,
 //! 1/f = 298.257223563): geodetic → Earth-centred Earth-fixed (ECEF) → rotated into the
@@ -21,8 +21,13 @@
 //! model at the origin.
 //!
 //! **Curvature.** The tangent plane is flat and the sea is not: a point of the plane d metres
-//! from the origin is d²/2R higher than the origin (0.3 m at 2 km, 7.8 m at 10 km). A scenario
-//! treats its surface as a plane, so depths away from the origin are off by as much.
+//! from the origin is d²/2R higher than the origin (0.3 m at 2 km, 7.8 m at 10 km). A scenario's
+//! z is a depth or a height (its `bounds.max[2]` is the sea surface, which follows the Earth),
+//! so z is not taken along the plane's "up" but as altitude: `(x, y)` is a point of the tangent
+//! plane at the origin's height, placed on the Earth by the latitude and longitude of that
+//! point (its vertical), and `z` is `alt − origin alt` there — the local-level frame of
+//! autopilots, on the ellipsoid. Had z been the plane's up, an AUV at z = −10 m 10 km out
+//! would be sent 2.2 m *above* the sea.
 
 use std::fmt;
 use std::ops::RangeInclusive;
@@ -111,33 +116,43 @@ impl GeoOrigin {
     }
 
     /// Scenario point `p` (x east, y north, z up, metres) as [latitude °, longitude ° in
-    /// [−180, 180], altitude m AMSL].
+    /// [−180, 180], altitude m AMSL] (see the module documentation for z).
     pub fn to_geodetic(&self, p: [f64; 3]) -> [f64; 3] {
-        let (lat, lon, h) = map_3d::enu2geodetic(
+        let (lat, lon, _) = map_3d::enu2geodetic(
             p[0],
             p[1],
-            p[2],
+            0.0,
             self.lat_deg.to_radians(),
             self.lon_deg.to_radians(),
             self.alt_m,
             Ellipsoid::WGS84,
         );
-        [lat.to_degrees(), lon.to_degrees(), h]
+        [lat.to_degrees(), lon.to_degrees(), self.alt_m + p[2]]
     }
 
     /// WGS-84 latitude °, longitude °, altitude m (AMSL) as a scenario point (x east, y north,
     /// z up, metres). Any longitude works: ±180° is the same meridian.
     pub fn to_local(&self, lat_deg: f64, lon_deg: f64, alt_m: f64) -> [f64; 3] {
-        let (e, n, u) = map_3d::geodetic2enu(
-            lat_deg.to_radians(),
-            lon_deg.to_radians(),
-            alt_m,
-            self.lat_deg.to_radians(),
-            self.lon_deg.to_radians(),
-            self.alt_m,
-            Ellipsoid::WGS84,
-        );
-        [e, n, u]
+        // The point of the tangent plane on this vertical: found by moving along it until the
+        // plane's up is 0 (the vertical leans d/R from the plane's up, so each step gains a
+        // factor of (d/R)² — three steps are exact to nanometres within 100 km).
+        let enu = |h: f64| {
+            map_3d::geodetic2enu(
+                lat_deg.to_radians(),
+                lon_deg.to_radians(),
+                h,
+                self.lat_deg.to_radians(),
+                self.lon_deg.to_radians(),
+                self.alt_m,
+                Ellipsoid::WGS84,
+            )
+        };
+        let mut h = self.alt_m;
+        for _ in 0..3 {
+            h -= enu(h).2;
+        }
+        let (e, n, _) = enu(h);
+        [e, n, alt_m - self.alt_m]
     }
 }
 

@@ -1,4 +1,6 @@
 //! The tangent-plane conversion against published inputs and an independent implementation.
+//! Latitude and longitude are those of the tangent plane's point (x, y, 0) — PROJ's inverse of
+//! it — and altitude is `origin alt + z` (the module documentation says why).
 //!
 //! Reference values: PROJ 9.5.1 through pyproj 3.7.2, the pipeline
 //! `+proj=unitconvert +xy_in=deg +xy_out=rad +step +proj=cart +ellps=WGS84 +step
@@ -26,23 +28,27 @@ fn close3(a: [f64; 3], b: [f64; 3], tol: f64) -> bool {
 }
 
 #[test]
-fn calais_from_paris_is_geographiclibs_forward_example() {
-    // Calais, 50.9°N 1.8°E, h = 0. PROJ: -37518.63904141415 229949.65345120477
-    // -4260.428647166642 (GeographicLib's example prints -37518.6 229949 -4260.43).
+fn calais_from_paris_is_the_plane_point_on_its_vertical() {
+    // Calais, 50.9°N 1.8°E, h = 0 (GeographicLib's forward example, whose ground point PROJ
+    // puts at -37518.64 229949.65 -4260.43: 4.3 km below the plane). The plane's point on
+    // Calais's vertical, PROJ (its inverse iterated to up = 0, at h = 4263.28 m):
+    // -37543.66666933034 229949.65 → 230103.4848372033.
     let p = PARIS.to_local(50.9, 1.8, 0.0);
-    let reference = [-37518.63904141415, 229949.65345120477, -4260.428647166642];
+    let reference = [-37543.66666933034, 230103.4848372033, 0.0];
     assert!(close3(p, reference, 1e-3), "{p:?}");
+    let p = PARIS.to_local(50.9, 1.8, -25.0);
+    assert!((p[2] + 25.0).abs() < 1e-12, "z is the altitude: {p:?}");
 }
 
 #[test]
 fn geographiclibs_reverse_example_lands_within_a_millimetre() {
-    // (-38 km, 230 km, -4 km) from Paris. PROJ: 50.90033642174366°N 1.7931756753255437°E
-    // h = 264.9151916280389 m (GeographicLib's example prints 50.9003 1.79318 264.915).
+    // (-38 km, 230 km) from Paris (GeographicLib's reverse example, at z = 0). PROJ:
+    // 50.89904122745323°N 1.7935282818281935°E; the altitude is the origin's plus z.
     let g = PARIS.to_geodetic([-38e3, 230e3, -4e3]);
-    let reference = [50.90033642174366, 1.7931756753255437, 264.9151916280389];
+    let reference = [50.89904122745323, 1.7935282818281935, -4e3];
     let (horizontal, vertical) = apart(g, reference);
     assert!(
-        horizontal < 1e-3 && vertical < 1e-3,
+        horizontal < 1e-3 && vertical < 1e-9,
         "{g:?}: {horizontal} m, {vertical} m"
     );
 }
@@ -76,18 +82,15 @@ fn round_trips_hold_to_a_millimetre_at_the_equator_at_60_north_and_over_the_date
 
 #[test]
 fn points_match_proj_at_60_north_and_east_of_the_date_line() {
-    // 1 km east of 60°N 10°E, h = 5 m. PROJ: 59.99999878434594°N 10.017921131850398°E
-    // 5.078195690177381 m (the plane rises d²/2R above the ellipsoid).
+    // 1 km east of 60°N 10°E, h = 5 m. PROJ: 59.99999878434594°N 10.017921131850398°E (at
+    // 5.078 m: the plane rises d²/2R above the ellipsoid; the altitude is the origin's).
     let g = GeoOrigin::new(60.0, 10.0, 5.0).to_geodetic([1000.0, 0.0, 0.0]);
-    let (h, v) = apart(
-        g,
-        [59.99999878434594, 10.017921131850398, 5.078195690177381],
-    );
+    let (h, v) = apart(g, [59.99999878434594, 10.017921131850398, 5.0]);
     assert!(h < 1e-3 && v < 1e-3, "{g:?}");
-    // (2.5 km, -1.8 km, -75 m) from 45°S 179.99°E: past the date line. PROJ:
-    // -45.01619275073289°, -179.97828365198876°, -74.25643602013588 m.
+    // (2.5 km, -1.8 km, -75 m) from 45°S 179.99°E: past the date line. PROJ for (2.5 km,
+    // -1.8 km, 0): -45.0161925600543°, -179.9782840244189°.
     let g = GeoOrigin::new(-45.0, 179.99, 0.0).to_geodetic([2500.0, -1800.0, -75.0]);
-    let reference = [-45.01619275073289, -179.97828365198876, -74.25643602013588];
+    let reference = [-45.0161925600543, -179.9782840244189, -75.0];
     let (h, v) = apart(g, reference);
     assert!(h < 1e-3 && v < 1e-3, "{g:?}");
 }
@@ -105,8 +108,9 @@ fn sphere_to_geodetic(o: &GeoOrigin, p: [f64; 3]) -> [f64; 3] {
 
 #[test]
 fn two_km_east_of_paris_the_sphere_is_metres_off_and_the_ellipsoid_is_within_a_centimetre() {
-    // PROJ: 48.83333011473296°N 2.3605754880251957°E h = 0.31297581270337105 m.
-    let reference = [48.83333011473296, 2.3605754880251957, 0.31297581270337105];
+    // PROJ: 48.83333011473296°N 2.3605754880251957°E (h = 0.313 m on the plane; the sea
+    // surface stays at the origin's altitude).
+    let reference = [48.83333011473296, 2.3605754880251957, 0.0];
     let p = [2000.0, 0.0, 0.0];
     let (sphere, _) = apart(sphere_to_geodetic(&PARIS, p), reference);
     let (ellipsoid, vertical) = apart(PARIS.to_geodetic(p), reference);

@@ -6,7 +6,9 @@ converts the scenario's own metres to WGS-84 with no Rust involved.
 
 The origin comes from the scenario's [origin] table; every position in the exports must be
 within 1 cm (horizontally, along the ellipsoid, and vertically) of the scenario point it stands
-for, converted by PROJ's topocentric (east-north-up) transform on WGS-84.
+for: latitude and longitude of the tangent plane's point (x, y, 0) by PROJ's topocentric
+(east-north-up) transform on WGS-84, altitude the origin's plus z (Shoal's z is an altitude:
+its surface follows the Earth, not the plane).
 
 Prints one JSON summary line on stdout; exit 0 when every check passed, 1 otherwise (the reason
 on stderr).
@@ -38,14 +40,18 @@ def need(ok, what):
 
 
 def enu_to_geodetic(origin):
-    """scenario point (x, y, z) -> (lon, lat, h), by PROJ."""
+    """scenario point (x, y, z) -> (lon, lat, alt): PROJ for (x, y, 0), alt = origin + z."""
     t = Transformer.from_pipeline(
         "+proj=pipeline +step +proj=unitconvert +xy_in=deg +xy_out=rad "
         "+step +proj=cart +ellps=WGS84 "
         f"+step +proj=topocentric +ellps=WGS84 +lat_0={origin['lat_deg']!r} "
         f"+lon_0={origin['lon_deg']!r} +h_0={origin['alt_m']!r}"
     )
-    return lambda p: t.transform(p[0], p[1], p[2], direction="INVERSE")
+    def convert(p):
+        lon, lat, _ = t.transform(p[0], p[1], 0.0, direction="INVERSE")
+        return lon, lat, origin["alt_m"] + p[2]
+
+    return convert
 
 
 def near(actual_lon_lat, expected, what, alt=None):

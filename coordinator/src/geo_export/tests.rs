@@ -1,8 +1,9 @@
 //! The exports of a two-vehicle toy plan at the equator, against values computed by hand.
 //!
 //! Origin 0°N 0°E at sea level, z = 0 the surface. East of it along the equator the ellipsoid's
-//! section is a circle of radius a = 6 378 137 m, so the scenario point (x, 0, z) is at longitude
-//! atan2(x, a + z) and altitude hypot(x, a + z) − a exactly. Northwards the meridian's radius of
+//! section is a circle of radius a = 6 378 137 m, so the scenario point (x, 0, z) — the tangent
+//! plane's point (x, 0, 0) on the Earth, at altitude z — is at longitude atan2(x, a) and
+//! altitude z exactly. Northwards the meridian's radius of
 //! curvature at the equator is a(1 − e²) = 6 335 439.327 m: y metres north is latitude
 //! y / 6 335 439.327 rad, to a micrometre over these distances.
 
@@ -22,7 +23,7 @@ const MERIDIAN_RADIUS: f64 = 6_335_439.327;
 
 /// Longitude (°) and altitude (m) of the scenario point (x, 0, z).
 fn east(x: f64, z: f64) -> (f64, f64) {
-    (x.atan2(A + z).to_degrees(), x.hypot(A + z) - A)
+    (x.atan2(A).to_degrees(), z)
 }
 
 /// Latitude (°) of y metres north.
