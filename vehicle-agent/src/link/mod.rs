@@ -271,4 +271,25 @@ mod tests {
         let near = GeoOrigin::new(43.1 + 5e-8, 5.9, 0.005);
         assert_eq!(mission_origin(Some(a), Some(near)), Ok(a));
     }
+
+    #[test]
+    fn an_agent_refuses_to_open_a_link_for_a_mission_placed_elsewhere() {
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../scenarios/amp-pso-3.toml");
+        let scenario = match Scenario::load(std::path::Path::new(path)) {
+            Ok(s) => s,
+            Err(e) => panic!("{e}"),
+        };
+        assert!(scenario.origin.is_some(), "amp-pso-3 has an [origin]");
+        let elsewhere = GeoOrigin::new(43.1, 5.9, 0.0);
+        let settings = LinkSettings {
+            kind: LinkKind::Mavlink,
+            position_noise_m: 0.0,
+            mavlink: Some(MavlinkSettings::new("udpout:127.0.0.1:9", Some(elsewhere))),
+        };
+        match open(&settings, &scenario, 0, 1) {
+            Err(LinkError::Refused(why)) => assert!(why.contains("--mavlink-origin"), "{why}"),
+            Err(e) => panic!("not refused: {e}"),
+            Ok(link) => panic!("opened {}", link.name()),
+        }
+    }
 }
