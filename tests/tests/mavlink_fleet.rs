@@ -83,7 +83,7 @@ fn run_drives_a_mavsdk_vehicle_on_the_scenarios_origin_to_its_goal() -> TestResu
             let p: Vec<f64> = p.iter().filter_map(Value::as_f64).collect();
             <[f64; 3]>::try_from(p).ok()
         })
-        .last()
+        .next_back()
         .ok_or("no telemetry in the log")?;
     let off = (0..3)
         .map(|i| (last[i] - GOAL[i]).powi(2))
