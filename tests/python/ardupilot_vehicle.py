@@ -218,11 +218,6 @@ class Vehicle:
         self.mav.mission_current_send(seq, len(self.items) - 1, state)
 
 
-def parse_home(text):
-    lat, lon, alt = (float(v) for v in text.split(","))
-    return lat, lon, alt
-
-
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("port", type=int)
@@ -230,7 +225,7 @@ def main():
     ap.add_argument("--mode", choices=["accept", "refuse"], default="accept")
     ap.add_argument("--drop-last-reached", action="store_true")
     ap.add_argument("--no-fence", action="store_true")
-    ap.add_argument("--home", type=parse_home, default=(43.1, 5.9, 0.0), help="LAT,LON,ALT")
+    ap.add_argument("--home", type=vk.parse_home, default=(43.1, 5.9, 0.0), help="LAT,LON,ALT")
     ap.add_argument("--default-speed", type=float, default=1.0, help="m/s, until DO_CHANGE_SPEED")
     ap.add_argument("--timeout", type=float, default=60.0)
     ap.add_argument("--ignore-stdin", action="store_true")

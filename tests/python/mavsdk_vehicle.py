@@ -285,17 +285,12 @@ class Vehicle:
         self.acks = [a for a in self.acks if now - a[0] < 5.0]  # acks to commands not shown
 
 
-def parse_home(text):
-    lat, lon, alt = (float(v) for v in text.split(","))
-    return lat, lon, alt
-
-
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("port", type=int)
     ap.add_argument("--hold", choices=["ignore", "accept", "refuse"], default="ignore")
     ap.add_argument("--autopilot", choices=["generic", "px4"], default="generic")
-    ap.add_argument("--home", type=parse_home, default=(43.1, 5.9, 0.0), help="LAT,LON,ALT")
+    ap.add_argument("--home", type=vk.parse_home, default=(43.1, 5.9, 0.0), help="LAT,LON,ALT")
     ap.add_argument("--default-speed", type=float, default=1.0, help="m/s, until DO_CHANGE_SPEED")
     ap.add_argument("--timeout", type=float, default=60.0)
     ap.add_argument("--ignore-stdin", action="store_true")

@@ -53,6 +53,12 @@ def emit(record):
     print(json.dumps(clean(record)), flush=True)
 
 
+def parse_home(text):
+    """`LAT,LON,ALT` (a vehicle's `--home`) as a tuple of floats."""
+    lat, lon, alt = (float(v) for v in text.split(","))
+    return lat, lon, alt
+
+
 def radii(lat_deg):
     """(M, N): the meridian and prime-vertical radii of curvature at `lat_deg`, metres."""
     s = math.sin(math.radians(lat_deg))

@@ -366,12 +366,18 @@ fn mavsdk_px4_accepting_hold_stops() -> TestResult {
     let args = ["--autopilot", "px4", "--hold", "accept"];
     let mut vehicle = at_start(Kind::Mavsdk, &plan, &args)?;
     hold_mid_leg(&mut vehicle, &plan, 6.0)?;
-    let modes = commands(&mut vehicle, 176)?;
+    held_by_mode(&mut vehicle, [4.0, 3.0]) // PX4 AUTO.LOITER
+}
+
+/// The hold was a DO_SET_MODE to custom mode `mode` (main, sub) that the vehicle accepted, and
+/// no fallback mission followed.
+fn held_by_mode(vehicle: &mut Vehicle, mode: [f64; 2]) -> TestResult {
+    let modes = commands(vehicle, 176)?;
     assert!(
         modes
             .iter()
-            .any(|(p, r)| p[1] == 4.0 && p[2] == 3.0 && *r == 0),
-        "no DO_SET_MODE answered as expected: {modes:?}"
+            .any(|(p, r)| p[1] == mode[0] && p[2] == mode[1] && *r == 0),
+        "no DO_SET_MODE {mode:?} accepted: {modes:?}"
     );
     assert_eq!(
         vehicle.events("mission").len(),
@@ -389,17 +395,7 @@ fn ardupilot_refusing_the_pause_holds_in_poshold() -> TestResult {
     hold_mid_leg(&mut vehicle, &plan, 6.0)?;
     let pauses = commands(&mut vehicle, 193)?;
     assert!(pauses.iter().all(|(_, r)| *r == 4), "FAILED: {pauses:?}");
-    let modes = commands(&mut vehicle, 176)?;
-    assert!(
-        modes.iter().any(|(p, r)| p[1] == 16.0 && *r == 0),
-        "no DO_SET_MODE answered as expected: {modes:?}"
-    );
-    assert_eq!(
-        vehicle.events("mission").len(),
-        1,
-        "held without a fallback mission"
-    );
-    Ok(())
+    held_by_mode(&mut vehicle, [16.0, 0.0]) // ArduSub POSHOLD
 }
 
 #[test]
