@@ -14,7 +14,7 @@ use crate::report::compare::{self, seeds_line};
 use crate::report::out::say;
 use crate::report::{crawler_table, significance};
 
-use super::EXIT_FEASIBLE;
+use super::exit::EXIT_FEASIBLE;
 
 /// `shoal-coordinator compare`.
 #[derive(Debug, Clone, clap::Args)]

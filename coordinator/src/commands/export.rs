@@ -98,7 +98,7 @@ pub fn command(args: &ExportArgs) -> anyhow::Result<i32> {
     for file in written {
         crate::report::out::say(&format!("Wrote {}\n", file.display()));
     }
-    Ok(crate::commands::EXIT_FEASIBLE)
+    Ok(crate::commands::exit::EXIT_FEASIBLE)
 }
 
 /// The plan at `path`, read within [`MAX_PLAN_BYTES`].

@@ -14,5 +14,5 @@ pub struct HealthArgs {
 pub fn command(args: &HealthArgs) -> anyhow::Result<i32> {
     shoal_common::health::check(&args.file, std::time::Duration::from_secs(10))
         .map_err(anyhow::Error::msg)?;
-    Ok(super::EXIT_FEASIBLE)
+    Ok(super::exit::EXIT_FEASIBLE)
 }

@@ -100,7 +100,7 @@ pub fn command(args: &KeysArgs) -> anyhow::Result<i32> {
         in_config.join("<operator>.json5").display(),
         args.coordinator_hosts.join(", ")
     );
-    Ok(crate::commands::EXIT_FEASIBLE)
+    Ok(crate::commands::exit::EXIT_FEASIBLE)
 }
 
 /// The members to certify, checked: ids usable as key chunks, none twice, none `coordinator`.
@@ -243,7 +243,10 @@ mod tests {
     fn every_member_gets_a_certificate_a_private_key_and_a_configuration_zenoh_reads(
     ) -> anyhow::Result<()> {
         let dir = tempfile::tempdir()?;
-        assert_eq!(command(&args(dir.path()))?, crate::commands::EXIT_FEASIBLE);
+        assert_eq!(
+            command(&args(dir.path()))?,
+            crate::commands::exit::EXIT_FEASIBLE
+        );
         for m in ["coordinator", "auv1", "auv2", "operator"] {
             let pem = std::fs::read_to_string(dir.path().join(format!("{m}.pem")))?;
             assert!(pem.starts_with("-----BEGIN CERTIFICATE-----"), "{m}");

@@ -5,6 +5,7 @@
 
 pub mod bench;
 pub mod compare;
+pub mod exit;
 pub mod export;
 pub mod generate;
 pub mod health;
@@ -21,6 +22,8 @@ use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
 
 use clap::{Parser, Subcommand};
+
+pub use exit::{EXIT_ERROR, EXIT_FEASIBLE, EXIT_VIOLATIONS};
 
 use crate::report::out::say;
 
@@ -82,13 +85,6 @@ pub enum Command {
     /// (coverage, planning time, clearance, cross-track error; Table 2 and Figure 7).
     BenchCoverage(bench::coverage::BenchCoverageArgs),
 }
-
-/// Exit status of a plan with no violations.
-pub const EXIT_FEASIBLE: i32 = 0;
-/// Exit status of an error (bad input, I/O).
-pub const EXIT_ERROR: i32 = 1;
-/// Exit status of a plan produced with constraint violations.
-pub const EXIT_VIOLATIONS: i32 = 3;
 
 /// The log filter a command uses when `RUST_LOG` is not set.
 pub fn default_log_filter(command: &Command) -> &'static str {

@@ -6,8 +6,8 @@ use std::sync::Arc;
 
 use anyhow::{bail, Context};
 
+use super::exit::{EXIT_FEASIBLE, EXIT_VIOLATIONS};
 use super::plan_args::{distributed_options, load_scenario, plan_coverage_mission, PlanArgs};
-use super::{EXIT_FEASIBLE, EXIT_VIOLATIONS};
 use crate::distributed;
 use crate::planning::planner;
 use crate::report::out::{say, write_outputs, write_svg};
@@ -77,14 +77,18 @@ mod tests {
     use super::*;
     use clap::Parser;
 
+    /// `plan`'s flags alone, parsed as the command line would be.
+    #[derive(Parser)]
+    struct Plan {
+        #[command(flatten)]
+        args: PlanArgs,
+    }
+
     fn plan_args(extra: &[&str]) -> anyhow::Result<PlanArgs> {
         let scenario = concat!(env!("CARGO_MANIFEST_DIR"), "/../scenarios/amp-pso-1.toml");
-        let mut line = vec!["shoal-coordinator", "plan", scenario, "--in-process"];
+        let mut line = vec!["plan", scenario, "--in-process"];
         line.extend_from_slice(extra);
-        match super::super::Cli::try_parse_from(line)?.command {
-            super::super::Command::Plan(a) => Ok(a),
-            _ => anyhow::bail!("not a plan command"),
-        }
+        Ok(Plan::try_parse_from(line)?.args)
     }
 
     /// A flag that breaks a rule is named as the command line's, not blamed on the file; the

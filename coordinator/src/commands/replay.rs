@@ -181,9 +181,9 @@ pub fn command(args: &ReplayArgs) -> anyhow::Result<i32> {
     crate::report::out::say(&out);
     // As `run`: 0 when the execution met its figures, 3 when it did not.
     Ok(if verdict::failures(f).is_empty() {
-        crate::commands::EXIT_FEASIBLE
+        crate::commands::exit::EXIT_FEASIBLE
     } else {
-        crate::commands::EXIT_VIOLATIONS
+        crate::commands::exit::EXIT_VIOLATIONS
     })
 }
 
@@ -477,7 +477,7 @@ mod tests {
             log: path,
             svg: Some(svg.clone()),
         })?;
-        assert_eq!(code, crate::commands::EXIT_VIOLATIONS);
+        assert_eq!(code, crate::commands::exit::EXIT_VIOLATIONS);
         let drawn = std::fs::read_to_string(&svg)?;
         std::fs::remove_dir_all(&dir)?;
         assert!(drawn.contains("soft1"), "the hazard is not drawn");

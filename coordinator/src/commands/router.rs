@@ -23,5 +23,5 @@ pub struct RouterArgs {
 /// Serves until `shutdown` is raised.
 pub fn command(args: &RouterArgs, shutdown: &AtomicBool) -> anyhow::Result<i32> {
     distributed::network::serve_router(&args.listen, &args.zenoh.security()?, shutdown)?;
-    Ok(super::EXIT_FEASIBLE)
+    Ok(super::exit::EXIT_FEASIBLE)
 }

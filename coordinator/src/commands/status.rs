@@ -61,7 +61,7 @@ pub fn command(args: &StatusArgs) -> anyhow::Result<i32> {
             "no running mission answered on {key} within {:.1} s",
             args.timeout
         );
-        return Ok(crate::commands::EXIT_ERROR);
+        return Ok(crate::commands::exit::EXIT_ERROR);
     }
     let mut out = String::new();
     for s in &statuses {
@@ -73,7 +73,7 @@ pub fn command(args: &StatusArgs) -> anyhow::Result<i32> {
         }
     }
     crate::report::out::say(&out);
-    Ok(crate::commands::EXIT_FEASIBLE)
+    Ok(crate::commands::exit::EXIT_FEASIBLE)
 }
 
 /// The fleet pictures the missions matching `key` answer with (bad answers are skipped, with a

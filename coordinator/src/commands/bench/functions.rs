@@ -521,7 +521,7 @@ pub fn command(args: &BenchFunctionsArgs, stop: &AtomicBool) -> anyhow::Result<i
         note.push_str(" (interrupted: the tables hold only the runs that finished)");
     }
     eprintln!("{note}");
-    Ok(crate::commands::EXIT_FEASIBLE)
+    Ok(crate::commands::exit::EXIT_FEASIBLE)
 }
 
 #[cfg(test)]

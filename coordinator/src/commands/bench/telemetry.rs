@@ -117,7 +117,7 @@ pub fn command(args: &BenchTelemetryArgs, stop: &AtomicBool) -> anyhow::Result<i
         f.min_separation_m.map_or("–".into(), |d| format!("{d:.1} m")),
         report.ended
     ));
-    Ok(crate::commands::EXIT_FEASIBLE)
+    Ok(crate::commands::exit::EXIT_FEASIBLE)
 }
 
 #[cfg(test)]

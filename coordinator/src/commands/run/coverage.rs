@@ -27,8 +27,8 @@ use shoal_common::coverage::drive::drive_trajectory;
 use shoal_common::scenario::Scenario;
 use shoal_common::trajectory::Trajectory;
 
+use super::executable::{executable, Executable};
 use crate::commands::plan_args::PlanArgs;
-use crate::commands::run::{executable, Executable};
 use crate::distributed::DistributedOptions;
 
 /// Plans `scenario`'s coverage into `--out` and returns what the agents execute; `None` (after

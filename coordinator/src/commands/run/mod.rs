@@ -3,7 +3,7 @@
 //! (`<out>/execution.json`, the mission log `<out>/mission.ndjson`).
 
 use std::path::PathBuf;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
 use std::time::Duration;
 
@@ -11,8 +11,8 @@ use anyhow::{bail, Context as _};
 use shoal_common::scenario::{Obstacle, ObstacleKind, Scenario};
 use shoal_common::trajectory::Trajectory;
 
+use super::exit::{EXIT_FEASIBLE, EXIT_VIOLATIONS};
 use super::plan_args::{distributed_options, load_scenario, PlanArgs};
-use super::{EXIT_FEASIBLE, EXIT_VIOLATIONS};
 use crate::distributed;
 use crate::execute::{self, verdict, ExecOptions, ExecutionReport};
 use crate::planning::planner;
@@ -21,6 +21,9 @@ use crate::report::progress::Progress;
 use crate::report::summary;
 
 pub mod coverage;
+pub mod executable;
+
+pub use executable::{executable, Executable};
 
 /// `shoal-coordinator run`.
 #[derive(Debug, Clone, clap::Args)]
@@ -144,17 +147,6 @@ fn separation_buffer(flag: Option<f64>, d_min: f64) -> anyhow::Result<f64> {
     Ok(buffer)
 }
 
-/// What `run` executes: the scenario the agents get (a coverage mission's starts moved to its
-/// paths), every vehicle's timed trajectory (scenario order) and the time they are timed to end.
-pub struct Executable {
-    /// The scenario sent to the agents.
-    pub scenario: Scenario,
-    /// Per vehicle, mission-timed.
-    pub trajectories: Vec<Trajectory>,
-    /// The common arrival (a coverage fleet: the last crawler's finish).
-    pub common_arrival_s: f64,
-}
-
 /// Plans a fleet, energy or tour mission as `plan` does and writes its outputs; `None` (after
 /// saying why) when the plan is not to be executed: infeasible, or Ctrl-C while planning.
 fn plan_trajectories(
@@ -189,21 +181,6 @@ fn plan_trajectories(
             .collect(),
         common_arrival_s: plan.common_arrival_s,
     }))
-}
-
-/// Whether a plan that is `feasible` or not is executed; says why not on stderr. Ctrl-C while
-/// planning (`shutdown`) asks for the plan so far, not for a mission started and stopped at
-/// once.
-pub(crate) fn executable(feasible: bool, shutdown: &AtomicBool) -> bool {
-    if shutdown.load(Ordering::Relaxed) {
-        eprintln!("interrupted while planning: the plan so far is written, it is not executed");
-        false
-    } else if !feasible {
-        eprintln!("the plan is not feasible: it is not executed (see plan.json)");
-        false
-    } else {
-        true
-    }
 }
 
 /// Plans, then executes; exit 0 when the execution kept d_min, stayed out of every hard
@@ -450,8 +427,12 @@ mod tests {
         let scenario = concat!(env!("CARGO_MANIFEST_DIR"), "/../scenarios/amp-pso-1.toml");
         let log = file.join("m.ndjson");
         let out = dir.join("out");
-        let cli = crate::commands::Cli::try_parse_from([
-            "shoal-coordinator".as_ref(),
+        #[derive(clap::Parser)]
+        struct Run {
+            #[command(flatten)]
+            args: RunArgs,
+        }
+        let cli = Run::try_parse_from([
             "run".as_ref(),
             scenario.as_ref(),
             "--in-process".as_ref(),
@@ -461,10 +442,8 @@ mod tests {
             log.as_os_str(),
             "--out".as_ref(),
             out.as_os_str(),
-        ] as [&std::ffi::OsStr; 10])?;
-        let crate::commands::Command::Run(args) = cli.command else {
-            anyhow::bail!("not a run command");
-        };
+        ] as [&std::ffi::OsStr; 9])?;
+        let args = cli.args;
         let e = command(&args, Arc::new(AtomicBool::new(false)))
             .err()
             .map(|e| format!("{e:#}"))

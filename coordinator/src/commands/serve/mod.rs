@@ -190,7 +190,7 @@ pub fn command(args: &ServeArgs, shutdown: Arc<AtomicBool>) -> anyhow::Result<i3
         "served {served} mission(s); refused {} submission(s)",
         refused.load(Ordering::Relaxed)
     );
-    Ok(crate::commands::EXIT_FEASIBLE)
+    Ok(crate::commands::exit::EXIT_FEASIBLE)
 }
 
 /// How a mission's router reaches the serving one.
