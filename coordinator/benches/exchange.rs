@@ -22,7 +22,7 @@ use shoal_common::wire::agent_to_coordinator::AgentToCoordinator;
 use shoal_common::wire::coordinator_to_agent::CoordinatorToAgent;
 use shoal_common::wire::security::Security;
 use shoal_common::wire::{codec, session, topics, Envelope, WireChromosome, WireContext};
-use shoal_coordinator::keys::{self, KeysArgs};
+use shoal_coordinator::commands::keys::{self, KeysArgs};
 use zenoh::qos::CongestionControl;
 use zenoh::Wait;
 

@@ -10,7 +10,7 @@ use rand::SeedableRng;
 use shoal_common::cost::FleetModel;
 use shoal_common::scenario::Scenario;
 use shoal_common::swarm::Problem;
-use shoal_coordinator::planner::plan_in_process;
+use shoal_coordinator::planning::planner::plan_in_process;
 
 fn scenario(n: u32) -> Scenario {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("../scenarios/amp-pso-{n}.toml"));

@@ -19,7 +19,7 @@ use shoal_common::wire::codec::{decode, decode_json, encode, encode_json};
 use shoal_common::wire::coordinator_to_agent::CoordinatorToAgent;
 use shoal_common::wire::open::{FleetStatus, Telemetry, VehicleStatusRow, OPEN_VERSION};
 use shoal_common::wire::{Envelope, WireChromosome, WireTrajectory, PROTOCOL_VERSION};
-use shoal_coordinator::serve::Submission;
+use shoal_coordinator::commands::serve::Submission;
 
 /// splitmix64: small, seeded, good enough to pick bytes.
 struct Rng(u64);

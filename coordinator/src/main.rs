@@ -5,7 +5,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 
 use clap::Parser;
-use shoal_coordinator::cli::Cli;
+use shoal_coordinator::Cli;
 
 fn main() -> ExitCode {
     let cli = match Cli::try_parse() {

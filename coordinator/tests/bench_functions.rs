@@ -4,8 +4,10 @@
 use std::sync::atomic::AtomicBool;
 
 use clap::Parser;
-use shoal_coordinator::bench_functions::{bench_functions, markdown, BenchFunctionsArgs};
-use shoal_coordinator::cli::{Cli, Command};
+use shoal_coordinator::commands::bench::functions::{
+    bench_functions, markdown, BenchFunctionsArgs,
+};
+use shoal_coordinator::{Cli, Command};
 
 fn args(extra: &[&str]) -> BenchFunctionsArgs {
     let mut line = vec![

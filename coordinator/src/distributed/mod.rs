@@ -21,7 +21,7 @@ use shoal_common::plan::Plan;
 use shoal_common::scenario::Scenario;
 use shoal_common::wire::topics;
 
-use crate::planner::to_plan;
+use crate::planning::planner::to_plan;
 
 /// Who starts the agents.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
@@ -121,7 +121,7 @@ pub fn plan_distributed(
             })
             .collect::<anyhow::Result<Vec<_>>>()?;
         let mut plan =
-            crate::tour_planner::assemble(scenario, &job, &tours, "distributed", started);
+            crate::planning::tour::assemble(scenario, &job, &tours, "distributed", started);
         for d in &figures.degraded {
             plan.notices.push(format!(
                 "{}'s tour was planned by the coordinator: {}",

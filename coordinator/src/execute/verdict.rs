@@ -2,7 +2,7 @@
 //! (`run`) and for `replay`, so the two say the same of the same figures.
 
 use super::fleet::{ExecutionFigures, VehicleFigures};
-use crate::summary::opt;
+use crate::report::summary::opt;
 
 /// Why the execution falls short: d_min broken, an executed track inside a hard obstacle (its
 /// physical sphere: the inflation is the planner's margin), an AUV's through the seabed, a

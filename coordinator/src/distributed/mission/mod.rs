@@ -32,7 +32,7 @@ pub use shares::{Share, ShareJob};
 
 use super::agents::LocalAgents;
 use super::network::{Event, Network};
-use crate::planner::RunResult;
+use crate::planning::solver::RunResult;
 
 /// How patient the coordinator is.
 #[derive(Debug, Clone)]

@@ -1,0 +1,10 @@
+//! The benchmark commands: the papers' tables re-run (`bench-functions`, `bench-energy`,
+//! `bench-cages`, `bench-coverage`) and the coordinator's own load (`bench-telemetry`); [`pool`]
+//! runs their independent jobs on worker threads.
+
+pub mod cages;
+pub mod coverage;
+pub mod energy;
+pub mod functions;
+pub mod pool;
+pub mod telemetry;

@@ -1,0 +1,10 @@
+//! The planners: a fleet's swarm in this process ([`planner`]), one AUV's energy-aware path
+//! ([`energy`]), inspection tours ([`tour`]) and coverage missions ([`coverage`],
+//! [`coverage_fleet`]), on the one solver loop of [`solver`].
+
+pub mod coverage;
+pub mod coverage_fleet;
+pub mod energy;
+pub mod planner;
+pub mod solver;
+pub mod tour;

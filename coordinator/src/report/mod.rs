@@ -1,0 +1,13 @@
+//! What the commands write and print: `plan.json` and `plan.svg` ([`out`], [`svg`]), progress,
+//! plan and coverage summaries, the comparison tables ([`compare`], [`significance`],
+//! [`crawler_table`]) and the exports for maps and ground stations ([`geo_export`]).
+
+pub mod compare;
+pub mod crawler_stats;
+pub mod crawler_table;
+pub mod geo_export;
+pub mod out;
+pub mod progress;
+pub mod significance;
+pub mod summary;
+pub mod svg;
