@@ -59,44 +59,66 @@ pub enum CurrentGridError {
     /// The reason is in the message, not a `source` (a chained report would print it twice).
     #[error("{}: cannot read: {error}", file.display())]
     Io {
+        /// The file.
         file: PathBuf,
+        /// Why it could not be read.
         error: std::io::Error,
     },
     /// The first line that is not blank or a comment is not `x,y,z,u,v,w` (`found` is empty when
     /// the file has no such line).
     #[error("{}:{line}: expected the header `{HEADER}`, found {}", file.display(), quoted(found))]
     Header {
+        /// The file.
         file: PathBuf,
+        /// The 1-based line blamed.
         line: usize,
+        /// The line's text.
         found: String,
     },
     /// A data line without exactly six values.
     #[error("{}:{line}: expected 6 values ({HEADER}), found {found} in `{text}`", file.display())]
     FieldCount {
+        /// The file.
         file: PathBuf,
+        /// The 1-based line blamed.
         line: usize,
+        /// Values on the line.
         found: usize,
+        /// The line's text.
         text: String,
     },
     /// A value that does not parse as a number.
     #[error("{}:{line}: column `{column}`: {} is not a number", file.display(), quoted(text))]
     NotANumber {
+        /// The file.
         file: PathBuf,
+        /// The 1-based line blamed.
         line: usize,
+        /// The column (`x`, `y`, `z`, `u`, `v` or `w`).
         column: &'static str,
+        /// The value's text, as written.
         text: String,
     },
     /// A number that is infinite or NaN.
     #[error("{}:{line}: column `{column}`: `{text}` is not a finite number", file.display())]
     NonFinite {
+        /// The file.
         file: PathBuf,
+        /// The 1-based line blamed.
         line: usize,
+        /// The column (`x`, `y`, `z`, `u`, `v` or `w`).
         column: &'static str,
+        /// The value's text, as written.
         text: String,
     },
     /// A header and no data line: the grid needs at least one node (`line` is the last line).
     #[error("{}:{line}: no data lines after the header: the grid needs at least one node", file.display())]
-    NoNodes { file: PathBuf, line: usize },
+    NoNodes {
+        /// The file.
+        file: PathBuf,
+        /// The 1-based line blamed.
+        line: usize,
+    },
     /// The distinct values of one coordinate are not evenly spaced; `value` is the one blamed
     /// (the value on fewest lines, a likely typo, else the end of the first uneven step) and
     /// `line` the first line where it appears.
@@ -107,13 +129,19 @@ pub enum CurrentGridError {
         file.display()
     )]
     Spacing {
+        /// The file.
         file: PathBuf,
+        /// The 1-based line blamed.
         line: usize,
+        /// The coordinate (`x`, `y` or `z`).
         axis: &'static str,
+        /// The value blamed.
         value: f64,
         /// The distinct values around `value`, for the message.
         values: String,
+        /// Smallest step between neighbouring values.
         min_step: f64,
+        /// Largest step between neighbouring values.
         max_step: f64,
     },
     /// Two lines for the same node; `line` is the later one.
@@ -122,9 +150,13 @@ pub enum CurrentGridError {
         file.display(), node[0], node[1], node[2]
     )]
     Duplicate {
+        /// The file.
         file: PathBuf,
+        /// The 1-based line blamed.
         line: usize,
+        /// The node's x, y and z.
         node: [f64; 3],
+        /// The line that gave it first.
         first_line: usize,
     },
     /// A combination of the x, y and z values with no line; `line` is the last line of the file.
@@ -135,8 +167,11 @@ pub enum CurrentGridError {
         node_count(lattice)
     )]
     Missing {
+        /// The file.
         file: PathBuf,
+        /// The 1-based line blamed.
         line: usize,
+        /// The missing node's x, y and z.
         node: [f64; 3],
         /// Distinct values along x, y and z.
         lattice: [usize; 3],

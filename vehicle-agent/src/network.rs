@@ -4,7 +4,7 @@
 //!
 //! Every message is decoded here. One that does not decode, has another protocol version,
 //! names a mission or vehicle this agent does not serve, or (on its inbox) carries an order
-//! number not after the last one taken ([`order_seq`]) is dropped, counted and logged once per
+//! number not after the last one taken (the `order_seq` module) is dropped, counted and logged once per
 //! kind — never a panic, never a stall.
 
 use std::collections::{HashMap, HashSet};

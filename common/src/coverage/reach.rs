@@ -123,7 +123,7 @@ impl ReachGrid {
 
     /// A forward-only path from `from` to `goal` on `free` within `bounds` (see
     /// [`hybrid_astar::plan`]), searched only when the two lie in the same free region of this
-    /// grid and guided by the grid distance to the goal, weighted by [`GUIDE_WEIGHT`]: a
+    /// grid and guided by the grid distance to the goal, weighted by `GUIDE_WEIGHT` (1.5): a
     /// transit or a way round needs to be found fast, not to be shortest. `Ok(None)` when the
     /// two are not connected or the search finds nothing within `params.max_expansions`.
     pub fn guided_search(

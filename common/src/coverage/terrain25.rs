@@ -39,13 +39,28 @@ use crate::terrain::{HeightGrid, TerrainError};
 pub enum Terrain25Error {
     /// A field of [`TerrainSpec`] or [`TraversalLimits`] is out of range.
     #[error("terrain spec: `{field}`: {what}")]
-    InvalidSpec { field: String, what: String },
+    InvalidSpec {
+        /// The field, as the scenario names it.
+        field: String,
+        /// What is wrong with its value.
+        what: String,
+    },
     /// A coverage-planner setting is out of range.
     #[error("coverage settings: `{field}`: {what}")]
-    InvalidParam { field: String, what: String },
+    InvalidParam {
+        /// The setting, as the scenario names it.
+        field: String,
+        /// What is wrong with its value.
+        what: String,
+    },
     /// The map would have more than [`MAX_CELLS`] cells.
     #[error("a {nx} × {ny} cell map exceeds the {MAX_CELLS} cell limit")]
-    TooLarge { nx: usize, ny: usize },
+    TooLarge {
+        /// Cells along x.
+        nx: usize,
+        /// Cells along y.
+        ny: usize,
+    },
     /// The height grid could not be read or built.
     #[error(transparent)]
     Grid(#[from] TerrainError),

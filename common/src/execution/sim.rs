@@ -84,13 +84,18 @@ pub type Seabed = Arc<dyn Fn(f64, f64) -> f64 + Send + Sync>;
 pub enum SimModel {
     /// Free-swimming AUV: water-relative speed in [v_min, v_max] while underway, yaw rate <= v / R_turn, |pitch| <= max_pitch; optional current field adds drift (ground velocity = water velocity + current).
     Auv {
+        /// The water's current, if the scenario has one.
         current: Option<Arc<dyn CurrentField>>,
+        /// The sea surface's z: the vehicle does not rise above it.
         surface_z: f64,
     },
     /// Tracked crawler on the seabed: z = seabed(x, y) + sensor height; speed reduced by slip (ground speed = (1 - slip) * commanded), slip in [0, 1).
     Crawler {
+        /// The seabed it drives on.
         seabed: Seabed,
+        /// Height of the sensor above the seabed, metres.
         sensor_height_m: f64,
+        /// Fraction of the commanded speed lost to the ground, in [0, 1).
         slip: f64,
     },
 }

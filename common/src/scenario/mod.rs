@@ -40,18 +40,29 @@ pub enum ScenarioError {
     /// would print it twice.
     #[error("{file}: cannot read: {error}")]
     Io {
+        /// The file.
         file: PathBuf,
+        /// Why it could not be read.
         error: std::io::Error,
     },
     /// TOML syntax, an unknown key, a missing key or a value of the wrong type.
     #[error("{file}: {message}")]
-    Parse { file: PathBuf, message: String },
+    Parse {
+        /// The file.
+        file: PathBuf,
+        /// The TOML parser's message, with the path of the field.
+        message: String,
+    },
     /// A value that parses but makes no sense for a mission.
     #[error("{file}: field `{field}` = {value}: {reason}")]
     Invalid {
+        /// The file.
         file: PathBuf,
+        /// The field's path (`vehicles[0].speed`).
         field: String,
+        /// The value, as written.
         value: String,
+        /// Why it makes no sense.
         reason: String,
     },
 }

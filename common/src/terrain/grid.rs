@@ -10,23 +10,36 @@ pub enum TerrainError {
     /// The reason is in the message, not a `source` (a chained report would print it twice).
     #[error("{}: cannot read: {error}", file.display())]
     Io {
+        /// The file.
         file: PathBuf,
+        /// Why it could not be read.
         error: std::io::Error,
     },
     /// [`HeightGrid::load`] does not know the extension.
     #[error("{}: unknown terrain format (expected extension .asc or .csv)", file.display())]
-    UnknownFormat { file: PathBuf },
+    UnknownFormat {
+        /// The file.
+        file: PathBuf,
+    },
     /// A caller-supplied parameter (cell size, origin) is unusable for this file.
     #[error("{}: {what}", file.display())]
-    BadParameter { file: PathBuf, what: String },
+    BadParameter {
+        /// The file.
+        file: PathBuf,
+        /// Which parameter, and why it does not fit.
+        what: String,
+    },
     /// [`HeightGrid::new`] was given inconsistent data.
     #[error("invalid height grid: {0}")]
     InvalidGrid(String),
     /// Something wrong at a given line (1-based) of a file.
     #[error("{}:{line}: {problem}", file.display())]
     At {
+        /// The file.
         file: PathBuf,
+        /// The 1-based line.
         line: usize,
+        /// What is wrong there.
         problem: Problem,
     },
 }
@@ -34,27 +47,58 @@ pub enum TerrainError {
 /// What is wrong at a line of a grid file; the offending text is always quoted.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum Problem {
+    /// A row with another number of values than the first (CSV) or the header's `ncols` (ASC).
     #[error("expected {expected} values, found {found}")]
-    Ragged { expected: usize, found: usize },
+    Ragged {
+        /// Values a row must have.
+        expected: usize,
+        /// Values on this row.
+        found: usize,
+    },
+    /// A value that does not parse as a number (its text).
     #[error("`{0}` is not a number")]
     NotANumber(String),
+    /// A value that is infinite or NaN (its text).
     #[error("`{0}` is not a finite number")]
     NonFinite(String),
+    /// An ESRI ASCII grid header without this key.
     #[error("header key `{0}` is missing (the header ends before this line)")]
     MissingHeader(&'static str),
+    /// An ESRI ASCII grid header line that cannot be read.
     #[error("bad header line `{text}`: {what}")]
-    BadHeader { text: String, what: &'static str },
+    BadHeader {
+        /// The line's text.
+        text: String,
+        /// What is wrong with it.
+        what: &'static str,
+    },
+    /// Fewer or more data rows than the header's `nrows`.
     #[error("header says `nrows {expected}` but the file has {found} data rows")]
-    RowCount { expected: usize, found: usize },
+    RowCount {
+        /// Rows the header announces.
+        expected: usize,
+        /// Rows in the file.
+        found: usize,
+    },
+    /// Fewer than 2 × 2 heights: nothing to interpolate between.
     #[error("grid of {cols} columns × {rows} rows is too small, need at least 2×2")]
-    TooSmall { cols: usize, rows: usize },
+    TooSmall {
+        /// Columns in the file.
+        cols: usize,
+        /// Rows in the file.
+        rows: usize,
+    },
+    /// A cell size of zero or less (its text).
     #[error("cell size `{0}` must be positive")]
     NonPositiveCell(String),
     /// `row` and `col` are 1-based, data row 1 being the first (northernmost) one of the file.
     #[error("data row {row}, column {col} is NODATA (`{text}`); unmeasured seabed is not guessed")]
     NoData {
+        /// The data row.
         row: usize,
+        /// The column.
         col: usize,
+        /// The NODATA value's text.
         text: String,
     },
 }

@@ -245,6 +245,7 @@ mod tests {
         assert_eq!(tour_from_wire(&joined, 2), None);
     }
 
+    #[cfg(feature = "transport")]
     #[test]
     fn a_coverage_strip_survives_the_codec() {
         use crate::coverage::boxes::Rect;

@@ -10,13 +10,21 @@
 //!   runs synchronously, so a timeout around it bounds nothing; open on a thread of its own.
 //! - [`security`] says how members authenticate (TLS, mutual TLS, user/password, access
 //!   control from a Zenoh configuration file); [`flags`] is the one flag group for it.
+//!
+//! The messages, [`topics`] and [`open`] are plain serde types and always built; [`codec`],
+//! [`session`], [`security`] and [`flags`] need the `transport` feature (on by default), which
+//! brings bincode, zenoh and clap.
 
 pub mod agent_to_coordinator;
+#[cfg(feature = "transport")]
 pub mod codec;
 pub mod coordinator_to_agent;
+#[cfg(feature = "transport")]
 pub mod flags;
 pub mod open;
+#[cfg(feature = "transport")]
 pub mod security;
+#[cfg(feature = "transport")]
 pub mod session;
 pub mod topics;
 

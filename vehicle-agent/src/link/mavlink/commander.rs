@@ -30,7 +30,9 @@ const HOLD_TRIES: u32 = 2;
 pub enum Job {
     /// Upload the legs of `plan` ending after mission time `after_t` and start them.
     Upload {
+        /// The vehicle's timed plan.
         plan: Trajectory,
+        /// Only the legs ending after this mission time go up (`None`: the whole plan).
         after_t: Option<f64>,
     },
     /// Hold (or stop) where it is.
@@ -43,7 +45,12 @@ pub enum Effect {
     /// Nothing (a failure, or a step on the way).
     None,
     /// Under way on a new mission: its last item, and where it ends (scenario frame).
-    Underway { last_item: u16, goal: [f64; 3] },
+    Underway {
+        /// Sequence number of the mission's last item.
+        last_item: u16,
+        /// Where the mission ends, scenario frame.
+        goal: [f64; 3],
+    },
     /// Held still, as the status says (Holding or Stopped).
     Still(VehicleStatus),
 }
@@ -81,12 +88,19 @@ pub struct FenceSource {
 
 /// The commander's side of the link.
 pub struct Commander {
+    /// The vehicle's MAVLink connection, shared with the telemetry reader.
     pub conn: Arc<Conn>,
+    /// Our system and component ids on the link.
     pub header: MavHeader,
+    /// The replies the reader passes on (acks, mission requests).
     pub replies: Receiver<M>,
+    /// What the reader knows of the vehicle (autopilot, position, mission progress).
     pub shared: Arc<Shared>,
+    /// Timeouts and tries of the exchanges.
     pub settings: MavlinkSettings,
+    /// The scenario's origin: plans go up as latitude, longitude and altitude.
     pub origin: GeoOrigin,
+    /// Where each finished command is reported.
     pub done: Sender<Done>,
     /// The geofence to upload with each mission, if any.
     pub fence: Option<FenceSource>,
