@@ -1,10 +1,10 @@
-//! Shoal's coordinator as a library: the binary parses its command line and calls [`run`]; tests
-//! call [`run`] (or the functions it uses) directly.
+//! Shoal's coordinator as a library: the binary parses its command line and calls [`run()`]; tests
+//! call [`run()`] (or the functions it uses) directly.
 //!
 //! # Layout
 //!
 //! - [`commands`]: one file per command, its clap arguments beside its handler; `commands/mod.rs`
-//!   holds the [`Command`] enum and the dispatch ([`run`]). Commands never call each other:
+//!   holds the [`Command`] enum and the dispatch ([`commands::run()`]). Commands never call each other:
 //!   what two of them share goes down a layer (or, for a flag group, into `plan_args`).
 //! - [`planning`]: the planners (fleet swarms, one-AUV energy, inspection tours, coverage) and
 //!   the seed-comparison runner's planners.

@@ -68,6 +68,8 @@ impl CompareArgs {
     }
 }
 
+/// `shoal-coordinator compare`: the table of every algorithm over the seeds, written where asked;
+/// `stop` ends it early with what is done.
 pub fn command(args: &CompareArgs, stop: &Arc<AtomicBool>) -> anyhow::Result<i32> {
     let seeds = args.seed_range()?;
     let scenarios = args

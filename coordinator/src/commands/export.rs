@@ -30,7 +30,7 @@ pub struct ExportArgs {
     /// geojson (paths, waypoints, obstacles, bounds) or qgc (one mission per vehicle).
     #[arg(long, env = "SHOAL_EXPORT_FORMAT", value_enum)]
     pub format: ExportFormat,
-    /// The scenario the plan was made for: obstacles, bounds, vehicle kinds and its [origin].
+    /// The scenario the plan was made for: obstacles, bounds, vehicle kinds and its `[origin]`.
     /// Without it only the paths are exported.
     #[arg(long, env = "SHOAL_SCENARIO")]
     pub scenario: Option<PathBuf>,

@@ -44,7 +44,7 @@ pub enum Command {
     /// Plan a scenario and write plan.json and plan.svg.
     Plan(plan_args::PlanArgs),
     /// Write a plan for maps (GeoJSON) or QGroundControl (.plan per vehicle), on WGS-84 through
-    /// the scenario's [origin].
+    /// the scenario's `[origin]`.
     Export(export::ExportArgs),
     /// Compare the optimizers over several seeds (markdown table on stdout).
     Compare(compare::CompareArgs),

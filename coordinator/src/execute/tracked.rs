@@ -40,7 +40,7 @@ pub struct Tracked {
     /// Executed track: every reported fix and, between two fixes, the corners of the plan at
     /// the later one shifted by the fixes' offsets from it (the earlier fix placed on that plan
     /// when the vehicle was replanned in between; fixes of a holding vehicle are joined
-    /// directly): [`Fleet::report`].
+    /// directly): [`super::fleet::Fleet::report`].
     pub track: Trajectory,
     /// Fixes in `track`.
     pub fixes: usize,

@@ -7,7 +7,7 @@ use shoal_common::swarm::IterationReport;
 use crate::distributed;
 
 /// Progress on stderr: a bar on a terminal; otherwise a line after the first iteration, every
-/// tenth of the run, and at least every [`PROGRESS_EVERY`].
+/// tenth of the run, and at least every `PROGRESS_EVERY` (2 s).
 pub struct Progress {
     bar: Option<indicatif::ProgressBar>,
     every: usize,
@@ -19,6 +19,7 @@ pub struct Progress {
 const PROGRESS_EVERY: std::time::Duration = std::time::Duration::from_secs(2);
 
 impl Progress {
+    /// Progress over `iterations`; `quiet` shows nothing.
     pub fn new(iterations: usize, quiet: bool) -> Progress {
         let bar = (!quiet && std::io::stderr().is_terminal()).then(|| {
             let b = indicatif::ProgressBar::new(iterations as u64);
@@ -37,6 +38,7 @@ impl Progress {
         }
     }
 
+    /// Shows an in-process iteration.
     pub fn update(&mut self, r: &IterationReport) {
         let msg = format!(
             "best fitness {:.4}, {} evaluations",
@@ -45,6 +47,7 @@ impl Progress {
         self.show(r.iteration, r.max_iterations, msg);
     }
 
+    /// Shows a distributed exchange round.
     pub fn update_distributed(&mut self, s: &distributed::mission::Status) {
         let msg = format!(
             "best fitness {:.4}, agents alive {}/{}",
@@ -68,6 +71,7 @@ impl Progress {
         }
     }
 
+    /// Ends the bar (a line-by-line progress has nothing to end).
     pub fn finish(&self) {
         if let Some(b) = &self.bar {
             b.finish_and_clear();

@@ -7,8 +7,8 @@
 //! (`shoal/<mission>/…`, see [`shoal_common::wire::open`]).
 //!
 //! Anyone who reaches the router can submit, so a submission is checked before it is queued
-//! ([`submission`]: sizes, rates, wall time, files under `--data-dir`, the mission id), the
-//! queue is bounded and takes each id once ([`queue`]), and missions still queued at exit are
+//! (`submission`: sizes, rates, wall time, files under `--data-dir`, the mission id), the
+//! queue is bounded and takes each id once (`queue`), and missions still queued at exit are
 //! named in the log.
 
 use std::panic::{catch_unwind, AssertUnwindSafe};

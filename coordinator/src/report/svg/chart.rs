@@ -6,6 +6,7 @@ use plotters::backend::SVGBackend;
 use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 
+/// A plotters chart on an SVG backend with two f64 axes: what every panel draws on.
 pub type Chart<'a, 'b> =
     ChartContext<'a, SVGBackend<'b>, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
 
