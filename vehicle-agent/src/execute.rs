@@ -17,8 +17,8 @@ use shoal_common::wire::coordinator_to_agent::CoordinatorToAgent;
 use shoal_common::wire::open::{Telemetry, OPEN_VERSION};
 use shoal_common::wire::WireTrajectory;
 
+use crate::assignment::MissionReport;
 use crate::link::VehicleLink;
-use crate::mission::MissionReport;
 
 /// An `Execute` order, checked.
 #[derive(Debug, Clone)]

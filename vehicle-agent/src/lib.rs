@@ -6,12 +6,15 @@
 //! and serves every mission that assigns its vehicle — several at once if they come — until it
 //! is stopped. The layers stay apart so a vehicle link can be added without touching the swarm:
 //! - [`network`]: the Zenoh session, subscriptions, decoding and counting of bad messages;
+//! - [`assignment`]: what a mission hands an agent and what it hands back, below both ways of
+//!   planning;
 //! - [`mission`]: one mission's planning loop, fed messages through a channel and sending
 //!   through a closure, with no knowledge of Zenoh;
 //! - [`execute`]: one execution: the vehicle drives its plan through its [`link::VehicleLink`]
 //!   and the agent reports telemetry;
 //! - [`link`]: the vehicle-link seam (a simulator now; real vehicles plug in there).
 
+pub mod assignment;
 pub mod execute;
 pub mod link;
 pub mod mission;

@@ -4,7 +4,6 @@
 //! through a closure, so this loop knows nothing of the transport (or, later, of the vehicle).
 //! Tour and coverage missions are planned in one go instead (`one_shot`).
 
-use std::path::Path;
 use std::sync::atomic::{AtomicBool, AtomicU32, Ordering};
 use std::sync::mpsc::{Receiver, RecvTimeoutError};
 use std::sync::Arc;
@@ -13,65 +12,13 @@ use std::time::{Duration, Instant};
 use shoal_common::cost::FleetModel;
 use shoal_common::distributed::follower::{FollowerSettings, Followers};
 use shoal_common::distributed::{round_iterations, rounds, Chromosome, Context};
-use shoal_common::scenario::Scenario;
 use shoal_common::swarm::Progress;
 use shoal_common::wire::agent_to_coordinator::AgentToCoordinator;
 use shoal_common::wire::coordinator_to_agent::CoordinatorToAgent;
-use shoal_common::wire::{WireChromosome, WireContext};
+use shoal_common::wire::WireChromosome;
 
+use crate::assignment::{Assignment, MissionReport};
 use crate::one_shot::{run_strip, run_tour};
-
-/// A mission this agent was assigned, checked.
-#[derive(Debug, Clone)]
-pub struct Assignment {
-    /// Mission id.
-    pub mission: String,
-    /// Our vehicle's id.
-    pub vehicle: String,
-    /// Its index in the scenario.
-    pub index: usize,
-    /// The scenario, overrides applied.
-    pub scenario: Scenario,
-    /// The first context.
-    pub context: Context,
-}
-
-impl Assignment {
-    /// Reads an `Assign` message; the error says what is wrong in plain words.
-    pub fn new(
-        mission: &str,
-        vehicle: &str,
-        scenario_toml: &str,
-        context: &WireContext,
-    ) -> Result<Assignment, String> {
-        let origin = format!("<scenario of mission {mission}>");
-        let scenario =
-            Scenario::parse(scenario_toml, Path::new(&origin)).map_err(|e| e.to_string())?;
-        let ids: Vec<&str> = scenario.vehicles.iter().map(|v| v.id.as_str()).collect();
-        let index = ids.iter().position(|id| *id == vehicle).ok_or_else(|| {
-            format!("mission {mission} has no vehicle {vehicle:?} (it has {ids:?})")
-        })?;
-        let context = context.to_context(&ids)?;
-        Ok(Assignment {
-            mission: mission.to_string(),
-            vehicle: vehicle.to_string(),
-            index,
-            scenario,
-            context,
-        })
-    }
-}
-
-/// How a mission ended for this agent.
-#[derive(Debug, Clone, PartialEq)]
-pub struct MissionReport {
-    /// Iterations the followers ran.
-    pub iterations: u32,
-    /// Elite messages sent.
-    pub elites_sent: u32,
-    /// Why it ended, in plain words.
-    pub outcome: String,
-}
 
 /// What waiting for the coordinator gave.
 enum Wait {

@@ -22,9 +22,10 @@ use shoal_common::wire::{session, topics, Envelope};
 use zenoh::qos::CongestionControl;
 use zenoh::{Session, Wait};
 
+use crate::assignment::{Assignment, MissionReport};
 use crate::execute::{self, Order};
 use crate::link;
-use crate::mission::{self, Assignment, MissionReport};
+use crate::mission;
 use crate::AgentArgs;
 use shoal_common::wire::open::Telemetry;
 

@@ -14,7 +14,7 @@ use shoal_common::tour::FleetTours;
 use shoal_common::wire::agent_to_coordinator::AgentToCoordinator;
 use shoal_common::wire::coordinator_to_agent::CoordinatorToAgent;
 
-use crate::mission::{Assignment, MissionReport};
+use crate::assignment::{Assignment, MissionReport};
 
 /// A tour mission (seed 003): this vehicle's share of the inspection points follows from the
 /// scenario alone ([`FleetTours`]), so the agent plans its tour at once, sends it, and is done.

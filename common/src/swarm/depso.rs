@@ -11,7 +11,7 @@
 //!    personal and global bests are then updated (Step 6).
 //!
 //! An "axis" is one group of [`Problem::move_groups`]: one dimension for a textbook function, one
-//! coordinate axis of a whole path for [`crate::tour::LegProblem`] (its x's, its y's, its z's),
+//! coordinate axis of a whole path for the tours' `LegProblem` (its x's, its y's, its z's),
 //! which is eq. (20) literally.
 //!
 //! Boundary absorption (eq. (30), second case): a coordinate that leaves the box is put on the
