@@ -26,6 +26,22 @@ pub fn segment_point_distance(a: &Vec3, b: &Vec3, p: &Vec3) -> f64 {
     (a + (b - a) * u - p).norm()
 }
 
+/// Closest approach of a path (its points joined by straight legs) to `centre` seen from above,
+/// metres: what decides whether a 2-D keep-out circle (a geofence, a map's exclusion zone)
+/// would cut a path that keeps clear in 3-D. Infinite for no points.
+pub fn horizontal_distance_to_path(points: &[Vec3], centre: [f64; 2]) -> f64 {
+    let flat = |p: &Vec3| Vec3::new(p.x, p.y, 0.0);
+    let c = Vec3::new(centre[0], centre[1], 0.0);
+    match points {
+        [] => f64::INFINITY,
+        [only] => (flat(only) - c).norm(),
+        _ => points
+            .windows(2)
+            .map(|w| segment_point_distance(&flat(&w[0]), &flat(&w[1]), &c))
+            .fold(f64::INFINITY, f64::min),
+    }
+}
+
 /// Extra distance, metres, the planner's penalties demand beyond a hard limit (an obstacle's
 /// inflated radius, a hazard's edge). A path the optimizer drives onto the limit itself would
 /// otherwise pass or fail on the last bit of rounding, and a checker that computes the same
@@ -136,6 +152,21 @@ pub fn pitch(a: &Vec3, b: &Vec3) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_paths_closest_approach_from_above_ignores_depth() {
+        // Legs (0,0,-50) → (100,0,-10) → (100,100,-10); centre (50, 30): 30 m from the first
+        // leg, hypot(50, 30) = 58.3 m from the second's start; depth plays no part.
+        let path = [
+            Vec3::new(0.0, 0.0, -50.0),
+            Vec3::new(100.0, 0.0, -10.0),
+            Vec3::new(100.0, 100.0, -10.0),
+        ];
+        assert!((horizontal_distance_to_path(&path, [50.0, 30.0]) - 30.0).abs() < 1e-12);
+        assert!((horizontal_distance_to_path(&path, [130.0, 60.0]) - 30.0).abs() < 1e-12);
+        assert!((horizontal_distance_to_path(&path[..1], [3.0, 4.0]) - 5.0).abs() < 1e-12);
+        assert_eq!(horizontal_distance_to_path(&[], [0.0, 0.0]), f64::INFINITY);
+    }
     use approx::assert_abs_diff_eq;
 
     fn v(x: f64, y: f64, z: f64) -> Vec3 {

@@ -18,7 +18,7 @@
 use serde_json::{json, Value};
 
 use super::{distance, footprint, leg_speeds, point, round, ExportInput, MAX_ACCEPTANCE_RADIUS_M};
-use shoal_common::geometry::{segment_point_distance, Vec3};
+use shoal_common::geometry::{horizontal_distance_to_path, Vec3};
 use shoal_common::plan::VehiclePlan;
 use shoal_common::scenario::{Obstacle, VehicleKind};
 
@@ -187,15 +187,9 @@ fn fence_circles(input: &ExportInput, v: &VehiclePlan) -> (Vec<Value>, Vec<Strin
 
 /// Whether the path, seen from above, enters the obstacle's inflated circle.
 fn crosses(v: &VehiclePlan, ob: &Obstacle) -> bool {
-    let flat = |p: [f64; 3]| Vec3::new(p[0], p[1], 0.0);
-    let c = flat(ob.centre);
-    let r = ob.inflated_radius();
-    match v.trajectory.as_slice() {
-        [only] => (flat(point(only)) - c).norm() < r,
-        samples => samples
-            .windows(2)
-            .any(|w| segment_point_distance(&flat(point(&w[0])), &flat(point(&w[1])), &c) < r),
-    }
+    let points: Vec<Vec3> = v.trajectory.iter().map(|s| Vec3::from(point(s))).collect();
+    let centre = [ob.centre[0], ob.centre[1]];
+    horizontal_distance_to_path(&points, centre) < ob.inflated_radius()
 }
 
 /// `[lat, lon, alt]`, rounded (0.1 mm, 1 mm).

@@ -19,6 +19,7 @@
 //! 3-D speed as ground speed would run a 20° dive leg 1/cos 20° = 6.4 % fast.
 
 use mavlink::dialects::common::{self as mav, MavAutopilot, MavCmd, MavFrame, MavType};
+use shoal_common::geometry::horizontal_distance_to_path;
 use shoal_common::scenario::{Bounds, Obstacle, ObstacleKind};
 use shoal_common::trajectory::Trajectory;
 
@@ -302,21 +303,8 @@ pub fn fence_items(
         .map(|c| fence_item(MavCmd::MAV_CMD_NAV_FENCE_POLYGON_VERTEX_INCLUSION, *c, 4.0))
         .collect();
     let passes_inside = |o: &Obstacle| {
-        let horizontal =
-            |p: &shoal_common::geometry::Vec3| (p.x - o.centre[0]).hypot(p.y - o.centre[1]);
-        plan.points.windows(2).any(|w| {
-            // Closest horizontal approach of the leg to the centre.
-            let (a, b) = (w[0], w[1]);
-            let d = b - a;
-            let len2 = d.x * d.x + d.y * d.y;
-            let s = match len2 > 0.0 {
-                true => {
-                    (((o.centre[0] - a.x) * d.x + (o.centre[1] - a.y) * d.y) / len2).clamp(0.0, 1.0)
-                }
-                false => 0.0,
-            };
-            horizontal(&(a + d * s)) <= o.radius_m
-        }) || plan.points.iter().any(|p| horizontal(p) <= o.radius_m)
+        let centre = [o.centre[0], o.centre[1]];
+        horizontal_distance_to_path(&plan.points, centre) <= o.radius_m
     };
     for o in obstacles.iter().filter(|o| o.kind == ObstacleKind::Hard) {
         if !passes_inside(o) {
