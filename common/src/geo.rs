@@ -115,6 +115,14 @@ impl GeoOrigin {
         None
     }
 
+    /// Whether `other` is this origin to within `deg` degrees of latitude and longitude and
+    /// `alt_m` metres of altitude (two copies of one origin read from different places).
+    pub fn agrees_with(&self, other: &GeoOrigin, deg: f64, alt_m: f64) -> bool {
+        (self.lat_deg - other.lat_deg).abs() <= deg
+            && (self.lon_deg - other.lon_deg).abs() <= deg
+            && (self.alt_m - other.alt_m).abs() <= alt_m
+    }
+
     /// Scenario point `p` (x east, y north, z up, metres) as [latitude °, longitude ° in
     /// [−180, 180], altitude m AMSL] (see the module documentation for z).
     pub fn to_geodetic(&self, p: [f64; 3]) -> [f64; 3] {

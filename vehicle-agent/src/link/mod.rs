@@ -160,13 +160,8 @@ pub fn mission_origin(
     agent: Option<GeoOrigin>,
     scenario: Option<GeoOrigin>,
 ) -> Result<GeoOrigin, LinkError> {
-    let same = |a: &GeoOrigin, b: &GeoOrigin| {
-        (a.lat_deg - b.lat_deg).abs() <= 1e-7
-            && (a.lon_deg - b.lon_deg).abs() <= 1e-7
-            && (a.alt_m - b.alt_m).abs() <= 0.01
-    };
     match (agent, scenario) {
-        (Some(a), Some(s)) if !same(&a, &s) => Err(LinkError::Refused(format!(
+        (Some(a), Some(s)) if !a.agrees_with(&s, 1e-7, 0.01) => Err(LinkError::Refused(format!(
             "the mission's origin ({}, {}, {} m) is not this agent's --mavlink-origin \
              ({}, {}, {} m): refused rather than fly the plan somewhere else",
             s.lat_deg, s.lon_deg, s.alt_m, a.lat_deg, a.lon_deg, a.alt_m

@@ -83,9 +83,7 @@ pub fn resolve_origin(
 
 /// Equal to well under a millimetre (the same numbers, read from different files).
 fn same(a: &GeoOrigin, b: &GeoOrigin) -> bool {
-    (a.lat_deg - b.lat_deg).abs() <= 1e-9
-        && (a.lon_deg - b.lon_deg).abs() <= 1e-9
-        && (a.alt_m - b.alt_m).abs() <= 1e-6
+    a.agrees_with(b, 1e-9, 1e-6)
 }
 
 /// Checks that `scenario` is the one `plan` was made for (same name, every vehicle in it) and
