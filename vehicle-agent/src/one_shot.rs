@@ -193,7 +193,6 @@ mod tests {
     use shoal_common::wire::agent_to_coordinator::tour_from_wire;
 
     use super::*;
-    use crate::mission::run;
 
     /// The `Stop` a coordinator sends on Ctrl-C.
     fn coordinator_stop() -> CoordinatorToAgent {
@@ -259,7 +258,8 @@ mod tests {
         Ok(a)
     }
 
-    /// Runs the mission with `queued` already in its inbox; returns its report and what it sent.
+    /// Runs the mission's share with `queued` already in its inbox; returns its report and what it
+    /// sent.
     fn run_one_shot(
         a: Assignment,
         queued: Option<CoordinatorToAgent>,
@@ -270,15 +270,13 @@ mod tests {
             let _ = tx.send(m);
         }
         let sent = RefCell::new(Vec::new());
-        let report = run(
-            a,
-            1,
-            &rx,
-            &|m| sent.borrow_mut().push(m),
-            &AtomicU32::new(0),
-            &AtomicBool::new(shutting_down),
-            Duration::from_secs(60),
-        );
+        let send = |m| sent.borrow_mut().push(m);
+        let (dropped, stop) = (AtomicU32::new(0), AtomicBool::new(shutting_down));
+        // The choice the agent's mission loop makes: a coverage share, else a tour share.
+        let report = match a.scenario.coverage.is_some() {
+            true => run_strip(&a, &rx, &send, &dropped, &stop),
+            false => run_tour(&a, &rx, &send, &dropped, &stop),
+        };
         (report, sent.into_inner())
     }
 
