@@ -253,7 +253,7 @@ pub fn check_parsed(scenario: &Scenario, plan: &Plan) -> Report {
         }
         figures.push(f);
     }
-    let tours: Vec<(&str, &crate::mobility::PlanTour)> = plan
+    let tours: Vec<(&str, &crate::sections::PlanTour)> = plan
         .vehicles
         .iter()
         .filter_map(|v| v.tour.as_ref().map(|t| (v.id.as_str(), t)))

@@ -33,6 +33,7 @@ pub mod mobility;
 mod model;
 mod report;
 pub mod seabed_grid;
+pub mod sections;
 
 pub use check::{check, check_file, check_parsed, close};
 pub use figures::{fleet_figures, vehicle_figures, FleetFigures, VehicleFigures};

@@ -2,45 +2,11 @@
 //! the turning radius, pitch and seabed clearance of an energy plan, and that a tour visits the
 //! inspection points it names, recomputed from the trajectory alone.
 
-use serde::Deserialize;
-
 use crate::model::{Obstacle, ObstacleKind, Scenario, Vehicle};
+use crate::sections::{eight, two, CurrentsSection, EnergySection, PlanEnergy, PlanTour};
 
 /// Relative and absolute slack of recomputed figures.
 const TOL: f64 = 1e-6;
-
-/// `[energy]` as far as the checker reads it.
-#[derive(Debug, Clone, Deserialize)]
-pub struct EnergySection {
-    /// R_AUV, metres.
-    #[serde(default = "eight")]
-    pub min_turn_radius_m: f64,
-    /// Height kept above the seabed, metres.
-    #[serde(default = "two")]
-    pub terrain_clearance_m: f64,
-}
-
-fn eight() -> f64 {
-    8.0
-}
-fn two() -> f64 {
-    2.0
-}
-fn five() -> f64 {
-    5.0
-}
-
-/// `[currents]` as far as the checker reads it: seed 001's depth-decay model (eq. (2)); a
-/// gridded field (`model = "grid"`, a file) is not recomputed.
-#[derive(Debug, Clone, Deserialize)]
-pub struct CurrentsSection {
-    /// `depth-decay` (the default) or `grid`.
-    #[serde(default)]
-    pub model: Option<String>,
-    /// `(u, v)` at the surface, m/s.
-    #[serde(default)]
-    pub surface_velocity_mps: Option<[f64; 2]>,
-}
 
 impl CurrentsSection {
     /// The current at `p` under seed 001 eq. (2): the surface value scaled by
@@ -60,44 +26,6 @@ impl CurrentsSection {
         };
         Some([u * s, v * s, 0.0])
     }
-}
-
-/// `[inspection]` as far as the checker reads it.
-#[derive(Debug, Clone, Deserialize)]
-pub struct InspectionSection {
-    /// Cage ids; empty: every hard obstacle.
-    #[serde(default)]
-    pub cages: Vec<String>,
-    /// Monitoring radius minus cage radius, metres.
-    #[serde(default = "five")]
-    pub standoff_m: f64,
-}
-
-/// `vehicles[].energy` of `plan.json`.
-#[derive(Debug, Clone, Deserialize)]
-pub struct PlanEnergy {
-    /// Reported length.
-    pub q_path: f64,
-    /// Reported turning-radius cost, m².
-    pub q_r: f64,
-    /// Reported pitch cost, deg².
-    pub q_a: f64,
-    /// Reported tightest turn.
-    pub min_turn_radius_m: f64,
-    /// Reported fastest speed through the water, m/s.
-    #[serde(default)]
-    pub max_water_speed_mps: Option<f64>,
-}
-
-/// `vehicles[].tour` of `plan.json`.
-#[derive(Debug, Clone, Deserialize)]
-pub struct PlanTour {
-    /// Point labels in visiting order.
-    pub order: Vec<String>,
-    /// Their positions.
-    pub points: Vec<[f64; 3]>,
-    /// Reported tour length.
-    pub tour_length_m: f64,
 }
 
 /// What the checks found.

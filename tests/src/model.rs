@@ -20,22 +20,22 @@ pub struct Scenario {
     pub fleet: Fleet,
     /// Seabed for crawlers.
     #[serde(default)]
-    pub seabed: Option<crate::crawler::Seabed>,
+    pub seabed: Option<crate::sections::Seabed>,
     /// Hazard cylinders crawlers must not enter.
     #[serde(default)]
-    pub hazards: Vec<crate::crawler::Hazard>,
+    pub hazards: Vec<crate::sections::Hazard>,
     /// Crawler cost settings.
     #[serde(default)]
-    pub crawler: Option<crate::crawler::CrawlerSettings>,
+    pub crawler: Option<crate::sections::CrawlerSettings>,
     /// Energy planner settings (seed 001).
     #[serde(default)]
-    pub energy: Option<crate::mobility::EnergySection>,
+    pub energy: Option<crate::sections::EnergySection>,
     /// Inspection tours (seed 003).
     #[serde(default)]
-    pub inspection: Option<crate::mobility::InspectionSection>,
+    pub inspection: Option<crate::sections::InspectionSection>,
     /// Ocean current (seed 001).
     #[serde(default)]
-    pub currents: Option<crate::mobility::CurrentsSection>,
+    pub currents: Option<crate::sections::CurrentsSection>,
 }
 
 /// Axis-aligned box, metres.
@@ -186,13 +186,13 @@ pub struct PlanVehicle {
     pub min_seabed_clearance_m: Option<f64>,
     /// Crawlers: reported seabed figures.
     #[serde(default)]
-    pub crawler: Option<crate::crawler::PlanCrawler>,
+    pub crawler: Option<crate::sections::PlanCrawler>,
     /// Energy-planned AUVs: reported seed 001 figures.
     #[serde(default)]
-    pub energy: Option<crate::mobility::PlanEnergy>,
+    pub energy: Option<crate::sections::PlanEnergy>,
     /// Inspection tours: reported seed 003 figures.
     #[serde(default)]
-    pub tour: Option<crate::mobility::PlanTour>,
+    pub tour: Option<crate::sections::PlanTour>,
 }
 
 /// Fleet figures in `plan.json`.
