@@ -50,14 +50,6 @@ impl Kind {
             Kind::ArduPilot => "ardupilot_vehicle.py",
         }
     }
-
-    /// The package whose import says a `python3` found on the PATH can run it.
-    fn package(self) -> &'static str {
-        match self {
-            Kind::Mavsdk => "mavsdk",
-            Kind::ArduPilot => "pymavlink",
-        }
-    }
 }
 
 /// A free UDP port on loopback (bound, read, released).
