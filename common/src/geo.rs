@@ -74,10 +74,14 @@ impl GeoOrigin {
 
     /// Whether the origin can anchor a tangent plane: latitude within [`MAX_ABS_LAT_DEG`],
     /// longitude in [−180, 180], altitude in [`ALT_RANGE_M`]; the error names the value.
-    pub fn check(&self) -> Result<(), String> {
+    pub fn check(&self) -> Result<(), BadOrigin> {
         match self.first_bad() {
             None => Ok(()),
-            Some((field, value, reason)) => Err(format!("{field} = {value}: {reason}")),
+            Some((field, value, reason)) => Err(BadOrigin {
+                field,
+                value,
+                reason,
+            }),
         }
     }
 
@@ -171,22 +175,40 @@ impl fmt::Display for GeoOrigin {
     }
 }
 
+/// An origin no tangent plane can hang from: the field (as in a scenario's `[origin]` table),
+/// its value and why it is refused.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{field} = {value}: {reason}")]
+pub struct BadOrigin {
+    /// `lat_deg`, `lon_deg` or `alt_m`.
+    pub field: &'static str,
+    /// The value refused.
+    pub value: f64,
+    /// Why.
+    pub reason: String,
+}
+
+/// Text that is not `LAT,LON,ALT` within range; the message shows the text and the ranges.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{0}")]
+pub struct BadOriginText(String);
+
 impl FromStr for GeoOrigin {
-    type Err = String;
+    type Err = BadOriginText;
     /// `LAT,LON,ALT`: a latitude within [`MAX_ABS_LAT_DEG`] of the equator, a longitude in
     /// [−180, 180], an altitude (AMSL) in [`ALT_RANGE_M`].
-    fn from_str(s: &str) -> Result<GeoOrigin, String> {
+    fn from_str(s: &str) -> Result<GeoOrigin, BadOriginText> {
         let v: Vec<f64> = s.split(',').filter_map(|p| p.trim().parse().ok()).collect();
         match v[..] {
             [lat, lon, alt] if GeoOrigin::new(lat, lon, alt).check().is_ok() => {
                 Ok(GeoOrigin::new(lat, lon, alt))
             }
-            _ => Err(format!(
+            _ => Err(BadOriginText(format!(
                 "{s:?} is not LAT,LON,ALT (latitude in [-{MAX_ABS_LAT_DEG}, {MAX_ABS_LAT_DEG}] and longitude in \
                  [-180, 180] degrees, altitude above mean sea level in [{}, {}] metres)",
                 ALT_RANGE_M.start(),
                 ALT_RANGE_M.end()
-            )),
+            ))),
         }
     }
 }

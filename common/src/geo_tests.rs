@@ -141,7 +141,8 @@ fn origins_are_checked_and_read_from_lat_lon_alt() {
             panic!("{bad:?} was accepted");
         };
         assert!(
-            e.starts_with(&format!("{bad:?} is not LAT,LON,ALT (")),
+            e.to_string()
+                .starts_with(&format!("{bad:?} is not LAT,LON,ALT (")),
             "{e}"
         );
     }
@@ -149,6 +150,7 @@ fn origins_are_checked_and_read_from_lat_lon_alt() {
     let e = GeoOrigin::new(90.0, 0.0, 0.0)
         .check()
         .err()
+        .map(|e| e.to_string())
         .unwrap_or_default();
     assert!(
         e.starts_with("lat_deg = 90: must be a latitude in [-89, 89]"),
@@ -157,11 +159,13 @@ fn origins_are_checked_and_read_from_lat_lon_alt() {
     let e = GeoOrigin::new(0.0, f64::NAN, 0.0)
         .check()
         .err()
+        .map(|e| e.to_string())
         .unwrap_or_default();
     assert!(e.starts_with("lon_deg = NaN"), "{e}");
     let e = GeoOrigin::new(0.0, 0.0, f64::INFINITY)
         .check()
         .err()
+        .map(|e| e.to_string())
         .unwrap_or_default();
     assert!(e.starts_with("alt_m = inf"), "{e}");
 }

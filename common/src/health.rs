@@ -59,23 +59,53 @@ impl Drop for Heartbeat {
     }
 }
 
+/// Why a process is not healthy.
+#[derive(Debug, thiserror::Error)]
+pub enum Unhealthy {
+    /// The health file cannot be read: the process never started beating, or stopped.
+    #[error("unhealthy: no health file {}: {source}", path.display())]
+    NoFile {
+        /// The health file.
+        path: PathBuf,
+        /// What the file system said.
+        source: std::io::Error,
+    },
+    /// The file is older than the limit: the process is alive no more, or hangs.
+    #[error(
+        "unhealthy: {} last written {:.0} s ago (limit {:.0} s)",
+        path.display(),
+        age.as_secs_f64(),
+        limit.as_secs_f64()
+    )]
+    Stale {
+        /// The health file.
+        path: PathBuf,
+        /// Time since it was last written.
+        age: Duration,
+        /// The limit it broke.
+        limit: Duration,
+    },
+}
+
 /// Whether `path` was rewritten within `max_age`; the error says why not.
-pub fn check(path: &Path, max_age: Duration) -> Result<(), String> {
+pub fn check(path: &Path, max_age: Duration) -> Result<(), Unhealthy> {
     let modified = std::fs::metadata(path)
         .and_then(|m| m.modified())
-        .map_err(|e| format!("unhealthy: no health file {}: {e}", path.display()))?;
+        .map_err(|source| Unhealthy::NoFile {
+            path: path.to_path_buf(),
+            source,
+        })?;
     let age = SystemTime::now()
         .duration_since(modified)
         .unwrap_or(Duration::ZERO);
     if age <= max_age {
         Ok(())
     } else {
-        Err(format!(
-            "unhealthy: {} last written {:.0} s ago (limit {:.0} s)",
-            path.display(),
-            age.as_secs_f64(),
-            max_age.as_secs_f64()
-        ))
+        Err(Unhealthy::Stale {
+            path: path.to_path_buf(),
+            age,
+            limit: max_age,
+        })
     }
 }
 
@@ -84,14 +114,17 @@ mod tests {
     use super::*;
 
     #[test]
-    fn a_beating_file_is_fresh_and_gone_after_drop() -> Result<(), String> {
+    fn a_beating_file_is_fresh_and_gone_after_drop() -> Result<(), Unhealthy> {
         let path = std::env::temp_dir().join(format!("shoal-health-{}", std::process::id()));
         assert!(check(&path, BEAT).is_err(), "no file yet");
         let beat = Heartbeat::start(&path);
         std::thread::sleep(Duration::from_millis(200));
         check(&path, BEAT)?;
         drop(beat);
-        let e = check(&path, BEAT).err().unwrap_or_default();
+        let e = check(&path, BEAT)
+            .err()
+            .map(|e| e.to_string())
+            .unwrap_or_default();
         assert!(e.contains("no health file"), "{e}");
         Ok(())
     }
@@ -103,6 +136,7 @@ mod tests {
         std::thread::sleep(Duration::from_millis(50));
         let e = check(&path, Duration::from_millis(1))
             .err()
+            .map(|e| e.to_string())
             .unwrap_or_default();
         std::fs::remove_file(&path)?;
         assert!(e.contains("last written"), "{e}");

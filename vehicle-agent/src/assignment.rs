@@ -6,7 +6,56 @@ use std::path::Path;
 
 use shoal_common::distributed::Context;
 use shoal_common::scenario::Scenario;
-use shoal_common::wire::WireContext;
+use shoal_common::scenario::ScenarioError;
+use shoal_common::wire::{BadContext, BadTrajectory, WireContext};
+
+/// Why an assignment or an execution order from the coordinator cannot be used.
+#[derive(Debug, thiserror::Error)]
+pub enum Unusable {
+    /// The scenario does not parse or validate.
+    #[error(transparent)]
+    Scenario(#[from] ScenarioError),
+    /// The scenario has no vehicle of ours.
+    #[error("mission {mission} has no vehicle {vehicle:?} (it has {ids:?})")]
+    NoVehicle {
+        /// The mission.
+        mission: String,
+        /// Our vehicle.
+        vehicle: String,
+        /// The vehicles it has.
+        ids: Vec<String>,
+    },
+    /// The context does not fit the fleet.
+    #[error(transparent)]
+    Context(#[from] BadContext),
+    /// The trajectory to drive is unusable.
+    #[error(transparent)]
+    Trajectory(#[from] BadTrajectory),
+    /// The mission clock does not run forward.
+    #[error("time scale {0} is not a positive number")]
+    TimeScale(f64),
+    /// Telemetry would be too slow to see or faster than the link is sized for.
+    #[error("telemetry rate {0} Hz is not in (0, 100]")]
+    TelemetryRate(f64),
+}
+
+/// The scenario of mission `mission` and `vehicle`'s index in it.
+pub fn parse_for(
+    mission: &str,
+    vehicle: &str,
+    scenario_toml: &str,
+) -> Result<(Scenario, usize), Unusable> {
+    let origin = format!("<scenario of mission {mission}>");
+    let scenario = Scenario::parse(scenario_toml, Path::new(&origin))?;
+    match scenario.vehicles.iter().position(|v| v.id == vehicle) {
+        Some(index) => Ok((scenario, index)),
+        None => Err(Unusable::NoVehicle {
+            mission: mission.to_string(),
+            vehicle: vehicle.to_string(),
+            ids: scenario.vehicles.iter().map(|v| v.id.clone()).collect(),
+        }),
+    }
+}
 
 /// A mission this agent was assigned, checked.
 #[derive(Debug, Clone)]
@@ -30,14 +79,9 @@ impl Assignment {
         vehicle: &str,
         scenario_toml: &str,
         context: &WireContext,
-    ) -> Result<Assignment, String> {
-        let origin = format!("<scenario of mission {mission}>");
-        let scenario =
-            Scenario::parse(scenario_toml, Path::new(&origin)).map_err(|e| e.to_string())?;
+    ) -> Result<Assignment, Unusable> {
+        let (scenario, index) = parse_for(mission, vehicle, scenario_toml)?;
         let ids: Vec<&str> = scenario.vehicles.iter().map(|v| v.id.as_str()).collect();
-        let index = ids.iter().position(|id| *id == vehicle).ok_or_else(|| {
-            format!("mission {mission} has no vehicle {vehicle:?} (it has {ids:?})")
-        })?;
         let context = context.to_context(&ids)?;
         Ok(Assignment {
             mission: mission.to_string(),

@@ -3,7 +3,6 @@
 //! holds and the stop arrive on a channel; reports leave through a closure, so this loop knows
 //! nothing of Zenoh.
 
-use std::path::Path;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::{Receiver, RecvTimeoutError};
 use std::time::{Duration, Instant};
@@ -17,8 +16,8 @@ use shoal_common::wire::coordinator_to_agent::CoordinatorToAgent;
 use shoal_common::wire::open::{Telemetry, OPEN_VERSION};
 use shoal_common::wire::WireTrajectory;
 
-use crate::assignment::MissionReport;
-use crate::link::VehicleLink;
+use crate::assignment::{parse_for, MissionReport, Unusable};
+use crate::link::{LinkError, VehicleLink};
 
 /// An `Execute` order, checked.
 #[derive(Debug, Clone)]
@@ -53,22 +52,13 @@ impl Order {
         time_scale: f64,
         telemetry_hz: f64,
         seed: u64,
-    ) -> Result<Order, String> {
-        let origin = format!("<scenario of mission {mission}>");
-        let scenario =
-            Scenario::parse(scenario_toml, Path::new(&origin)).map_err(|e| e.to_string())?;
-        let index = scenario
-            .vehicles
-            .iter()
-            .position(|v| v.id == vehicle)
-            .ok_or_else(|| format!("mission {mission} has no vehicle {vehicle:?}"))?;
+    ) -> Result<Order, Unusable> {
+        let (scenario, index) = parse_for(mission, vehicle, scenario_toml)?;
         if !(time_scale.is_finite() && time_scale > 0.0) {
-            return Err(format!("time scale {time_scale} is not a positive number"));
+            return Err(Unusable::TimeScale(time_scale));
         }
         if !(telemetry_hz.is_finite() && telemetry_hz > 0.0 && telemetry_hz <= 100.0) {
-            return Err(format!(
-                "telemetry rate {telemetry_hz} Hz is not in (0, 100]"
-            ));
+            return Err(Unusable::TelemetryRate(telemetry_hz));
         }
         Ok(Order {
             mission: mission.to_string(),
@@ -113,14 +103,18 @@ struct Driver<'a> {
 impl Driver<'_> {
     /// Gives `command` to the vehicle (`plan` for an upload); the error if it could not even
     /// be given.
-    fn give(&mut self, command: VehicleCommand, plan: Option<&Trajectory>) -> Result<(), String> {
+    fn give(
+        &mut self,
+        command: VehicleCommand,
+        plan: Option<&Trajectory>,
+    ) -> Result<(), LinkError> {
         let now = self.order.clock.now();
         let given = match (command, plan) {
             (VehicleCommand::Upload, Some(plan)) => self.link.upload(plan),
             (VehicleCommand::Stop, _) => self.link.stop(),
             _ => self.link.hold(now),
         };
-        given.map_err(|e| e.to_string())?;
+        given?;
         self.command = Some(CommandReport {
             command,
             state: CommandState::Pending,
@@ -433,7 +427,7 @@ mod tests {
         let ok = wire(vec![[0.0, 1.0, 2.0, 3.0], [10.0, 4.0, 5.0, 6.0]]);
         let s = scenario_toml();
         assert!(Order::new("m", "auv1", &s, &ok, 0, 50.0, 2.0, 1).is_ok());
-        let e = |r: Result<Order, String>| r.err().unwrap_or_default();
+        let e = |r: Result<Order, Unusable>| r.err().map(|e| e.to_string()).unwrap_or_default();
         assert!(
             e(Order::new("m", "auv9", &s, &ok, 0, 50.0, 2.0, 1)).contains("no vehicle \"auv9\"")
         );

@@ -311,7 +311,9 @@ impl Inbound<'_> {
                         take(self.seqs);
                         self.start(a)
                     }
-                    Err(why) => self.drops.drop_message("unusable assignment", &why),
+                    Err(why) => self
+                        .drops
+                        .drop_message("unusable assignment", &why.to_string()),
                 }
             }
             CoordinatorToAgent::Execute {
@@ -356,7 +358,9 @@ impl Inbound<'_> {
                         take(self.seqs);
                         self.start_execution(order)
                     }
-                    Err(why) => self.drops.drop_message("unusable execution order", &why),
+                    Err(why) => self
+                        .drops
+                        .drop_message("unusable execution order", &why.to_string()),
                 }
             }
             CoordinatorToAgent::Migrants { vehicle: ref v, .. }

@@ -31,7 +31,7 @@ pub(crate) fn run_tour(
     stop: &AtomicBool,
 ) -> MissionReport {
     run_share(a, send, dropped, &|a| {
-        let job = FleetTours::new(&a.scenario)?;
+        let job = FleetTours::new(&a.scenario).map_err(|e| e.to_string())?;
         let (tour, why) = plan_watched(inbox, stop, |cut| job.plan_vehicle(a.index, Some(cut)));
         let mut words = format!(
             "tour of {} points planned: {:.1} m",
@@ -114,7 +114,7 @@ pub(crate) fn run_strip(
     stop: &AtomicBool,
 ) -> MissionReport {
     run_share(a, send, dropped, &|a| {
-        let job = FleetCoverage::new(&a.scenario)?;
+        let job = FleetCoverage::new(&a.scenario).map_err(|e| e.to_string())?;
         let map = job.map(Path::new(".")).map_err(|e| e.to_string())?;
         let (plan, why) = plan_watched(inbox, stop, |cut| {
             job.plan_vehicle(&map, a.index, Some(cut), &mut |stage, f| {
@@ -330,7 +330,10 @@ mod tests {
             return Err(format!("sent {sent:?}"));
         };
         assert_eq!(done, evaluations);
-        let share = FleetTours::new(&tour_assignment(1)?.scenario)?.shares[0].len();
+        let share = FleetTours::new(&tour_assignment(1)?.scenario)
+            .map_err(|e| e.to_string())?
+            .shares[0]
+            .len();
         let t = tour_from_wire(tour, share).ok_or("not a tour")??;
         assert_eq!(t.order.len(), share, "every point of the share is visited");
         Ok(())

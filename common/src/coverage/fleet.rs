@@ -37,15 +37,59 @@ const DELAY_ROUNDS: usize = 24;
 /// Multiples of the delay step tried for each vehicle of the worst pair in a round.
 const DELAY_MULTIPLES: [f64; 8] = [1.0, 2.0, 4.0, 8.0, 16.0, 32.0, 64.0, 128.0];
 
+/// Why a scenario has no fleet coverage job.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum FleetCoverageError {
+    /// The scenario has no `[coverage]` table.
+    #[error("scenario {0:?} has no [coverage] table")]
+    NoCoverageTable(String),
+    /// A vehicle is not a crawler.
+    #[error("vehicles: {0:?} is not a crawler; a [coverage] mission drives crawlers only")]
+    NotACrawler(String),
+    /// The area is too narrow for one row per crawler.
+    #[error(
+        "[coverage] fleet strips: the area holds {rows} rows {spacing} m apart: too few for {crawlers} crawlers (each needs one row at least)"
+    )]
+    TooFewRows {
+        /// Rows the area holds.
+        rows: usize,
+        /// Row spacing, metres.
+        spacing: f64,
+        /// Crawlers in the fleet.
+        crawlers: usize,
+    },
+}
+
+/// Why a strip plan that came from elsewhere is refused.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum BadStripPlan {
+    /// It covers another area than its strip.
+    #[error(
+        "a plan of the area [{}, {}] × [{}, {}], not of its strip [{}, {}] × [{}, {}]",
+        area.x0, area.x1, area.y0, area.y1, strip.x0, strip.x1, strip.y0, strip.y1
+    )]
+    OtherArea {
+        /// The area the plan covers.
+        area: Rect,
+        /// The strip it was asked for.
+        strip: Rect,
+    },
+    /// Its path has a non-finite number or a non-positive arc radius.
+    #[error("a path with a non-finite number or a non-positive arc radius")]
+    InvalidPath,
+}
+
 /// Splits `area` into `n` strips of whole rows `spacing` apart, south to north; the first
 /// `rows mod n` strips take one row more, the last strip also takes the sliver above the last
 /// row. Fails when the area holds fewer rows than crawlers.
-pub fn strips(area: Rect, n: usize, spacing: f64) -> Result<Vec<Rect>, String> {
+pub fn strips(area: Rect, n: usize, spacing: f64) -> Result<Vec<Rect>, FleetCoverageError> {
     let rows = ((area.y1 - area.y0) / spacing + 1e-9).floor().max(0.0) as usize;
     if n == 0 || rows < n {
-        return Err(format!(
-            "the area holds {rows} rows {spacing} m apart: too few for {n} crawlers (each needs one row at least)"
-        ));
+        return Err(FleetCoverageError::TooFewRows {
+            rows,
+            spacing,
+            crawlers: n,
+        });
     }
     let (base, extra) = (rows / n, rows % n);
     let mut out = Vec::with_capacity(n);
@@ -85,20 +129,17 @@ pub struct FleetCoverage {
 
 impl FleetCoverage {
     /// The job of a scenario with a `[coverage]` table and crawlers only.
-    pub fn new(scenario: &Scenario) -> Result<FleetCoverage, String> {
+    pub fn new(scenario: &Scenario) -> Result<FleetCoverage, FleetCoverageError> {
         let settings = scenario
             .coverage
             .clone()
-            .ok_or_else(|| format!("scenario {:?} has no [coverage] table", scenario.name))?;
+            .ok_or_else(|| FleetCoverageError::NoCoverageTable(scenario.name.clone()))?;
         if let Some(v) = scenario
             .vehicles
             .iter()
             .find(|v| v.kind != VehicleKind::Crawler)
         {
-            return Err(format!(
-                "vehicles: {:?} is not a crawler; a [coverage] mission drives crawlers only",
-                v.id
-            ));
+            return Err(FleetCoverageError::NotACrawler(v.id.clone()));
         }
         let b = &scenario.bounds;
         let area = Rect::new(b.min[0], b.min[1], b.max[0], b.max[1]);
@@ -106,8 +147,7 @@ impl FleetCoverage {
             area,
             scenario.vehicles.len(),
             settings.planner.row_spacing(),
-        )
-        .map_err(|e| format!("[coverage] fleet strips: {e}"))?;
+        )?;
         Ok(FleetCoverage {
             terrain_seed: settings.terrain_seed.unwrap_or(scenario.optimizer.seed),
             tracking_seed: scenario.optimizer.seed,
@@ -172,7 +212,7 @@ pub struct StripPlan {
 
 impl StripPlan {
     /// Checks a strip plan that came from elsewhere: planned for `strip`, every number finite.
-    pub fn check(&self, strip: Rect) -> Result<(), String> {
+    pub fn check(&self, strip: Rect) -> Result<(), BadStripPlan> {
         let a = self.report.area;
         let off = [
             a.x0 - strip.x0,
@@ -181,13 +221,10 @@ impl StripPlan {
             a.y1 - strip.y1,
         ];
         if off.iter().any(|d| d.is_nan() || d.abs() > 1e-6) {
-            return Err(format!(
-                "a plan of the area [{}, {}] × [{}, {}], not of its strip [{}, {}] × [{}, {}]",
-                a.x0, a.x1, a.y0, a.y1, strip.x0, strip.x1, strip.y0, strip.y1
-            ));
+            return Err(BadStripPlan::OtherArea { area: a, strip });
         }
         if !self.path.is_valid() {
-            return Err("a path with a non-finite number or a non-positive arc radius".into());
+            return Err(BadStripPlan::InvalidPath);
         }
         Ok(())
     }

@@ -13,11 +13,11 @@ use std::path::Path;
 
 use super::boxes::Rect;
 use super::drive::{thin, DRIVE_STEP_M, THIN_TOL_M};
-use super::fleet::FleetCoverage;
+use super::fleet::{FleetCoverage, FleetCoverageError};
 use super::hybrid_astar::HybridAStarParams;
 use super::path::Pose2;
 use super::reach::ReachGrid;
-use super::TerrainMap25;
+use super::{Terrain25Error, TerrainMap25};
 use crate::geometry::Vec3;
 use crate::scenario::Scenario;
 
@@ -39,13 +39,22 @@ pub struct CrawlerGround {
     pub sensor_height_m: f64,
 }
 
+/// Why a scenario gives no ground to reroute crawlers on.
+#[derive(Debug, thiserror::Error)]
+pub enum NoGround {
+    /// The scenario is no crawler coverage mission.
+    #[error(transparent)]
+    Job(#[from] FleetCoverageError),
+    /// Its seabed map cannot be built.
+    #[error("the [coverage] map: {0}")]
+    Map(#[from] Terrain25Error),
+}
+
 impl CrawlerGround {
     /// The ground of a scenario with a `[coverage]` table; `dir` resolves a heightmap file.
-    pub fn of(scenario: &Scenario, dir: &Path) -> Result<CrawlerGround, String> {
+    pub fn of(scenario: &Scenario, dir: &Path) -> Result<CrawlerGround, NoGround> {
         let job = FleetCoverage::new(scenario)?;
-        let map = job
-            .map(dir)
-            .map_err(|e| format!("the [coverage] map: {e}"))?;
+        let map = job.map(dir)?;
         Ok(CrawlerGround {
             map,
             area: job.area,

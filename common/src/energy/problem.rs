@@ -72,19 +72,32 @@ pub struct EnergyProblem {
     upper: Vec<f64>,
 }
 
+/// Why a scenario's vehicle cannot be planned by the energy-saving planner.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum NotPlannable {
+    /// The vehicle index is past the scenario's vehicles.
+    #[error("the scenario has no vehicle {0}")]
+    NoVehicle(usize),
+    /// The planner's model (Zhang et al. 2022) is an AUV's: a crawler has no pitch or currents.
+    #[error("{id} is a {kind:?}: the energy-saving planner (seed 001) plans AUVs")]
+    NotAnAuv {
+        /// The vehicle's id.
+        id: String,
+        /// What it is.
+        kind: VehicleKind,
+    },
+}
+
 impl EnergyProblem {
     /// The problem of vehicle `i` of `scenario`. Errors say why the scenario cannot be planned
     /// this way.
-    pub fn new(scenario: &Scenario, i: usize, objective: Objective) -> Result<Self, String> {
-        let v = scenario
-            .vehicles
-            .get(i)
-            .ok_or_else(|| format!("the scenario has no vehicle {i}"))?;
+    pub fn new(scenario: &Scenario, i: usize, objective: Objective) -> Result<Self, NotPlannable> {
+        let v = scenario.vehicles.get(i).ok_or(NotPlannable::NoVehicle(i))?;
         if v.kind != VehicleKind::Auv {
-            return Err(format!(
-                "{} is a {:?}: the energy-saving planner (seed 001) plans AUVs",
-                v.id, v.kind
-            ));
+            return Err(NotPlannable::NotAnAuv {
+                id: v.id.clone(),
+                kind: v.kind,
+            });
         }
         let e = &scenario.energy;
         let b = &scenario.bounds;

@@ -48,17 +48,23 @@ pub struct FleetTours {
     pub seed: u64,
 }
 
+/// A scenario that is no inspection mission: it names no `[inspection]` table or no tour
+/// algorithm.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("{0} needs an [inspection] table and a tour algorithm (de-pso, ldiw-pso, lcpso)")]
+pub struct NoTours(
+    /// The scenario's name.
+    pub String,
+);
+
 impl FleetTours {
     /// The job of `scenario`; the error says why the scenario has none.
-    pub fn new(scenario: &Scenario) -> Result<FleetTours, String> {
+    pub fn new(scenario: &Scenario) -> Result<FleetTours, NoTours> {
         let o = &scenario.optimizer;
         let (Some(inspection), Some(algorithm)) =
             (&scenario.inspection, leg_algorithm(o.algorithm))
         else {
-            return Err(format!(
-                "{} needs an [inspection] table and a tour algorithm (de-pso, ldiw-pso, lcpso)",
-                scenario.name
-            ));
+            return Err(NoTours(scenario.name.clone()));
         };
         let chosen: Vec<(Cage, f64)> = inspection
             .cage_indices(scenario)

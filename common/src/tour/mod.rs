@@ -24,7 +24,7 @@ pub use cages::{
     InspectionPoint, MONITOR_STANDOFF_M,
 };
 pub use figures::TourFigures;
-pub use fleet::{leg_algorithm, shares, FleetTours};
+pub use fleet::{leg_algorithm, shares, FleetTours, NoTours};
 pub use leg::{
     feasible, intersections, path_length, safety_spheres, segment_hits, LegProblem, Sphere,
     CHORD_WEIGHT, HIT_PENALTY_M,

@@ -108,6 +108,41 @@ pub struct WireContext {
     pub trajectories: Vec<WireTrajectory>,
 }
 
+/// Why a context from the coordinator does not fit the agent's fleet.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum BadContext {
+    /// One trajectory per vehicle is expected.
+    #[error("context has {trajectories} trajectories for a fleet of {fleet}")]
+    Count {
+        /// Trajectories received.
+        trajectories: usize,
+        /// Vehicles in the fleet.
+        fleet: usize,
+    },
+    /// The trajectories come in scenario order.
+    #[error("context names {named:?} where {expected:?} was expected")]
+    Vehicle {
+        /// The id the context gives.
+        named: String,
+        /// The id in that place of the scenario.
+        expected: String,
+    },
+    /// A trajectory is unusable.
+    #[error(transparent)]
+    Trajectory(#[from] BadTrajectory),
+    /// The synchronised arrival time is not a number.
+    #[error("arrival time {0} is not finite")]
+    Arrival(f64),
+}
+
+/// A trajectory from the network that is empty, not finite or not timed in order.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("trajectory of {0} is empty, not finite or not timed in order")]
+pub struct BadTrajectory(
+    /// The vehicle it is said to be of.
+    pub String,
+);
+
 impl WireContext {
     /// `c` on the wire; `ids` names the vehicles in scenario order.
     pub fn new(c: &Context, ids: &[&str]) -> WireContext {
@@ -124,26 +159,25 @@ impl WireContext {
     }
 
     /// Back to a context for a fleet of `ids` (scenario order), or why it does not fit.
-    pub fn to_context(&self, ids: &[&str]) -> Result<Context, String> {
+    pub fn to_context(&self, ids: &[&str]) -> Result<Context, BadContext> {
         if self.trajectories.len() != ids.len() {
-            return Err(format!(
-                "context has {} trajectories for a fleet of {}",
-                self.trajectories.len(),
-                ids.len()
-            ));
+            return Err(BadContext::Count {
+                trajectories: self.trajectories.len(),
+                fleet: ids.len(),
+            });
         }
         let mut trajectories = Vec::with_capacity(ids.len());
         for (t, id) in self.trajectories.iter().zip(ids) {
             if t.vehicle != *id {
-                return Err(format!(
-                    "context names {:?} where {id:?} was expected",
-                    t.vehicle
-                ));
+                return Err(BadContext::Vehicle {
+                    named: t.vehicle.clone(),
+                    expected: (*id).to_string(),
+                });
             }
             trajectories.push(t.checked()?);
         }
         if !self.arrival_s.is_finite() {
-            return Err(format!("arrival time {} is not finite", self.arrival_s));
+            return Err(BadContext::Arrival(self.arrival_s));
         }
         Ok(Context {
             round: self.round,
@@ -182,17 +216,14 @@ impl WireTrajectory {
     }
 
     /// Back to a trajectory, or why it is unusable (empty, not finite, not timed in order).
-    pub fn checked(&self) -> Result<Trajectory, String> {
+    pub fn checked(&self) -> Result<Trajectory, BadTrajectory> {
         let ok = !self.samples.is_empty()
             && self.samples.iter().flatten().all(|v| v.is_finite())
             && self.samples.windows(2).all(|w| w[1][0] >= w[0][0]);
         if ok {
             Ok(self.to_trajectory())
         } else {
-            Err(format!(
-                "trajectory of {} is empty, not finite or not timed in order",
-                self.vehicle
-            ))
+            Err(BadTrajectory(self.vehicle.clone()))
         }
     }
 }

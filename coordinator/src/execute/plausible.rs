@@ -265,23 +265,53 @@ fn diagonal(b: &Bounds) -> f64 {
 /// Whether published obstacle `o` fits the navigation space: its inflated radius no larger
 /// than the bounds' diagonal, its centre no farther outside them than that diagonal. Either
 /// beyond would block everything or nothing, at any cost to the replans.
-pub fn check_obstacle_scale(o: &Obstacle, bounds: &Bounds) -> Result<(), String> {
+pub fn check_obstacle_scale(o: &Obstacle, bounds: &Bounds) -> Result<(), OutOfScale> {
     let d = diagonal(bounds);
     let r = o.radius_m + o.inflation_m;
     if r > d {
-        return Err(format!(
-            "obstacle {:?}: radius_m + inflation_m = {r} is over the {d:.0} m diagonal of the scenario's bounds",
-            o.id
-        ));
+        return Err(OutOfScale::TooLarge {
+            id: o.id.clone(),
+            radius_m: r,
+            diagonal_m: d,
+        });
     }
     let outside = distance_outside(o.centre, bounds);
     if outside > d {
-        return Err(format!(
-            "obstacle {:?}: centre {:?} is {outside:.0} m outside the scenario's bounds (over their {d:.0} m diagonal)",
-            o.id, o.centre
-        ));
+        return Err(OutOfScale::TooFar {
+            id: o.id.clone(),
+            centre: o.centre,
+            outside_m: outside,
+            diagonal_m: d,
+        });
     }
     Ok(())
+}
+
+/// A published obstacle out of all proportion to the navigation space.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum OutOfScale {
+    /// Larger than the bounds' diagonal: it would block everything.
+    #[error("obstacle {id:?}: radius_m + inflation_m = {radius_m} is over the {diagonal_m:.0} m diagonal of the scenario's bounds")]
+    TooLarge {
+        /// The obstacle's id.
+        id: String,
+        /// Its inflated radius, metres.
+        radius_m: f64,
+        /// The bounds' diagonal, metres.
+        diagonal_m: f64,
+    },
+    /// Farther outside the bounds than their diagonal: it would block nothing.
+    #[error("obstacle {id:?}: centre {centre:?} is {outside_m:.0} m outside the scenario's bounds (over their {diagonal_m:.0} m diagonal)")]
+    TooFar {
+        /// The obstacle's id.
+        id: String,
+        /// Its centre.
+        centre: [f64; 3],
+        /// How far outside the bounds, metres.
+        outside_m: f64,
+        /// The bounds' diagonal, metres.
+        diagonal_m: f64,
+    },
 }
 
 /// A token bucket: `rate` tokens a second, at most `capacity` saved up.

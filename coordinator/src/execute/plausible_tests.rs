@@ -194,7 +194,8 @@ fn an_obstacle_larger_than_the_bounds_diagonal_or_far_outside_them_is_refused() 
     assert!(check_obstacle_scale(&obstacle([2700.0, 500.0, 500.0], 10.0, 5.0), &cube()).is_ok());
     let far = check_obstacle_scale(&obstacle([2800.0, 500.0, 500.0], 10.0, 5.0), &cube());
     assert!(
-        far.as_ref().is_err_and(|e| e.contains("1800 m outside")),
+        far.as_ref()
+            .is_err_and(|e| e.to_string().contains("1800 m outside")),
         "{far:?}"
     );
 }

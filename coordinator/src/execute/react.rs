@@ -232,7 +232,7 @@ pub(super) fn obstacle_bytes(x: &mut Exec, bytes: &[u8], arrived: Instant) {
             EVENT_OBSTACLE_DROPPED,
             "obstacles",
             Reason::ObstacleOutOfScale,
-            why,
+            why.to_string(),
         );
     }
     // A known id is dropped rather than replacing the obstacle: a client resending for

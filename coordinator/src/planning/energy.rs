@@ -50,7 +50,7 @@ pub fn plan(
     let o = &scenario.optimizer;
     let problem = match EnergyProblem::new(scenario, 0, objective_of(o.algorithm)) {
         Ok(p) => p,
-        Err(why) => return unplannable(scenario, why),
+        Err(why) => return unplannable(scenario, why.to_string()),
     };
     let executor = Executor {
         max_iterations: o.iterations,

@@ -30,7 +30,7 @@ pub fn plan(
     let started = Instant::now();
     let job = match FleetTours::new(scenario) {
         Ok(j) => j,
-        Err(why) => return unplannable(scenario, why),
+        Err(why) => return unplannable(scenario, why.to_string()),
     };
     let n = scenario.vehicles.len();
     // Progress, as in a distributed run: the tours finished so far, their summed length.

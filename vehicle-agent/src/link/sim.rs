@@ -47,7 +47,7 @@ impl SimLink {
             // as the agent's planning does).
             VehicleKind::Crawler if scenario.coverage.is_some() => {
                 let map = FleetCoverage::new(scenario)
-                    .map_err(LinkError::Io)?
+                    .map_err(|e| LinkError::Io(e.to_string()))?
                     .map(Path::new("."))
                     .map_err(|e| LinkError::Io(format!("the [coverage] seabed map: {e}")))?;
                 SimModel::Crawler {
@@ -167,7 +167,8 @@ mod tests {
     fn a_coverage_crawler_drives_on_the_map_for_longer_than_a_battery_lasts() -> Result<(), String>
     {
         let s = scenario("cpp-seabed.toml")?;
-        let map = FleetCoverage::new(&s)?
+        let map = FleetCoverage::new(&s)
+            .map_err(|e| e.to_string())?
             .map(Path::new("."))
             .map_err(|e| e.to_string())?;
         let mut link = SimLink::new(&s, 0, 0.0, 1).map_err(|e| e.to_string())?;

@@ -75,7 +75,10 @@ impl ShareJob {
             (ShareJob::Strips(job, _), AgentToCoordinator::Coverage { strip, plan, .. }) => {
                 Some(match job.strips.get(i) {
                     _ if strip as usize != i => Err(format!("strip {strip} for vehicle {i}")),
-                    Some(rect) => plan.check(*rect).map(|()| Share::Strip(plan)),
+                    Some(rect) => plan
+                        .check(*rect)
+                        .map(|()| Share::Strip(plan))
+                        .map_err(|e| e.to_string()),
                     None => Err(format!("no strip for vehicle {i}")),
                 })
             }

@@ -53,13 +53,51 @@ impl ExportInput<'_> {
     }
 }
 
+/// Why a plan cannot be exported as asked.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum ExportError {
+    /// Neither the plan, the scenario nor the command line gives an origin.
+    #[error("no origin: the plan and the scenario have none; give one with --origin LAT,LON,ALT (or add an [origin] table to the scenario and plan again)")]
+    NoOrigin,
+    /// Two given origins differ (each named with where it came from).
+    #[error("{first} and {second} differ: give one origin, or the one the plan was made with")]
+    OriginsDiffer {
+        /// The first origin given, with its source.
+        first: String,
+        /// The one that differs from it, with its source.
+        second: String,
+    },
+    /// A vehicle id cannot name a file.
+    #[error("{0}: a vehicle id must be 1-64 letters, digits, '-', '_' or '.'")]
+    BadId(String),
+    /// A vehicle has no trajectory.
+    #[error("vehicle {0} has no trajectory")]
+    NoTrajectory(String),
+    /// The scenario given is not the plan's.
+    #[error("the plan was made for scenario {plan:?}, not {scenario:?}")]
+    OtherScenario {
+        /// The plan's scenario name.
+        plan: String,
+        /// The given scenario's name.
+        scenario: String,
+    },
+    /// The plan has a vehicle the scenario lacks.
+    #[error("vehicle {vehicle} is not in scenario {scenario:?}")]
+    NotInScenario {
+        /// The vehicle id.
+        vehicle: String,
+        /// The scenario's name.
+        scenario: String,
+    },
+}
+
 /// The one origin of an export, from wherever it is given: the plan's, the scenario's or the
 /// command line's. None is an error, and so are two that differ (both named).
 pub fn resolve_origin(
     plan: Option<GeoOrigin>,
     scenario: Option<GeoOrigin>,
     flag: Option<GeoOrigin>,
-) -> Result<GeoOrigin, String> {
+) -> Result<GeoOrigin, ExportError> {
     let given: Vec<(&str, GeoOrigin)> = [
         ("plan.json's origin", plan),
         ("the scenario's [origin]", scenario),
@@ -69,13 +107,14 @@ pub fn resolve_origin(
     .filter_map(|(name, o)| o.map(|o| (name, o)))
     .collect();
     let Some(&(first_name, first)) = given.first() else {
-        return Err("no origin: the plan and the scenario have none; give one with --origin LAT,LON,ALT (or add an [origin] table to the scenario and plan again)".into());
+        return Err(ExportError::NoOrigin);
     };
     for &(name, o) in &given[1..] {
         if !same(&first, &o) {
-            return Err(format!(
-                "{first_name} {first} and {name} {o} differ: give one origin, or the one the plan was made with"
-            ));
+            return Err(ExportError::OriginsDiffer {
+                first: format!("{first_name} {first}"),
+                second: format!("{name} {o}"),
+            });
         }
     }
     Ok(first)
@@ -88,30 +127,32 @@ fn same(a: &GeoOrigin, b: &GeoOrigin) -> bool {
 
 /// Checks that `scenario` is the one `plan` was made for (same name, every vehicle in it) and
 /// that every vehicle id can name a file.
-pub fn check(plan: &Plan, scenario: Option<&Scenario>) -> Result<(), String> {
+pub fn check(plan: &Plan, scenario: Option<&Scenario>) -> Result<(), ExportError> {
     for v in &plan.vehicles {
-        shoal_common::wire::topics::check_id("vehicle", &v.id).map_err(|e| {
-            format!("{e}: a vehicle id must be 1-64 letters, digits, '-', '_' or '.'")
-        })?;
+        shoal_common::wire::topics::check_id("vehicle", &v.id)
+            .map_err(|e| ExportError::BadId(e.to_string()))?;
         if v.trajectory.is_empty() {
-            return Err(format!("vehicle {} has no trajectory", v.id));
+            return Err(ExportError::NoTrajectory(v.id.clone()));
         }
     }
     let Some(s) = scenario else {
         return Ok(());
     };
     if s.name != plan.scenario {
-        return Err(format!(
-            "the plan was made for scenario {:?}, not {:?}",
-            plan.scenario, s.name
-        ));
+        return Err(ExportError::OtherScenario {
+            plan: plan.scenario.clone(),
+            scenario: s.name.clone(),
+        });
     }
     if let Some(v) = plan
         .vehicles
         .iter()
         .find(|v| !s.vehicles.iter().any(|w| w.id == v.id))
     {
-        return Err(format!("vehicle {} is not in scenario {:?}", v.id, s.name));
+        return Err(ExportError::NotInScenario {
+            vehicle: v.id.clone(),
+            scenario: s.name.clone(),
+        });
     }
     Ok(())
 }

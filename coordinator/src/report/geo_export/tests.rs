@@ -138,13 +138,17 @@ fn origins_come_from_anywhere_but_must_agree() {
     assert_eq!(resolve_origin(Some(p), None, None), Ok(p));
     assert_eq!(resolve_origin(None, None, Some(q)), Ok(q));
     assert_eq!(resolve_origin(Some(p), Some(p), Some(p)), Ok(p));
-    let e = resolve_origin(None, None, None).err().unwrap_or_default();
+    let e = resolve_origin(None, None, None)
+        .err()
+        .map(|e| e.to_string())
+        .unwrap_or_default();
     assert!(
         e.starts_with("no origin:") && e.contains("--origin LAT,LON,ALT"),
         "{e}"
     );
     let e = resolve_origin(None, Some(p), Some(q))
         .err()
+        .map(|e| e.to_string())
         .unwrap_or_default();
     assert!(
         e.starts_with("the scenario's [origin] 1,2,3 and --origin 1,2,4 differ"),
@@ -152,6 +156,7 @@ fn origins_come_from_anywhere_but_must_agree() {
     );
     let e = resolve_origin(Some(q), Some(p), None)
         .err()
+        .map(|e| e.to_string())
         .unwrap_or_default();
     assert!(
         e.starts_with("plan.json's origin 1,2,4 and the scenario's [origin] 1,2,3"),
@@ -166,14 +171,23 @@ fn a_plan_goes_out_with_its_own_scenario_and_file_safe_ids(
     assert_eq!(check(&plan, Some(&s)), Ok(()));
     let mut other = s.clone();
     other.name = "other".into();
-    let e = check(&plan, Some(&other)).err().unwrap_or_default();
+    let e = check(&plan, Some(&other))
+        .err()
+        .map(|e| e.to_string())
+        .unwrap_or_default();
     assert_eq!(e, "the plan was made for scenario \"toy\", not \"other\"");
     other = s.clone();
     other.vehicles.truncate(1);
-    let e = check(&plan, Some(&other)).err().unwrap_or_default();
+    let e = check(&plan, Some(&other))
+        .err()
+        .map(|e| e.to_string())
+        .unwrap_or_default();
     assert_eq!(e, "vehicle b is not in scenario \"toy\"");
     plan.vehicles[1].id = "../b".into();
-    let e = check(&plan, None).err().unwrap_or_default();
+    let e = check(&plan, None)
+        .err()
+        .map(|e| e.to_string())
+        .unwrap_or_default();
     assert!(
         e.contains("../b") && e.contains("a vehicle id must be"),
         "{e}"
