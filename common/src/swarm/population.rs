@@ -106,11 +106,21 @@ pub fn trusted_best<'a, P: Problem>(
     elite_cost: f64,
 ) -> Option<TrustedBest> {
     let (x, parts) = assemble(problem, particles)?;
-    if problem.blocks() == 1 || x == elite {
+    if problem.blocks() == 1 {
+        // One block: the best personal best, whose cost was a true evaluation.
         let cost = parts.iter().sum();
         return Some(TrustedBest {
             x,
             cost,
+            evaluations: 0,
+        });
+    }
+    if x == elite {
+        // The elite's own cost, not the sum of the remembered blocks: those were scored next to
+        // other partners and can hide a conflict the elite has (a pair closer than d_min).
+        return Some(TrustedBest {
+            x,
+            cost: elite_cost,
             evaluations: 0,
         });
     }
@@ -509,6 +519,37 @@ mod tests {
         let pop =
             Population::from_particles(&TwoBlocks(coupled), vec![a, b], StdRng::seed_from_u64(1));
         assert_eq!((pop.gbest.clone(), pop.elite_cost), (vec![0.0, 3.0], 9.0));
+    }
+
+    /// Blocks coupled the other way round: each pays the distance between them, so a block's
+    /// memory can be cheaper than the same block next to another partner.
+    fn tethered(x: &[f64]) -> [f64; 2] {
+        let d = (x[0] - x[1]).abs();
+        [x[0] * x[0] + d, x[1] * x[1] + d]
+    }
+
+    #[test]
+    fn an_assembled_best_equal_to_the_elite_costs_what_the_elite_truly_costs() {
+        // e = (0, 3): parts (0 + 3, 9 + 3), cost 15. o = (3, 3): parts (9, 9), cost 18.
+        // Block 0 comes from e (3 < 9), block 1 from o (9 < 12): the assembled best is (0, 3),
+        // the elite itself, whose cost is 15 and not the remembered 3 + 9 = 12.
+        let e = Particle::new(&TwoBlocks(tethered), vec![0.0, 3.0]);
+        let o = Particle::new(&TwoBlocks(tethered), vec![3.0, 3.0]);
+        let best = trusted_best(&TwoBlocks(tethered), [&e, &o].into_iter(), &e.x, e.cost);
+        assert_eq!(
+            best,
+            Some(TrustedBest {
+                x: vec![0.0, 3.0],
+                cost: 15.0,
+                evaluations: 0
+            })
+        );
+        let pop =
+            Population::from_particles(&TwoBlocks(tethered), vec![e, o], StdRng::seed_from_u64(1));
+        assert_eq!(
+            (pop.elite_x.clone(), pop.elite_cost),
+            (vec![0.0, 3.0], 15.0)
+        );
     }
 
     #[test]
