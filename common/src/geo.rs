@@ -192,5 +192,4 @@ impl FromStr for GeoOrigin {
 }
 
 #[cfg(test)]
-#[path = "geo_tests.rs"]
 mod tests;

@@ -153,5 +153,4 @@ impl WaysRound<'_> {
 }
 
 #[cfg(test)]
-#[path = "reroute_tests.rs"]
 mod tests;
