@@ -366,5 +366,4 @@ impl Guard {
 }
 
 #[cfg(test)]
-#[path = "plausible_tests.rs"]
 mod tests;
