@@ -214,5 +214,4 @@ impl FromStr for GeoOrigin {
 }
 
 #[cfg(test)]
-#[path = "geo_tests.rs"]
 mod tests;

@@ -433,5 +433,4 @@ pub struct DegradedVehicle {
 }
 
 #[cfg(test)]
-#[path = "plan_tests.rs"]
 mod tests;

@@ -7,7 +7,8 @@
 //! cargo run --release -p shoal-coordinator --example fuzz_decoders [-- INPUTS [SEED]]
 //! ```
 //!
-//! The test suite runs the same properties with a few thousand cases (`codec_fuzz_tests.rs`).
+//! The test suite runs the same properties with a few thousand cases
+//! (`common/src/wire/codec/tests/fuzz.rs`).
 
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::time::Instant;

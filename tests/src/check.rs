@@ -10,15 +10,7 @@ use crate::model::{
     parse_plan, parse_scenario, parse_scenario_file, Plan, PlanVehicle, Scenario, Vehicle,
 };
 use crate::report::Report;
-use crate::{SEPARATION_TOL, TOL};
-
-/// True when `a` and `b` agree within `abs` or within [`TOL`] relative.
-pub fn close(a: f64, b: f64, abs: f64) -> bool {
-    if a == b {
-        return true;
-    }
-    (a - b).abs() <= abs.max(TOL * a.abs().max(b.abs()))
-}
+use crate::tolerance::{close, SEPARATION_TOL, TOL};
 
 /// True when `x` lies in `[lo − slack, hi + slack]`: for figures that are ill-conditioned where a
 /// path grazes a surface, checked against the range their recomputation spans under a 1 µm

@@ -232,7 +232,7 @@ pub fn check(
         return out;
     };
     let mut num = |what: &str, reported: f64, recomputed: f64| {
-        if !crate::close(reported, recomputed, crate::TOL) {
+        if !crate::tolerance::close(reported, recomputed, crate::tolerance::TOL) {
             out.mismatches.push(format!(
                 "{id}.crawler.{what}: reported {reported} but recomputed {recomputed}"
             ));

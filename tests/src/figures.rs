@@ -4,7 +4,7 @@
 
 use crate::geometry::{self, dist, point, P3};
 use crate::model::{ObstacleKind, Scenario};
-use crate::TOL;
+use crate::tolerance::TOL;
 
 /// Figures of one vehicle, recomputed from its trajectory.
 #[derive(Debug, Clone, PartialEq)]

@@ -20,7 +20,8 @@
 //!
 //! Modules: `model` reads the files, [`geometry`] is the checker's own geometry, `figures`
 //! recomputes the figures, `check` compares them with the plan and applies the contract rules,
-//! `feasibility` judges the plan's `feasible` verdict, and `report` holds the result.
+//! `feasibility` judges the plan's `feasible` verdict, `report` holds the result, and
+//! `tolerance` says how close is equal.
 
 mod check;
 pub mod crawler;
@@ -34,20 +35,13 @@ mod model;
 mod report;
 pub mod seabed_grid;
 pub mod sections;
+mod tolerance;
 
-pub use check::{check, check_file, check_parsed, close};
+pub use check::{check, check_file, check_parsed};
 pub use figures::{fleet_figures, vehicle_figures, FleetFigures, VehicleFigures};
 pub use model::{
     parse_plan, parse_scenario, parse_scenario_file, Bounds, Fleet, Obstacle, ObstacleKind, Plan,
     PlanFleet, PlanVehicle, Scenario, Vehicle,
 };
 pub use report::Report;
-
-/// Absolute slack for float noise (metres, seconds, degrees, m/s); also used as relative slack.
-pub const TOL: f64 = 1e-6;
-
-/// Absolute slack for separation figures, metres (and seconds for the breach time).
-pub const SEPARATION_TOL: f64 = 1e-3;
-
-/// Largest arrival spread of a feasible plan, seconds.
-pub const MAX_ARRIVAL_SPREAD_S: f64 = 1.0;
+pub use tolerance::{close, MAX_ARRIVAL_SPREAD_S, SEPARATION_TOL, TOL};

@@ -8,7 +8,7 @@
 //! kind — never a panic, never a stall.
 
 use std::collections::{HashMap, HashSet};
-use std::sync::atomic::{AtomicBool, AtomicU32, Ordering};
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::{self, RecvTimeoutError, Sender};
 use std::sync::Arc;
 use std::thread::JoinHandle;
@@ -22,14 +22,16 @@ use shoal_common::wire::{session, topics, Envelope};
 use zenoh::qos::CongestionControl;
 use zenoh::{Session, Wait};
 
+use crate::args::AgentArgs;
 use crate::assignment::{Assignment, MissionReport};
 use crate::execute::{self, Order};
 use crate::link;
 use crate::mission;
-use crate::AgentArgs;
 use shoal_common::wire::open::Telemetry;
 
+mod drops;
 mod order_seq;
+pub use drops::Drops;
 use order_seq::OrderSeqs;
 
 /// A mission being planned on its own thread.
@@ -39,26 +41,6 @@ struct Worker {
     drives: bool,
     stop: Arc<AtomicBool>,
     handle: JoinHandle<MissionReport>,
-}
-
-/// Counts dropped messages and logs the first of each kind.
-#[derive(Debug, Default)]
-pub struct Drops {
-    /// Messages dropped so far.
-    pub count: Arc<AtomicU32>,
-    logged: HashSet<&'static str>,
-}
-
-impl Drops {
-    /// Counts one dropped message of `kind`, logging the first of that kind.
-    pub fn drop_message(&mut self, kind: &'static str, detail: &str) {
-        self.count.fetch_add(1, Ordering::Relaxed);
-        if self.logged.insert(kind) {
-            tracing::warn!(
-                "dropped a message ({kind}): {detail}; further ones of this kind are only counted"
-            );
-        }
-    }
 }
 
 /// Opens a client session on a thread of its own (zenoh's open blocks while it waits for the

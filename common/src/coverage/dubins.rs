@@ -305,5 +305,4 @@ pub fn angle_diff(a: f64, b: f64) -> f64 {
 }
 
 #[cfg(test)]
-#[path = "dubins_tests.rs"]
 mod tests;

@@ -34,7 +34,6 @@ pub const MAX_CHECK_SPACING_M: f64 = 0.5;
 /// Largest grid extent per axis in cells (the cell key packs 24 bits per axis).
 const MAX_AXIS_CELLS: f64 = (1u64 << 24) as f64;
 
-#[path = "hybrid_astar_params.rs"]
 mod params;
 pub use params::{HybridAStarError, HybridAStarParams};
 
@@ -456,5 +455,4 @@ fn result(pieces: Vec<Piece>, expansions: usize) -> HybridAStarResult {
 }
 
 #[cfg(test)]
-#[path = "hybrid_astar_tests.rs"]
 mod tests;

@@ -36,6 +36,7 @@ pub mod rows;
 pub mod spec;
 pub mod sweeps;
 pub mod terrain25;
+mod terrain25_error;
 pub mod tracking;
 
 pub use perlin::{FractalNoise, Perlin};
@@ -43,7 +44,8 @@ pub use spec::{
     GaussianPeak, GaussianPit, RandomGaussians, SyntheticSeabed, TerrainSpec, TraversalLimits,
     UndulationSpec,
 };
-pub use terrain25::{slope_field_deg, Terrain25Error, TerrainMap25, MAX_CELLS};
+pub use terrain25::{slope_field_deg, TerrainMap25};
+pub use terrain25_error::{Terrain25Error, MAX_CELLS};
 
 /// Test maps: an `n × n` grid of 2 m cells from row-major heights (south row first), with the
 /// default limits.

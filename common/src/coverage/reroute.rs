@@ -162,5 +162,4 @@ impl WaysRound<'_> {
 }
 
 #[cfg(test)]
-#[path = "reroute_tests.rs"]
 mod tests;

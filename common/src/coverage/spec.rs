@@ -19,7 +19,7 @@ use rand::{Rng, SeedableRng};
 use serde::{Deserialize, Serialize};
 
 use super::perlin::FractalNoise;
-use super::Terrain25Error;
+use super::terrain25_error::Terrain25Error;
 
 /// Perlin undulation of the sediment, `U(x, y)` (seed 002 §2.1 "minor undulations", treated as a
 /// posture disturbance, never as an obstacle).

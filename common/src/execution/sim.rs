@@ -395,5 +395,4 @@ fn gaussian(rng: &mut StdRng) -> f64 {
 }
 
 #[cfg(test)]
-#[path = "sim_tests.rs"]
 mod tests;

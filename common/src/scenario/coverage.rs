@@ -4,8 +4,8 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::sizes::{in_range, over};
-use super::{Bad, ScenarioError};
+use super::error::{in_range, over};
+use super::error::{Bad, ScenarioError};
 use crate::coverage::params::CoverageParams;
 use crate::coverage::tracking::TrackingParams;
 use crate::coverage::{Terrain25Error, TerrainSpec, TraversalLimits};

@@ -11,7 +11,8 @@
 
 use std::path::{Path, PathBuf};
 
-use super::{Scenario, ScenarioError};
+use super::error::ScenarioError;
+use super::model::Scenario;
 use crate::limits;
 
 /// Every scenario field that names a file, as its TOML key path. A field added to the scenario

@@ -6,8 +6,8 @@ use std::sync::Arc;
 
 use serde::{Deserialize, Serialize};
 
-use super::sizes::{in_range, over};
-use super::{Bad, ScenarioError};
+use super::error::{in_range, over};
+use super::error::{Bad, ScenarioError};
 use crate::current::{CurrentField, DepthDecayCurrent, StillWater};
 use crate::current_grid::GridCurrent;
 use crate::energy::Weights;
@@ -159,7 +159,7 @@ impl Currents {
         if !path.is_absolute() {
             *path = dir.join(&*path);
         }
-        super::check_data_file(path, "currents.file", bad)?;
+        super::error::check_data_file(path, "currents.file", bad)?;
         let grid = GridCurrent::load(path)
             .map_err(|e| bad("currents.file".into(), written, &e.to_string()))?;
         let nodes = grid

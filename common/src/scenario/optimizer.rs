@@ -3,8 +3,8 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::sizes::over;
-use super::{Bad, ScenarioError};
+use super::error::over;
+use super::error::{Bad, ScenarioError};
 use crate::limits::{MAX_ITERATIONS, MAX_PARTICLES, MAX_POPULATIONS, MAX_THREADS, MAX_WAYPOINTS};
 
 /// The optimizers `plan` can run.

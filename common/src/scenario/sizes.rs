@@ -3,35 +3,9 @@
 //! first, so that no later check loops over a million vehicles and nothing is allocated for a
 //! value no vehicle could have.
 
-use super::{Bad, Scenario, ScenarioError};
+use super::error::{in_range, Bad, ScenarioError};
+use super::model::Scenario;
 use crate::limits;
-
-/// `field = value is over the limit bound`, with the constant that sets the bound.
-pub(super) fn over(bad: Bad, field: &str, value: usize, bound: usize, name: &str) -> ScenarioError {
-    bad(
-        field.into(),
-        value.to_string(),
-        &format!("is over the limit {bound} (limits::{name})"),
-    )
-}
-
-/// `Err` unless `v` lies in `range`; the reason names the range and the unit.
-pub(super) fn in_range(
-    bad: Bad,
-    field: &str,
-    v: f64,
-    range: std::ops::RangeInclusive<f64>,
-    unit: &str,
-) -> Result<(), ScenarioError> {
-    if range.contains(&v) {
-        return Ok(());
-    }
-    Err(bad(
-        field.into(),
-        v.to_string(),
-        &format!("must be in [{}, {}] {unit}", range.start(), range.end()),
-    ))
-}
 
 impl Scenario {
     /// The counts of every list, before anything loops over them.

@@ -1,6 +1,7 @@
 //! Unit tests of `scenario`.
 
 use super::*;
+use std::path::Path;
 
 const GOOD: &str = r#"
 name = "t"

@@ -10,10 +10,10 @@ use crate::geometry::Vec3;
 use crate::scenario::{Algorithm, FirstPointMode, Scenario};
 use crate::swarm::multi::stream_seed;
 
-use super::{
-    inspection_points, plan_tour, short_tour, split_points, Cage, FirstPoint, InspectionPoint,
-    LegAlgorithm, LegSettings, SwapPso, TourPlan, TourSettings,
-};
+use super::cages::{inspection_points, Cage, FirstPoint, InspectionPoint};
+use super::order::SwapPso;
+use super::plan::{plan_tour, LegAlgorithm, LegSettings, TourPlan, TourSettings};
+use super::split::{short_tour, split_points};
 
 /// The leg swarm of an algorithm (`None` for the algorithms that do not plan tours).
 pub fn leg_algorithm(a: Algorithm) -> Option<LegAlgorithm> {

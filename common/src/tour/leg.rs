@@ -27,7 +27,7 @@ use rand::Rng;
 use crate::geometry::{chord_inside_sphere, segment_hits_sphere, Vec3, CONTACT_GUARD_M};
 use crate::swarm::Problem;
 
-use super::Cage;
+use super::cages::Cage;
 
 /// Cost of one segment–sphere intersection, metres of path. Not in the seed (eq. (33) only marks
 /// a segment infeasible); 10⁴ m is more than any detour inside Table 4's 700 m box can cost.

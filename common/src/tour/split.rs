@@ -13,8 +13,8 @@
 
 use crate::geometry::Vec3;
 
+use super::cages::InspectionPoint;
 use super::order::{distance_matrix, open_order_length, two_opt};
-use super::InspectionPoint;
 
 /// A short closed tour from `base` through `points` (nearest neighbour, then 2-opt): the indices
 /// into `points` in visiting order, and the tour's straight-line length.
@@ -227,7 +227,7 @@ fn balance(points: &[InspectionPoint], base: Vec3, groups: &mut [Vec<usize>]) {
 
 #[cfg(test)]
 mod tests {
-    use super::super::{cage_group_a, inspection_points, Cage, FirstPoint};
+    use super::super::cages::{cage_group_a, inspection_points, Cage, FirstPoint};
     use super::*;
 
     fn lengths(points: &[InspectionPoint], base: Vec3, split: &[Vec<usize>]) -> Vec<f64> {

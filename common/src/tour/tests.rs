@@ -1,7 +1,10 @@
 //! Tours and legs: plans of cage group A, the stop flag, the velocity cap, convergence curves.
 
 use super::*;
+use crate::geometry::Vec3;
 use approx::assert_abs_diff_eq;
+use std::sync::atomic::AtomicBool;
+use std::sync::Arc;
 
 fn small() -> TourSettings {
     TourSettings {

@@ -26,6 +26,8 @@ pub mod open;
 pub mod security;
 #[cfg(feature = "transport")]
 pub mod session;
+#[cfg(feature = "transport")]
+mod session_error;
 pub mod topics;
 
 use serde::{Deserialize, Serialize};

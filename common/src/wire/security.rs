@@ -13,7 +13,7 @@ use std::path::{Path, PathBuf};
 
 use zenoh::Config;
 
-use super::session::{set, SessionError};
+use super::session_error::{set, SessionError};
 
 /// Largest Zenoh configuration file read (a generated one with a 100-vehicle ACL is ~60 kB).
 pub const MAX_CONFIG_FILE_BYTES: u64 = 1 << 20;

@@ -503,5 +503,4 @@ pub struct ExecutionFigures {
 }
 
 #[cfg(test)]
-#[path = "fleet_tests.rs"]
 mod tests;

@@ -22,7 +22,7 @@ pub(super) fn update_lead_s(budget: Duration, time_scale: f64) -> f64 {
 /// A conflict seen less than the lead ahead can only be met by a hold (at 500× the lead is
 /// 275 mission seconds, more than the 180 s horizon), so each is seen at least the horizon
 /// before an update can act on it.
-pub(super) fn conflict_horizon_s(o: &super::ExecOptions) -> f64 {
+pub(super) fn conflict_horizon_s(o: &super::state::ExecOptions) -> f64 {
     o.horizon_s + update_lead_s(o.replan_budget, o.time_scale)
 }
 
@@ -102,7 +102,7 @@ mod tests {
 
     #[test]
     fn conflicts_are_looked_for_the_horizon_beyond_the_update_lead() {
-        let mut o = super::super::ExecOptions {
+        let mut o = super::super::state::ExecOptions {
             time_scale: 500.0,
             telemetry_hz: 2.0,
             horizon_s: 180.0,

@@ -14,16 +14,17 @@ mod keep_out;
 mod lead;
 pub mod log;
 pub mod plausible;
+mod queue;
 mod react;
 mod repair;
 pub mod replan;
 mod replan_queue;
 mod standing;
+mod state;
 mod track;
 mod tracked;
 pub mod verdict;
 
-use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::{self, Receiver, RecvTimeoutError};
 use std::sync::Arc;
@@ -35,7 +36,6 @@ use shoal_common::scenario::{Obstacle, Scenario};
 use shoal_common::trajectory::Trajectory;
 use shoal_common::wire::codec;
 use shoal_common::wire::coordinator_to_agent::CoordinatorToAgent;
-use shoal_common::wire::open::{FleetStatus, MissionEvent, PlanNotice, OPEN_VERSION};
 use shoal_common::wire::topics::{self, OpenKey};
 use shoal_common::wire::WireTrajectory;
 use zenoh::Wait;
@@ -44,38 +44,8 @@ use crate::distributed::network::Event;
 use crate::distributed::{DistributedOptions, Session};
 use fleet::{ExecutionFigures, Fleet};
 use log::{LogWriter, Record, Start};
-
-/// Settings of an execution.
-#[derive(Debug, Clone)]
-pub struct ExecOptions {
-    /// Mission seconds per wall second.
-    pub time_scale: f64,
-    /// Telemetry reports per wall second and vehicle.
-    pub telemetry_hz: f64,
-    /// How far ahead separation is predicted for the live status, mission seconds; conflicts
-    /// are looked for this far past the update lead (`react::conflict_horizon_s`).
-    pub horizon_s: f64,
-    /// Cross-track error beyond which a vehicle is replanned, metres.
-    pub deviation_m: f64,
-    /// Metres over d_min a replan keeps from the other vehicles' predicted trajectories, for
-    /// the tracking error and fix noise of both (a conflict is still predicted at d_min).
-    pub separation_buffer_m: f64,
-    /// Wall time without a report after which a vehicle is lost.
-    pub lost_after: Duration,
-    /// Wall-time budget of one replan.
-    pub replan_budget: Duration,
-    /// Half-width of the arrival window around the common arrival, mission seconds.
-    pub arrival_window_s: f64,
-    /// The mission log (NDJSON).
-    pub log: PathBuf,
-    /// Obstacles to publish at given mission times (tests and figures: an obstacle appearing
-    /// on a vehicle's path mid-mission), as any client would.
-    pub inject: Vec<(f64, Obstacle)>,
-    /// No progress line on stderr.
-    pub quiet: bool,
-    /// RNG seed (simulated noise, replanning).
-    pub seed: u64,
-}
+pub(crate) use state::Exec;
+pub use state::ExecOptions;
 
 /// Raw input from the open-interface subscriptions (callbacks do no work themselves).
 enum Open {
@@ -83,45 +53,6 @@ enum Open {
     Telemetry(String, Vec<u8>, u64),
     /// An obstacle and when it came (the rate limit counts arrivals, not the loop's pace).
     Obstacle(Vec<u8>, Instant),
-}
-
-/// Everything the execution loop shares.
-pub(crate) struct Exec<'a> {
-    scenario: Scenario,
-    mission: String,
-    options: &'a ExecOptions,
-    fleet: Fleet,
-    session: Session,
-    log: LogWriter,
-    mission_clock: MissionClock,
-    common_arrival_s: f64,
-    revision: u32,
-    replans: u64,
-    holds: u64,
-    /// Per vehicle: when it was last replanned or held (wall), for a cool-down.
-    last_reaction: Vec<Option<Instant>>,
-    /// Per vehicle: failed replans since it was told to hold (each retry doubles the budget).
-    hold_retries: Vec<u32>,
-    /// Per vehicle: the wall time its last replan took (see [`lead::hold_retry_after`]).
-    last_attempt: Vec<Duration>,
-    /// The replans waiting and the one under way (see [`replan_queue`]).
-    queue: replan_queue::ReplanQueue,
-    /// (crawler, standing vehicle): repaired for this stand of it (see [`standing`]).
-    rounded: Vec<(usize, usize)>,
-    /// Per vehicle: the revision sent and when, to time its delivery.
-    pending: Vec<Option<(u32, Instant)>>,
-    /// Delivery times of updates (decision → first report on the new revision), ms.
-    pub(crate) deliveries_ms: Vec<f64>,
-    /// Decision times of obstacle replans (obstacle received → update sent), ms.
-    pub(crate) decisions_ms: Vec<f64>,
-    dropped: u64,
-    /// Implausible reports and obstacles refused, the obstacles' rate limit.
-    guard: plausible::Guard,
-    /// Longest wall time between two passes of the loop (see [`ExecutionReport`]).
-    longest_pause: Duration,
-    /// A coverage fleet's seabed map, for a crawler's way round a new obstacle; `None` for
-    /// other missions, or when the map cannot be built (a crawler then holds instead).
-    ground: Option<Arc<CrawlerGround>>,
 }
 
 /// What an execution leaves.
@@ -147,70 +78,6 @@ pub struct ExecutionReport {
     pub loop_longest_pause_ms: f64,
     /// Why it ended.
     pub ended: String,
-}
-
-impl Exec<'_> {
-    fn clock(&self) -> f64 {
-        self.mission_clock.now()
-    }
-
-    fn put_json<T: serde::Serialize>(&self, key: &str, payload: &T) {
-        match codec::encode_json(payload) {
-            Ok(bytes) => {
-                if let Err(e) = self.session.net.session().put(key, bytes).wait() {
-                    tracing::warn!("cannot publish on {key}: {e}");
-                }
-            }
-            Err(e) => tracing::warn!("cannot encode for {key}: {e}"),
-        }
-    }
-
-    /// Logs and publishes an event.
-    fn event(&mut self, kind: &str, vehicles: Vec<String>, detail: String) {
-        let e = MissionEvent {
-            version: OPEN_VERSION,
-            mission: self.mission.clone(),
-            t_s: self.clock(),
-            kind: kind.to_string(),
-            vehicles,
-            detail,
-        };
-        tracing::info!(kind, "{}", e.detail);
-        if let Ok(key) = topics::open_key(&self.mission, OpenKey::Events) {
-            self.put_json(&key, &e);
-        }
-        self.log.write(&Record::Event(e));
-    }
-
-    /// Publishes and logs the current plan; `changed` names the vehicles this revision moved.
-    fn publish_plan(&mut self, changed: Vec<String>) {
-        let notice = PlanNotice {
-            version: OPEN_VERSION,
-            mission: self.mission.clone(),
-            revision: self.revision,
-            changed,
-            trajectories: self
-                .fleet
-                .vehicles
-                .iter()
-                .map(|v| (v.id.clone(), WireTrajectory::new(&v.id, &v.plan).samples))
-                .collect(),
-        };
-        if let Ok(key) = topics::open_key(&self.mission, OpenKey::Plan) {
-            self.put_json(&key, &notice);
-        }
-        self.log.write(&Record::Plan(notice));
-    }
-
-    fn status(&self) -> FleetStatus {
-        self.fleet.status(&self.mission, self.clock())
-    }
-
-    fn send(&self, vehicle: &str, m: CoordinatorToAgent) {
-        if let Err(e) = self.session.net.send(vehicle, m) {
-            tracing::warn!("cannot send to {vehicle}: {e:#}");
-        }
-    }
 }
 
 /// The seabed of a coverage fleet, for its crawlers' ways round new obstacles; `None` for
@@ -313,7 +180,7 @@ pub fn execute_trajectories(
         last_reaction: vec![None; ids.len()],
         hold_retries: vec![0; ids.len()],
         last_attempt: vec![Duration::ZERO; ids.len()],
-        queue: replan_queue::ReplanQueue::default(),
+        queue: queue::ReplanQueue::default(),
         rounded: Vec::new(),
         pending: vec![None; ids.len()],
         deliveries_ms: Vec::new(),

@@ -396,5 +396,4 @@ impl Guard {
 }
 
 #[cfg(test)]
-#[path = "plausible_tests.rs"]
 mod tests;

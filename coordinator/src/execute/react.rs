@@ -24,7 +24,7 @@ use super::lead::{conflict_horizon_s, hold_retry_after};
 use super::log::{Record, EVENT_FAULT, EVENT_IMPLAUSIBLE, EVENT_LOST, EVENT_OBSTACLE_DROPPED};
 use super::plausible::{self, FixLimits, LastFix, Reason};
 use super::replan_queue;
-use super::Exec;
+use super::state::Exec;
 
 /// Shortest wall time between two reactions for one vehicle (a new obstacle does not wait; a
 /// held vehicle's retries come sooner at high time scales, see [`hold_retry_after`]).

@@ -479,5 +479,4 @@ fn closest_vehicle(r: &Request, trajectory: &Trajectory, d_min: f64) -> (f64, f6
 }
 
 #[cfg(test)]
-#[path = "repair_tests.rs"]
 mod tests;

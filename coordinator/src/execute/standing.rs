@@ -24,7 +24,7 @@ use shoal_common::trajectory::Trajectory;
 use super::fleet::Tracked;
 use super::lead::conflict_horizon_s;
 use super::replan_queue;
-use super::Exec;
+use super::state::Exec;
 
 /// Whether `v` stands still for the others: held, lost or faulted (not arrived: the plans
 /// were made with its finish in them).

@@ -3,7 +3,7 @@
 //! position at an instant, and the exact closest approach and breach time of two vehicles (with a
 //! sampled closest approach to cross-check it).
 
-use super::{closest_param, dist, lerp, norm, param_interval_within, sub, P3};
+use super::vector::{closest_param, dist, lerp, norm, param_interval_within, sub, P3};
 
 /// Position part of a sample.
 pub fn point(sample: &[f64; 4]) -> P3 {

@@ -11,7 +11,7 @@ use shoal_common::execution::{VehicleCommand, VehicleState};
 use shoal_common::scenario::{Scenario, VehicleKind};
 use shoal_common::trajectory::Trajectory;
 
-use super::{LinkError, LinkOutcome, VehicleLink};
+use super::types::{LinkError, LinkOutcome, VehicleLink};
 
 /// A simulated vehicle.
 pub struct SimLink {

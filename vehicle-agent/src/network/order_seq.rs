@@ -10,7 +10,7 @@
 
 use std::collections::HashMap;
 
-use super::Drops;
+use super::drops::Drops;
 
 /// Kind under which a refused order is counted (and logged once).
 pub const REFUSED: &str = "replayed or out-of-order order";

@@ -1,9 +1,19 @@
 //! Exact zero-order-hold discretisation of the V-MPC error model (seed 002 §2.3.2), see
 //! [`super::mpc`] for the continuous model.
 
-use super::mpc::StageRef;
-use super::TrackingParams;
+use super::params::TrackingParams;
 use nalgebra::SMatrix;
+
+/// What the controller knows about one horizon stage k (reference point at predicted progress).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StageRef {
+    /// Reference curvature κ_k, 1/m.
+    pub curvature: f64,
+    /// Predicted traction efficiency η_k = cosθ·(1 − s), -.
+    pub efficiency: f64,
+    /// Predicted lateral drift w_y,k, m/s (terrain law + EKF residual).
+    pub drift: f64,
+}
 
 /// Model states: e_y, e_ψ, ω_a, v_a.
 pub(crate) const NZ: usize = 4;

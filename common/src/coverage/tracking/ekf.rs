@@ -7,8 +7,9 @@
 //! Inputs each sub-step: track odometry `u` (m/s) and gyro yaw rate `ω_g` (rad/s).
 //! Measurements: gyro-compass heading every control period, a position fix every fix period.
 
+use super::params::TrackingParams;
 use super::plant::{attitude, slip_ratio};
-use super::{checked_gradient, wrap_angle, Pose2, TerrainSlope, TrackingError, TrackingParams};
+use super::types::{checked_gradient, wrap_angle, Pose2, TerrainSlope, TrackingError};
 use nalgebra::{Matrix2, SMatrix, SVector, Vector2};
 
 /// State dimension.
@@ -215,7 +216,7 @@ impl Ekf {
 #[cfg(test)]
 mod tests {
     use super::super::plant::Plant;
-    use super::super::{gaussian, FlatTerrain};
+    use super::super::types::{gaussian, FlatTerrain};
     use super::*;
     use rand::rngs::StdRng;
     use rand::SeedableRng;

@@ -19,10 +19,11 @@
 //!   v_min ≤ v_j ≤ v_max,  |ω_j| ≤ (1 + m)·v_j/R_min,  |ω_j − ω_(j−1)| ≤ α_max·T,
 //!   |v_j − v_(j−1)| ≤ a_max·T.
 
-use super::TrackingParams;
+use super::params::TrackingParams;
 use clarabel::algebra::CscMatrix;
 use clarabel::solver::{DefaultSettings, DefaultSolver, IPSolver, SolverStatus, SupportedConeT};
 
+pub use super::discrete::StageRef;
 use super::discrete::{discretise, stage_key, Aug, CACHE_LEN, NZ};
 
 /// A command pair.
@@ -32,17 +33,6 @@ pub struct Command {
     pub yaw_rate: f64,
     /// Speed, m/s.
     pub speed: f64,
-}
-
-/// What the controller knows about one horizon stage k (reference point at predicted progress).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct StageRef {
-    /// Reference curvature κ_k, 1/m.
-    pub curvature: f64,
-    /// Predicted traction efficiency η_k = cosθ·(1 − s), -.
-    pub efficiency: f64,
-    /// Predicted lateral drift w_y,k, m/s (terrain law + EKF residual).
-    pub drift: f64,
 }
 
 /// The V-MPC weights at one stage.
@@ -497,5 +487,4 @@ pub fn project_command(cmd: Command, prev: Command, p: &TrackingParams, rates: b
 }
 
 #[cfg(test)]
-#[path = "mpc_tests.rs"]
 mod tests;

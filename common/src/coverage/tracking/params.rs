@@ -1,6 +1,6 @@
 //! Every constant of the tracking layer, with units, physical reason and default.
 
-use super::TrackingError;
+use super::types::TrackingError;
 use serde::{Deserialize, Serialize};
 
 /// Parameters of the closed-loop tracker. Defaults describe a heavy tracked nodule collector

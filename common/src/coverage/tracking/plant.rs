@@ -1,8 +1,8 @@
 //! The truth model of the crawler on the 2.5D seabed (seed 002 §2.2 "Kinematic model of the
 //! mining vehicle", rebuilt) and the terrain–traction law shared with the EKF and the MPC.
 
-use super::TrackingParams;
-use super::{checked_gradient, gaussian, wrap_angle, Pose2, TerrainSlope, TrackingError};
+use super::params::TrackingParams;
+use super::types::{checked_gradient, gaussian, wrap_angle, Pose2, TerrainSlope, TrackingError};
 use rand::Rng;
 
 /// Vehicle attitude imposed by the terrain under it, radians.
@@ -181,7 +181,7 @@ impl Plant {
 
 #[cfg(test)]
 mod tests {
-    use super::super::FlatTerrain;
+    use super::super::types::FlatTerrain;
     use super::*;
     use approx::assert_abs_diff_eq;
     use rand::rngs::StdRng;

@@ -1,7 +1,7 @@
 //! The sampled reference path: windowed monotone projection (progress and signed cross-track
 //! error, seed 002 §3 Figure 7(c)) and look-ups by arc length for the MPC horizon.
 
-use super::{wrap_angle, PathSample, TrackingError};
+use super::types::{wrap_angle, PathSample, TrackingError};
 
 /// A checked, read-only view of the reference samples.
 #[derive(Debug, Clone, Copy)]
@@ -258,10 +258,34 @@ impl<'a> Reference<'a> {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::super::tests::two_rows_with_uturn;
+pub(super) mod tests {
+    use super::super::types::geometry::{CoveragePath, Piece, PieceKind};
     use super::*;
     use approx::assert_abs_diff_eq;
+    use std::f64::consts::PI;
+
+    /// Two rows of `row_len` m along +x then −x, `2r` apart, joined by a left semicircle of
+    /// radius r.
+    pub(crate) fn two_rows_with_uturn(row_len: f64, r: f64) -> Vec<PathSample> {
+        let row1 = Piece::Line {
+            from: [0.0, 0.0],
+            to: [row_len, 0.0],
+        };
+        let turn = Piece::turn(row1.end(), r, PI, true);
+        let end = turn.end();
+        let row2 = Piece::Line {
+            from: [end.x, end.y],
+            to: [0.0, end.y],
+        };
+        CoveragePath {
+            pieces: vec![
+                (PieceKind::Straight, row1),
+                (PieceKind::UTurn, turn),
+                (PieceKind::Straight, row2),
+            ],
+        }
+        .sample(0.5)
+    }
 
     #[test]
     fn signed_cross_track_is_left_positive() {

@@ -3,11 +3,12 @@
 
 use super::ekf::Ekf;
 use super::mpc::{project_command, Command, Mpc, MpcProblem, StageRef};
+use super::params::TrackingParams;
 use super::plant::{attitude, body_velocity, Plant};
 use super::reference::Reference;
-use super::{
+use super::types::{
     checked_gradient, gaussian, wrap_angle, PathSample, Pose2, TerrainSlope, TrackedSample,
-    TrackingError, TrackingParams, TrackingResult,
+    TrackingError, TrackingResult,
 };
 use rand::rngs::StdRng;
 use rand::SeedableRng;

@@ -1,31 +1,11 @@
 //! Whole-loop tests: plant + TA-AEKF + V-MPC along synthetic coverage paths.
 
-use super::geometry::{CoveragePath, Piece, PieceKind};
+use super::reference::tests::two_rows_with_uturn;
+use super::types::geometry::{CoveragePath, Piece, PieceKind};
+use super::types::{PathSample, Pose2};
 use super::*;
 use std::f64::consts::{FRAC_PI_4, PI};
 use std::sync::atomic::{AtomicBool, Ordering};
-
-/// Two rows of `row_len` m along +x then −x, `2r` apart, joined by a left semicircle of radius r.
-pub(crate) fn two_rows_with_uturn(row_len: f64, r: f64) -> Vec<PathSample> {
-    let row1 = Piece::Line {
-        from: [0.0, 0.0],
-        to: [row_len, 0.0],
-    };
-    let turn = Piece::turn(row1.end(), r, PI, true);
-    let end = turn.end();
-    let row2 = Piece::Line {
-        from: [end.x, end.y],
-        to: [0.0, end.y],
-    };
-    CoveragePath {
-        pieces: vec![
-            (PieceKind::Straight, row1),
-            (PieceKind::UTurn, turn),
-            (PieceKind::Straight, row2),
-        ],
-    }
-    .sample(0.5)
-}
 
 /// Two 200 m rows joined by a 5 m semicircle, with an S-shaped tangent-arc detour (four 45° arcs
 /// of radius 5 m and two 6 m diagonals, ≈ 7.2 m sideways for 20 m) in the first row.

@@ -9,7 +9,7 @@ use shoal_common::wire::agent_to_coordinator::AgentToCoordinator;
 
 use super::super::agents::LocalAgents;
 use super::super::network::{Event, POLL};
-use super::Run;
+use super::state::Run;
 
 impl Run<'_> {
     /// Waits until every vehicle's agent is up and has accepted the mission, re-sending the

@@ -25,57 +25,18 @@ use shoal_common::wire::{WireChromosome, WireContext};
 
 mod join;
 mod seat;
+mod share;
 mod shares;
+mod state;
 
 use seat::{RoundSpan, Seat};
-pub use shares::{Share, ShareJob};
+pub use share::{Share, ShareJob};
+use state::{Run, GONE_GRACE};
+pub use state::{Status, Timing};
 
 use super::agents::LocalAgents;
 use super::network::{Event, Network};
 use crate::planning::solver::RunResult;
-
-/// How patient the coordinator is.
-#[derive(Debug, Clone)]
-pub struct Timing {
-    /// How long agents have to join.
-    pub join: Duration,
-    /// How long one round may wait for an agent's elites before planning its vehicle here.
-    pub round: Duration,
-}
-
-/// Progress of a distributed run, for stderr.
-#[derive(Debug, Clone, Copy)]
-pub struct Status {
-    /// Iterations done.
-    pub iteration: usize,
-    /// Iteration budget.
-    pub max_iterations: usize,
-    /// Best fitness so far.
-    pub best_cost: f64,
-    /// Agents planning their own vehicle.
-    pub alive: usize,
-    /// Vehicles.
-    pub vehicles: usize,
-}
-
-/// How long a vehicle whose agent was seen to go keeps its seat: Zenoh sends declarations
-/// (the liveliness token's end) ahead of queued data, so an agent that leaves right after its
-/// last elites can be "gone" before they arrive, and an agent whose link blinked may be back.
-const GONE_GRACE: Duration = Duration::from_secs(1);
-
-/// Everything the loop shares.
-struct Run<'a> {
-    scenario: &'a Scenario,
-    model: Arc<FleetModel>,
-    net: &'a mut Network,
-    seats: Vec<Seat>,
-    timing: Timing,
-    mission: String,
-    /// One-shot missions: the fleet's job (to check the results agents send).
-    job: Option<Arc<ShareJob>>,
-    /// One-shot missions: the stop flag; a share planned here is cut short when it is raised.
-    stop: Option<Arc<AtomicBool>>,
-}
 
 /// Runs the mission and returns the best plan's run result and the network figures.
 pub fn run(

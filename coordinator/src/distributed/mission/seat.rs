@@ -10,7 +10,7 @@ use shoal_common::distributed::{Chromosome, Context};
 use shoal_common::plan::DegradedVehicle;
 use shoal_common::wire::WireChromosome;
 
-use super::Share;
+use super::share::Share;
 
 /// The exchange round being collected: its index and its iterations `start..start + len`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -9,17 +9,15 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
-use shoal_common::coverage::fleet::{FleetCoverage, StripPlan};
-use shoal_common::coverage::TerrainMap25;
 use shoal_common::distributed::Context;
 use shoal_common::plan::{AgentFigures, DegradedVehicle, DistributedFigures};
-use shoal_common::tour::{FleetTours, TourPlan};
 use shoal_common::trajectory::Trajectory;
-use shoal_common::wire::agent_to_coordinator::{tour_from_wire, AgentToCoordinator};
+use shoal_common::wire::agent_to_coordinator::AgentToCoordinator;
 
 use super::super::agents::LocalAgents;
 use super::super::network::{Event, POLL};
-use super::{Run, Status, GONE_GRACE};
+pub use super::share::{Share, ShareJob};
+use super::state::{Run, Status, GONE_GRACE};
 
 /// Shortest time the coordinator waits for the results once every agent has joined.
 const MIN_SHARE_WAIT: Duration = Duration::from_secs(60);
@@ -28,92 +26,6 @@ const MIN_SHARE_WAIT: Duration = Duration::from_secs(60);
 /// finishes the missing ones itself (an agent needs milliseconds to end its swarms or its
 /// tracking simulation).
 const STOP_GRACE: Duration = Duration::from_secs(2);
-
-/// What the agents of a one-shot mission plan.
-pub enum ShareJob {
-    /// Inspection tours (seed 003).
-    Tours(Box<FleetTours>),
-    /// Coverage strips (seed 002) on the seabed map.
-    Strips(Box<FleetCoverage>, Box<TerrainMap25>),
-}
-
-/// One vehicle's result.
-#[derive(Debug, Clone)]
-pub enum Share {
-    /// Its inspection tour.
-    Tour(TourPlan),
-    /// Its strip's coverage plan.
-    Strip(Box<StripPlan>),
-    /// The coordinator could not plan it either.
-    Failed(String),
-}
-
-impl ShareJob {
-    /// Plans vehicle `i`'s share in this process. A raised `stop` cuts a tour's swarms short
-    /// (the tour is still complete) or a strip's tracking simulation (the strip is planned
-    /// whole).
-    fn plan_here(&self, i: usize, stop: Option<&Arc<AtomicBool>>) -> Share {
-        match self {
-            ShareJob::Tours(job) => Share::Tour(job.plan_vehicle(i, stop)),
-            ShareJob::Strips(job, map) => {
-                match job.plan_vehicle(map, i, stop.map(|s| &**s), &mut |_, _| {}) {
-                    Ok(p) => Share::Strip(Box::new(p)),
-                    Err(e) => Share::Failed(e.to_string()),
-                }
-            }
-        }
-    }
-
-    /// The share a result message carries for vehicle `i`, checked; `None` when the message
-    /// is not this job's kind of result.
-    fn read(&self, i: usize, m: AgentToCoordinator) -> Option<Result<Share, String>> {
-        match (self, m) {
-            (ShareJob::Tours(job), m) => {
-                let share = job.shares.get(i).map_or(0, Vec::len);
-                tour_from_wire(&m, share).map(|t| t.map(Share::Tour))
-            }
-            (ShareJob::Strips(job, _), AgentToCoordinator::Coverage { strip, plan, .. }) => {
-                Some(match job.strips.get(i) {
-                    _ if strip as usize != i => Err(format!("strip {strip} for vehicle {i}")),
-                    Some(rect) => plan
-                        .check(*rect)
-                        .map(|()| Share::Strip(plan))
-                        .map_err(|e| e.to_string()),
-                    None => Err(format!("no strip for vehicle {i}")),
-                })
-            }
-            _ => None,
-        }
-    }
-
-    /// What the agents send, in words.
-    fn noun(&self) -> &'static str {
-        match self {
-            ShareJob::Tours(_) => "tour",
-            ShareJob::Strips(..) => "strip plan",
-        }
-    }
-}
-
-impl Share {
-    /// Its length, metres (the progress line's figure).
-    fn length_m(&self) -> f64 {
-        match self {
-            Share::Tour(t) => t.tour_length_m,
-            Share::Strip(p) => p.path.length(),
-            Share::Failed(_) => 0.0,
-        }
-    }
-
-    /// Whether a stop cut it short: a tour's swarms, or a strip's tracking simulation.
-    fn interrupted(&self) -> bool {
-        match self {
-            Share::Tour(t) => t.interrupted,
-            Share::Strip(p) => p.report.tracking.as_ref().is_some_and(|t| t.interrupted),
-            Share::Failed(_) => false,
-        }
-    }
-}
 
 /// The assignment's context for a one-shot mission: every vehicle at its start (the agents do
 /// not score against it; `Assign` carries one for every mission).

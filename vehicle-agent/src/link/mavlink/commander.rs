@@ -14,9 +14,10 @@ use shoal_common::execution::{CommandState, VehicleCommand, VehicleStatus};
 use shoal_common::scenario::{Bounds, Obstacle};
 use shoal_common::trajectory::Trajectory;
 
-use super::super::{GeoOrigin, LinkError, LinkOutcome, MavlinkSettings};
+use super::super::types::{LinkError, LinkOutcome, MavlinkSettings};
 use super::items::{self, Items, Profile};
 use super::reader::{Conn, Shared, READ_TICK};
+use shoal_common::geo::GeoOrigin;
 
 /// How long to wait for a heartbeat that names the autopilot before a first upload.
 const HEARTBEAT_WAIT: Duration = Duration::from_secs(3);

@@ -23,7 +23,7 @@ use shoal_common::geometry::horizontal_distance_to_path;
 use shoal_common::scenario::{Bounds, Obstacle, ObstacleKind};
 use shoal_common::trajectory::Trajectory;
 
-use super::super::GeoOrigin;
+use shoal_common::geo::GeoOrigin;
 
 /// How long a fallback hold keeps the vehicle at its waypoint, seconds (an hour: until the
 /// next upload, in practice).
@@ -324,5 +324,4 @@ pub fn fence_items(
 }
 
 #[cfg(test)]
-#[path = "items_tests.rs"]
 mod tests;

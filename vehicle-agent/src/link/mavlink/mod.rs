@@ -33,10 +33,11 @@ use mavlink::{Connectable, ConnectionAddress, MavConnection, MavHeader, MavlinkV
 use shoal_common::execution::{VehicleCommand, VehicleState, VehicleStatus};
 use shoal_common::trajectory::Trajectory;
 
-use super::{GeoOrigin, LinkError, LinkOutcome, MavlinkSettings, VehicleLink};
+use super::types::{LinkError, LinkOutcome, MavlinkSettings, VehicleLink};
 pub use commander::FenceSource;
 use commander::{Commander, Done, Effect, Job};
 use reader::{Shared, READ_TICK};
+use shoal_common::geo::GeoOrigin;
 
 pub use items::{fence_items, mission_items, AutopilotChoice, Profile};
 

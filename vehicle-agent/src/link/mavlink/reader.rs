@@ -14,7 +14,7 @@ use mavlink::dialects::common::{MavState, MavType};
 use mavlink::error::MessageReadError;
 use mavlink::{MavConnection, MavHeader};
 
-use super::super::GeoOrigin;
+use shoal_common::geo::GeoOrigin;
 
 /// How often the reader wakes up to send the heartbeat and check for shutdown.
 pub const READ_TICK: Duration = Duration::from_millis(50);

@@ -1,6 +1,8 @@
 //! Unit tests of `execute::replan_queue`.
 
+use super::super::queue::ReplanQueue;
 use super::*;
+use shoal_common::geometry::Vec3;
 use shoal_common::scenario::{Obstacle, ObstacleKind};
 
 fn waiting(vehicle: usize, ms: u64) -> Waiting {

@@ -1,7 +1,7 @@
 //! Settings and errors of the Hybrid A* detour planner ([`super::plan`]), kept apart so the
 //! search file stays short. Re-exported from `hybrid_astar`.
 
-use super::Pose2;
+use crate::coverage::path::Pose2;
 use serde::{Deserialize, Serialize};
 use std::f64::consts::{PI, SQRT_2};
 

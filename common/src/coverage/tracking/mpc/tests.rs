@@ -1,6 +1,6 @@
 use super::super::discrete::{discretise, stage_key};
 use super::super::plant::Plant;
-use super::super::{FlatTerrain, Pose2};
+use super::super::types::{FlatTerrain, Pose2};
 use super::*;
 use approx::assert_abs_diff_eq;
 use rand::rngs::StdRng;

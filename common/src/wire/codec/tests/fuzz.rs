@@ -5,7 +5,7 @@
 
 use proptest::prelude::*;
 
-use super::*;
+use super::super::*;
 use crate::execution::{VehicleState, VehicleStatus};
 use crate::scenario::{Obstacle, ObstacleKind};
 use crate::wire::agent_to_coordinator::AgentToCoordinator;
