@@ -4,21 +4,27 @@
 //! # Layout
 //!
 //! - [`commands`]: one file per command, its clap arguments beside its handler; `commands/mod.rs`
-//!   holds the [`Command`] enum and the dispatch ([`commands::run()`]). Commands never call each other:
-//!   what two of them share goes down a layer (or, for a flag group, into `plan_args`).
-//! - [`planning`]: the planners (fleet swarms, one-AUV energy, inspection tours, coverage) and
-//!   the seed-comparison runner's planners.
+//!   holds the [`Command`] enum and the dispatch ([`commands::run()`]). Each command turns its
+//!   flags into typed options in one place. Commands never call each other and never build an
+//!   argv: what two of them share goes down a layer (or, for a flag group, into `plan_args` or
+//!   `shoal_common::wire::flags`).
+//! - [`mission`]: the typed mission options ([`MissionOptions`], [`RunOptions`]) and the entry
+//!   points [`plan_mission`] and [`run_mission`] that `plan`, `run`, `serve` and tests call.
+//! - [`planning`]: the planners (fleet swarms, one-AUV energy, inspection tours, coverage),
+//!   the seed-comparison runner's planners and the random scenario generator.
 //! - [`report`]: what the commands print and write: `plan.json`/`plan.svg`, progress, summaries,
 //!   the comparison tables, the SVG charts and the GeoJSON/QGroundControl exports.
 //! - [`distributed`] (planning over agents on Zenoh) and [`execute`] (driving a plan, watching
 //!   the fleet, replanning).
-//! - The rule: `commands` → `planning`, `report`, `distributed`, `execute`, never back; no cycle
-//!   between files (`.ci/module-cycles` checks it).
+//! - The rule: `commands` → `mission` → `planning`, `report`, `distributed`, `execute`, never
+//!   back (`commands` may also call the lower layers directly); no cycle between files
+//!   (`.ci/module-cycles` checks it).
 
 pub mod acl;
 pub mod commands;
 pub mod distributed;
 pub mod execute;
+pub mod mission;
 pub mod planning;
 pub mod report;
 
@@ -26,3 +32,4 @@ pub use commands::plan_args::PlanArgs;
 pub use commands::{
     default_log_filter, run, Cli, Command, EXIT_ERROR, EXIT_FEASIBLE, EXIT_VIOLATIONS,
 };
+pub use mission::{plan_mission, run_mission, MissionOptions, RunOptions};

@@ -220,9 +220,9 @@ fn a_forged_far_fix_and_a_replayed_hold_leave_the_mission_met_and_are_counted() 
     assert_eq!(kinds("obstacle_dropped"), 2);
     assert_eq!(r.total(), 1 + 1 + r.obstacle_rate, "{r:?}");
     assert!(
-        shoal_coordinator::commands::run::execution_ok(&report),
+        shoal_coordinator::mission::run::execution_ok(&report),
         "{}",
-        shoal_coordinator::commands::run::execution_summary(&report)
+        shoal_coordinator::mission::run::execution_summary(&report)
     );
     Ok(())
 }

@@ -1,4 +1,5 @@
-//! `shoal-agent`: parses the command line, sets up logging, and calls the library's `run`.
+//! `shoal-agent`: parses the command line, sets up logging, and calls the library's `run` with
+//! the configuration the command line gives (or its healthcheck).
 
 use std::process::ExitCode;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -38,7 +39,13 @@ fn main() -> ExitCode {
     }) {
         tracing::warn!("cannot install the Ctrl-C handler: {e}");
     }
-    match shoal_agent::run(args, shutdown) {
+    let result = if args.health_check {
+        shoal_agent::health_check(args.health_file.as_deref())
+    } else {
+        args.config()
+            .and_then(|config| shoal_agent::run(config, shutdown))
+    };
+    match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("error: {e:#}");

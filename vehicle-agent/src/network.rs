@@ -22,8 +22,8 @@ use shoal_common::wire::{session, topics, Envelope};
 use zenoh::qos::CongestionControl;
 use zenoh::{Session, Wait};
 
-use crate::args::AgentArgs;
 use crate::assignment::{Assignment, MissionReport};
+use crate::config::AgentConfig;
 use crate::execute::{self, Order};
 use crate::link;
 use crate::mission;
@@ -45,8 +45,8 @@ struct Worker {
 
 /// Opens a client session on a thread of its own (zenoh's open blocks while it waits for the
 /// router), giving up when `shutdown` is raised.
-fn open(args: &AgentArgs, shutdown: &AtomicBool) -> anyhow::Result<Option<Session>> {
-    let config = session::client_config(&args.connect, true, &args.zenoh.security()?)?;
+fn open(agent: &AgentConfig, shutdown: &AtomicBool) -> anyhow::Result<Option<Session>> {
+    let config = session::client_config(&agent.connect, true, &agent.security)?;
     let (tx, rx) = mpsc::channel();
     std::thread::spawn(move || {
         let _ = tx.send(zenoh::open(config).wait());
@@ -67,7 +67,7 @@ fn open(args: &AgentArgs, shutdown: &AtomicBool) -> anyhow::Result<Option<Sessio
                 if waited.as_millis().is_multiple_of(10_000) {
                     tracing::info!(
                         "waiting for the coordinator at {} ({} s so far)",
-                        args.connect.join(", "),
+                        agent.connect.join(", "),
                         waited.as_secs()
                     );
                 }
@@ -102,7 +102,7 @@ fn send(session: &Session, vehicle: &str, message: AgentToCoordinator) {
 }
 
 /// Serves missions until `shutdown` (or, with `--once`, the first mission's end).
-pub fn serve(args: &AgentArgs, shutdown: &AtomicBool) -> anyhow::Result<()> {
+pub fn serve(args: &AgentConfig, shutdown: &AtomicBool) -> anyhow::Result<()> {
     let vehicle = args.vehicle.clone();
     tracing::info!(
         "agent for {vehicle}: connecting to {}",
@@ -229,7 +229,7 @@ pub fn serve(args: &AgentArgs, shutdown: &AtomicBool) -> anyhow::Result<()> {
 
 /// One inbound message and what it may touch.
 struct Inbound<'a> {
-    args: &'a AgentArgs,
+    args: &'a AgentConfig,
     session: &'a Session,
     workers: &'a mut HashMap<String, Worker>,
     finished: &'a HashSet<String>,
@@ -381,7 +381,7 @@ impl Inbound<'_> {
         let stop = Arc::new(AtomicBool::new(false));
         let session = self.session.clone();
         let dropped = Arc::clone(&self.drops.count);
-        let (threads, idle, flag) = (self.args.threads, self.args.idle(), Arc::clone(&stop));
+        let (threads, idle, flag) = (self.args.threads, self.args.idle_timeout, Arc::clone(&stop));
         let spawned = std::thread::Builder::new()
             .name(format!("mission-{mission}"))
             .spawn(move || {
@@ -422,12 +422,7 @@ impl Inbound<'_> {
     /// chose.
     fn start_execution(self, order: Order) {
         let mission = order.mission.clone();
-        let mut link = match link::open(
-            &self.args.link_settings(),
-            &order.scenario,
-            order.index,
-            order.seed,
-        ) {
+        let mut link = match link::open(&self.args.link, &order.scenario, order.index, order.seed) {
             Ok(l) => l,
             Err(e) => {
                 tracing::error!("mission {mission}: cannot open the vehicle link: {e}");
@@ -441,7 +436,7 @@ impl Inbound<'_> {
         let (tx, rx) = mpsc::channel();
         let stop = Arc::new(AtomicBool::new(false));
         let session = self.session.clone();
-        let (idle, flag) = (self.args.idle(), Arc::clone(&stop));
+        let (idle, flag) = (self.args.idle_timeout, Arc::clone(&stop));
         let spawned = std::thread::Builder::new()
             .name(format!("execute-{mission}"))
             .spawn(move || {

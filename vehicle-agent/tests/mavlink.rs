@@ -475,9 +475,7 @@ fn the_agent_flags_build_the_settings_and_bad_values_name_the_flag() -> TestResu
         );
     }
     let without = AgentArgs::try_parse_from(base)?;
-    let err = shoal_agent::run(without, Arc::new(AtomicBool::new(false)))
-        .err()
-        .map(|e| e.to_string());
+    let err = without.config().err().map(|e| e.to_string());
     assert!(err.is_some_and(|e| e.contains("--mavlink-address")));
     Ok(())
 }

@@ -1,5 +1,7 @@
-//! The Zenoh security flags every binary takes, declared once (as zenoh's examples share one
-//! `CommonArgs`) and flattened into each command that opens a session.
+//! The Zenoh flags every binary takes, declared once (as zenoh's examples share one
+//! `CommonArgs`) and flattened into each command that opens a session: the endpoints a router
+//! listens on ([`ZenohListen`]), the endpoints a client connects to ([`ZenohConnect`]) and how
+//! members authenticate ([`ZenohSecurityArgs`]).
 
 use std::path::{Path, PathBuf};
 
@@ -8,6 +10,38 @@ use super::session::SessionError;
 
 /// Largest password file read.
 const MAX_PASSWORD_BYTES: u64 = 4096;
+
+/// Where a Zenoh router is reached when nothing says otherwise: loopback, Zenoh's own port.
+pub const DEFAULT_ENDPOINT: &str = "tcp/127.0.0.1:7447";
+
+/// The endpoints a process's Zenoh router listens on (`router`, `serve`, and `plan`/`run` in
+/// distributed mode). A command whose default differs (`plan` picks one from its agents' mode)
+/// changes the default and the help with clap's `mut_arg`, so the flag's name, environment
+/// variable and list syntax stay declared here alone.
+#[derive(Debug, Clone, PartialEq, Eq, clap::Args)]
+pub struct ZenohListen {
+    /// Endpoint(s) to listen on (comma-separated); beyond loopback needs authentication.
+    #[arg(
+        long,
+        env = "SHOAL_LISTEN",
+        value_delimiter = ',',
+        default_value = DEFAULT_ENDPOINT
+    )]
+    pub listen: Vec<String>,
+}
+
+/// The endpoints a Zenoh client (an agent, `status`) connects to: the coordinator's router.
+#[derive(Debug, Clone, PartialEq, Eq, clap::Args)]
+pub struct ZenohConnect {
+    /// The coordinator's Zenoh endpoint(s), e.g. tcp/coordinator:7447 (comma-separated).
+    #[arg(
+        long,
+        env = "SHOAL_CONNECT",
+        value_delimiter = ',',
+        default_value = DEFAULT_ENDPOINT
+    )]
+    pub connect: Vec<String>,
+}
 
 /// How this process joins the fleet's Zenoh network securely (see `docs/guide/security.md`).
 #[derive(Debug, Clone, Default, PartialEq, Eq, clap::Args)]
@@ -121,6 +155,22 @@ mod tests {
     struct Cli {
         #[command(flatten)]
         zenoh: ZenohSecurityArgs,
+        #[command(flatten)]
+        listen: ZenohListen,
+        #[command(flatten)]
+        connect: ZenohConnect,
+    }
+
+    #[test]
+    fn endpoints_default_to_loopback_and_split_on_commas() -> Result<(), clap::Error> {
+        let cli = Cli::try_parse_from(["x"])?;
+        assert_eq!(cli.listen.listen, [DEFAULT_ENDPOINT]);
+        assert_eq!(cli.connect.connect, [DEFAULT_ENDPOINT]);
+        let cli =
+            Cli::try_parse_from(["x", "--listen", "tcp/a:1,tcp/b:2", "--connect", "tls/c:3"])?;
+        assert_eq!(cli.listen.listen, ["tcp/a:1", "tcp/b:2"]);
+        assert_eq!(cli.connect.connect, ["tls/c:3"]);
+        Ok(())
     }
 
     #[test]

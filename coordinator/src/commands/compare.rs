@@ -9,7 +9,7 @@ use std::sync::Arc;
 use anyhow::Context;
 use shoal_common::scenario::{Algorithm, Scenario};
 
-use crate::distributed;
+use crate::mission::NetworkOptions;
 use crate::report::compare::{self, seeds_line};
 use crate::report::out::say;
 use crate::report::{crawler_table, significance};
@@ -98,18 +98,13 @@ pub fn command(args: &CompareArgs, stop: &Arc<AtomicBool>) -> anyhow::Result<i32
     let per_scenario = args.algorithms.len() + if args.distributed { multi } else { 0 };
     let total = scenarios.len() * per_scenario * args.seeds as usize;
     let mut done = 0;
-    let distributed = args.distributed.then(|| distributed::DistributedOptions {
-        mission: String::new(),
-        agents: distributed::AgentsMode::Embedded,
-        listen: vec!["tcp/127.0.0.1:0".into()],
-        routers: Vec::new(),
-        security: Default::default(),
-        join_timeout: std::time::Duration::from_secs(30),
-        round_timeout: std::time::Duration::from_secs(10),
-        agent_bin: None,
-        log_dir: std::env::temp_dir().join("shoal-compare-logs"),
-        health_file: None,
-        agent_args: Vec::new(),
+    // Embedded agents on a free loopback port with the default timeouts; each run names its
+    // own mission.
+    let distributed = args.distributed.then(|| {
+        NetworkOptions::default().for_mission(
+            String::new(),
+            std::env::temp_dir().join("shoal-compare-logs"),
+        )
     });
     let cells = compare::compare(
         &scenarios,

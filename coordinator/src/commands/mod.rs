@@ -1,7 +1,7 @@
 //! The coordinator's commands: one file per command, its clap arguments beside its handler.
 //! Every flag also reads a `SHOAL_*` environment variable, so containers need only environment
-//! settings. A command calls the layers below (`planning`, `report`, `distributed`, `execute`),
-//! never another command.
+//! settings. A command turns its flags into typed options in one place and calls the layers
+//! below (`mission`, `planning`, `report`, `distributed`, `execute`), never another command.
 
 pub mod bench;
 pub mod compare;
@@ -24,8 +24,6 @@ use std::sync::Arc;
 use clap::{Parser, Subcommand};
 
 pub use exit::{EXIT_ERROR, EXIT_FEASIBLE, EXIT_VIOLATIONS};
-
-use crate::report::out::say;
 
 /// Shoal fleet coordinator: plans collision-free, time-coordinated paths for a fleet of
 /// underwater vehicles.
@@ -101,11 +99,7 @@ pub fn run(command: Command, shutdown: Arc<AtomicBool>) -> anyhow::Result<i32> {
         Command::Plan(args) => plan::command(&args, shutdown),
         Command::Export(args) => export::command(&args),
         Command::Compare(args) => compare::command(&args, &shutdown),
-        Command::Generate(args) => {
-            generate::generate(&args)?;
-            say(&format!("Wrote {}\n", args.out.display()));
-            Ok(EXIT_FEASIBLE)
-        }
+        Command::Generate(args) => generate::command(&args),
         Command::Run(args) => run::command(&args, shutdown),
         Command::Serve(args) => serve::command(&args, shutdown),
         Command::Status(args) => status::command(&args),

@@ -1,19 +1,26 @@
-//! The planning flags `plan` and `run` share (each flattens [`PlanArgs`]), and what they become:
-//! the scenario with the overrides applied, the distributed-mode options, a coverage mission
-//! planned as `plan` plans it. Flags only: no command's handler lives here.
+//! The planning flags `plan` and `run` share (each flattens [`PlanArgs`]), and the one place
+//! they become [`MissionOptions`] ([`PlanArgs::options`]). Flags only: no command's handler
+//! lives here.
 
 use std::path::PathBuf;
-use std::sync::atomic::AtomicBool;
-use std::sync::Arc;
 
-use anyhow::{bail, Context};
-use shoal_common::scenario::{Algorithm, Scenario};
+use shoal_common::scenario::Algorithm;
+use shoal_common::wire::flags::{ZenohListen, ZenohSecurityArgs};
 
-use crate::distributed::{self, AgentsMode};
-use crate::planning::{coverage, coverage_fleet};
+use crate::distributed::AgentsMode;
+use crate::mission::options::{
+    default_listen, seconds, DEFAULT_JOIN_TIMEOUT_S, DEFAULT_ROUND_TIMEOUT_S,
+};
+use crate::mission::{MissionOptions, NetworkOptions, Overrides};
+
+/// `--listen`'s help under `plan` and `run`, whose default depends on `--agents`.
+const LISTEN_HELP: &str = "Distributed mode: endpoint(s) the embedded Zenoh router listens on (comma-separated). \
+Default: tcp/127.0.0.1:0 (a free port) with embedded agents, tcp/127.0.0.1:7447 with external ones; \
+listening beyond loopback needs authentication (or --insecure)";
 
 /// `shoal-coordinator plan`.
 #[derive(Debug, Clone, clap::Args)]
+#[command(mut_arg("listen", |a| a.default_value(Option::<&str>::None).help(LISTEN_HELP)))]
 pub struct PlanArgs {
     /// Scenario file (TOML).
     #[arg(env = "SHOAL_SCENARIO")]
@@ -57,11 +64,9 @@ pub struct PlanArgs {
     /// elsewhere to connect (external).
     #[arg(long, env = "SHOAL_AGENTS", value_enum, default_value_t = AgentsMode::Embedded)]
     pub agents: AgentsMode,
-    /// Distributed mode: endpoint(s) the embedded Zenoh router listens on (comma-separated).
-    /// Default: tcp/127.0.0.1:0 (a free port) with embedded agents, tcp/127.0.0.1:7447 with
-    /// external ones; listening beyond loopback needs authentication (or --insecure).
-    #[arg(long, env = "SHOAL_LISTEN", value_delimiter = ',')]
-    pub listen: Vec<String>,
+    /// Distributed mode: where the embedded router listens (empty: [`default_listen`]).
+    #[command(flatten)]
+    pub listen: ZenohListen,
     /// Distributed mode: other Zenoh routers to link to, e.g. another coordinator's endpoint, so
     /// two missions share one network and its agents (comma-separated).
     #[arg(long, env = "SHOAL_ROUTERS", value_delimiter = ',')]
@@ -69,17 +74,13 @@ pub struct PlanArgs {
     /// Distributed mode: how members authenticate to the embedded router (listening beyond
     /// loopback needs it, or --insecure).
     #[command(flatten)]
-    pub zenoh: shoal_common::wire::flags::ZenohSecurityArgs,
-    /// Set by `serve` (never a flag): the identity its mission routers link to the serving
-    /// router with, instead of `zenoh`.
-    #[arg(skip)]
-    pub link_security: Option<shoal_common::wire::security::Security>,
+    pub zenoh: ZenohSecurityArgs,
     /// Distributed mode: seconds the agents have to join.
-    #[arg(long, env = "SHOAL_JOIN_TIMEOUT", default_value_t = 30.0)]
+    #[arg(long, env = "SHOAL_JOIN_TIMEOUT", default_value_t = DEFAULT_JOIN_TIMEOUT_S)]
     pub join_timeout: f64,
     /// Distributed mode: seconds a round waits for an agent's elites before the coordinator
     /// plans that vehicle itself (degraded mode).
-    #[arg(long, env = "SHOAL_ROUND_TIMEOUT", default_value_t = 10.0)]
+    #[arg(long, env = "SHOAL_ROUND_TIMEOUT", default_value_t = DEFAULT_ROUND_TIMEOUT_S)]
     pub round_timeout: f64,
     /// Distributed mode: mission id (default: scenario name, process id and time).
     #[arg(long, env = "SHOAL_MISSION")]
@@ -93,142 +94,99 @@ pub struct PlanArgs {
     pub health_file: Option<PathBuf>,
 }
 
-/// Loads a scenario and applies the command-line overrides.
-pub fn load_scenario(args: &PlanArgs) -> anyhow::Result<Scenario> {
-    let mut s = Scenario::load(&args.scenario)?;
-    let o = &mut s.optimizer;
-    // The flags given, as typed, for an error that would otherwise blame the file.
-    let mut given = Vec::new();
-    if let Some(v) = args.seed {
-        o.seed = v;
-        given.push(format!("--seed {v}"));
+impl PlanArgs {
+    /// The mission these flags ask for. The network's settings (the password file read, the
+    /// timeouts checked) only when they are used: over the agents, or for `run`'s execution
+    /// (`network`).
+    pub fn options(&self, network: bool) -> anyhow::Result<MissionOptions> {
+        Ok(MissionOptions {
+            scenario: self.scenario.clone(),
+            out: self.out.clone(),
+            overrides: Overrides {
+                seed: self.seed,
+                algorithm: self.algorithm,
+                iterations: self.iterations,
+                populations: self.populations,
+                particles: self.particles,
+                threads: self.threads,
+                no_touch_up: self.no_touch_up,
+            },
+            quiet: self.quiet,
+            in_process: self.in_process,
+            network: if network || !self.in_process {
+                Some(self.network()?)
+            } else {
+                None
+            },
+        })
     }
-    if let Some(v) = args.algorithm {
-        o.algorithm = v;
-        given.push(format!("--algorithm {}", v.as_str()));
-    }
-    if let Some(v) = args.iterations {
-        o.iterations = v;
-        given.push(format!("--iterations {v}"));
-    }
-    if let Some(v) = args.populations {
-        o.populations = v;
-        given.push(format!("--populations {v}"));
-    }
-    if let Some(v) = args.particles {
-        o.particles = v;
-        given.push(format!("--particles {v}"));
-    }
-    if let Some(v) = args.threads {
-        o.threads = v;
-        given.push(format!("--threads {v}"));
-    }
-    if args.no_touch_up {
-        o.touch_up = false;
-    }
-    // Overrides are user input too: check them with the same rules, naming the field, and
-    // saying that the command line set it.
-    match s.validate(&args.scenario) {
-        Ok(()) => Ok(s),
-        Err(e) if given.is_empty() => Err(e.into()),
-        Err(e) => Err(anyhow::Error::new(e).context(format!(
-            "with the command line's {} over the scenario file",
-            given.join(" ")
-        ))),
-    }
-}
 
-/// A duration from a number of seconds given by the user, or an error naming the flag.
-fn seconds(flag: &str, value: f64) -> anyhow::Result<std::time::Duration> {
-    match std::time::Duration::try_from_secs_f64(value) {
-        Ok(d) if value > 0.0 => Ok(d),
-        _ => bail!("{flag} = {value}: must be a positive number of seconds"),
-    }
-}
-
-/// The distributed-mode settings the command line gives.
-pub fn distributed_options(
-    args: &PlanArgs,
-    scenario: &Scenario,
-) -> anyhow::Result<distributed::DistributedOptions> {
-    let listen = if args.listen.is_empty() {
-        vec![match args.agents {
-            distributed::AgentsMode::Embedded => "tcp/127.0.0.1:0".to_string(),
-            distributed::AgentsMode::External => "tcp/127.0.0.1:7447".to_string(),
-        }]
-    } else {
-        args.listen.clone()
-    };
-    Ok(distributed::DistributedOptions {
-        mission: args
-            .mission
-            .clone()
-            .unwrap_or_else(|| distributed::default_mission_id(scenario)),
-        agents: args.agents,
-        listen,
-        routers: args.router.clone(),
-        security: match &args.link_security {
-            Some(s) => s.clone(),
-            None => args.zenoh.security()?,
-        },
-        join_timeout: seconds("--join-timeout (SHOAL_JOIN_TIMEOUT)", args.join_timeout)?,
-        round_timeout: seconds("--round-timeout (SHOAL_ROUND_TIMEOUT)", args.round_timeout)?,
-        agent_bin: args.agent_bin.clone(),
-        log_dir: args.out.join("logs"),
-        health_file: args.health_file.clone(),
-        agent_args: Vec::new(),
-    })
-}
-
-/// Plans a `[coverage]` mission as `plan` does (`run` too): one crawler in this process, a
-/// fleet over its agents (with the options `distributed` gives) unless `--in-process`; writes
-/// `plan.json` and `plan.svg` into `--out`.
-pub fn plan_coverage_mission(
-    args: &PlanArgs,
-    scenario: &Scenario,
-    shutdown: &Arc<AtomicBool>,
-    distributed: impl FnOnce() -> anyhow::Result<distributed::DistributedOptions>,
-) -> anyhow::Result<coverage::PlannedCoverage> {
-    let Some(settings) = &scenario.coverage else {
-        bail!("{}: no [coverage] table", args.scenario.display());
-    };
-    let fleet = scenario.vehicles.len() > 1;
-    if !fleet && !args.in_process {
-        bail!(
-            "{}: a [coverage] mission with one crawler plans inside this process: add --in-process (several crawlers split the area among their agents)",
-            args.scenario.display()
-        );
-    }
-    if let Some(a) = args.algorithm {
-        eprintln!(
-            "note: --algorithm {} is not used: a [coverage] mission plans with seed 002's Boustrophedon",
-            a.as_str()
-        );
-    }
-    std::fs::create_dir_all(&args.out)
-        .with_context(|| format!("cannot create output directory {}", args.out.display()))?;
-    if fleet {
-        let options = if args.in_process {
-            None
+    /// The distributed-mode flags as network settings.
+    fn network(&self) -> anyhow::Result<NetworkOptions> {
+        let listen = if self.listen.listen.is_empty() {
+            vec![default_listen(self.agents).to_string()]
         } else {
-            Some(distributed()?)
+            self.listen.listen.clone()
         };
-        coverage_fleet::plan_fleet_coverage(
-            &args.scenario,
-            scenario,
-            &args.out,
-            args.quiet,
-            options.as_ref(),
-            shutdown,
-        )
-    } else {
-        coverage::plan_coverage_command(
-            &args.scenario,
-            scenario,
-            settings,
-            &args.out,
-            args.quiet,
-            shutdown,
-        )
+        Ok(NetworkOptions {
+            mission: self.mission.clone(),
+            agents: self.agents,
+            listen,
+            routers: self.router.clone(),
+            security: self.zenoh.security()?,
+            join_timeout: seconds("--join-timeout (SHOAL_JOIN_TIMEOUT)", self.join_timeout)?,
+            round_timeout: seconds("--round-timeout (SHOAL_ROUND_TIMEOUT)", self.round_timeout)?,
+            agent_bin: self.agent_bin.clone(),
+            health_file: self.health_file.clone(),
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::Parser;
+
+    /// `plan`'s flags alone, parsed as the command line would be.
+    #[derive(Parser)]
+    struct Plan {
+        #[command(flatten)]
+        args: PlanArgs,
+    }
+
+    /// The command line's surface: `--listen` has no default under `plan` (it follows
+    /// `--agents`), and the flags land in the options.
+    #[test]
+    fn the_flags_become_the_options() -> anyhow::Result<()> {
+        let line = [
+            "plan",
+            "s.toml",
+            "--seed",
+            "4",
+            "--agents",
+            "external",
+            "--no-touch-up",
+        ];
+        let o = Plan::try_parse_from(line)?.args.options(false)?;
+        assert_eq!(o.overrides.seed, Some(4));
+        assert!(o.overrides.no_touch_up);
+        let n = o.network()?;
+        assert_eq!(n.listen, ["tcp/127.0.0.1:7447"]);
+        assert_eq!(n.join_timeout.as_secs_f64(), DEFAULT_JOIN_TIMEOUT_S);
+        let o = Plan::try_parse_from(["plan", "s.toml", "--in-process"])?
+            .args
+            .options(false)?;
+        assert!(o.in_process && o.network.is_none());
+        let e = Plan::try_parse_from(["plan", "s.toml", "--join-timeout=-1"])?
+            .args
+            .options(false)
+            .err()
+            .map(|e| e.to_string())
+            .unwrap_or_default();
+        assert!(
+            e.contains("--join-timeout (SHOAL_JOIN_TIMEOUT) = -1"),
+            "{e}"
+        );
+        Ok(())
     }
 }

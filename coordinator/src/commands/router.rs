@@ -7,14 +7,9 @@ use crate::distributed;
 /// `shoal-coordinator router`.
 #[derive(Debug, Clone, clap::Args)]
 pub struct RouterArgs {
-    /// Endpoint(s) to listen on (comma-separated); beyond loopback needs authentication.
-    #[arg(
-        long,
-        env = "SHOAL_LISTEN",
-        value_delimiter = ',',
-        default_value = "tcp/127.0.0.1:7447"
-    )]
-    pub listen: Vec<String>,
+    /// Where the router listens.
+    #[command(flatten)]
+    pub listen: shoal_common::wire::flags::ZenohListen,
     /// How members authenticate (a router beyond loopback needs it, or --insecure).
     #[command(flatten)]
     pub zenoh: shoal_common::wire::flags::ZenohSecurityArgs,
@@ -22,6 +17,6 @@ pub struct RouterArgs {
 
 /// Serves until `shutdown` is raised.
 pub fn command(args: &RouterArgs, shutdown: &AtomicBool) -> anyhow::Result<i32> {
-    distributed::network::serve_router(&args.listen, &args.zenoh.security()?, shutdown)?;
+    distributed::network::serve_router(&args.listen.listen, &args.zenoh.security()?, shutdown)?;
     Ok(super::exit::EXIT_FEASIBLE)
 }

@@ -14,14 +14,9 @@ use crate::report::summary::opt;
 /// `shoal-coordinator status`.
 #[derive(Debug, Clone, clap::Args)]
 pub struct StatusArgs {
-    /// The coordinator's Zenoh endpoint(s) (comma-separated).
-    #[arg(
-        long,
-        env = "SHOAL_CONNECT",
-        value_delimiter = ',',
-        default_value = "tcp/127.0.0.1:7447"
-    )]
-    pub connect: Vec<String>,
+    /// The coordinator's router.
+    #[command(flatten)]
+    pub connect: shoal_common::wire::flags::ZenohConnect,
     /// How to authenticate to the fleet's network.
     #[command(flatten)]
     pub zenoh: shoal_common::wire::flags::ZenohSecurityArgs,
@@ -55,7 +50,12 @@ pub fn command(args: &StatusArgs) -> anyhow::Result<i32> {
                 args.timeout
             )
         })?;
-    let statuses = query(&args.connect, &args.zenoh.security()?, &key, timeout)?;
+    let statuses = query(
+        &args.connect.connect,
+        &args.zenoh.security()?,
+        &key,
+        timeout,
+    )?;
     if statuses.is_empty() {
         eprintln!(
             "no running mission answered on {key} within {:.1} s",

@@ -1,10 +1,12 @@
 //! The planners: a fleet's swarm in this process ([`planner`]), one AUV's energy-aware path
 //! ([`energy`]), inspection tours ([`tour`]) and coverage missions ([`coverage`],
-//! [`coverage_fleet`]), on the one solver loop of [`solver`].
+//! [`coverage_fleet`]), on the one solver loop of [`solver`]; and random fleet scenarios to plan
+//! ([`generated`]).
 
 pub mod coverage;
 pub mod coverage_fleet;
 pub mod energy;
+pub mod generated;
 pub mod planner;
 pub mod solver;
 pub mod tour;

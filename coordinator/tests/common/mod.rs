@@ -4,7 +4,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::thread::JoinHandle;
 
-use shoal_agent::AgentArgs;
+use shoal_agent::AgentConfig;
 
 pub type TestResult = Result<(), Box<dyn std::error::Error>>;
 
@@ -23,27 +23,15 @@ pub struct Agent {
 /// The agent of `vehicle`, connecting to `endpoint`, leaving after its first mission.
 pub fn agent(vehicle: &str, endpoint: &str) -> Agent {
     let stop = Arc::new(AtomicBool::new(false));
-    let args = AgentArgs {
-        vehicle: vehicle.into(),
-        connect: vec![endpoint.into()],
-        zenoh: Default::default(),
+    let config = AgentConfig {
         once: true,
-        threads: 1,
-        idle_timeout: 10.0,
-        health_file: None,
-        health_check: false,
-        link: shoal_agent::link::LinkKind::Sim,
-        position_noise: 1.0,
-        mavlink_address: None,
-        mavlink_origin: None,
-        mavlink_target: None,
-        mavlink_autopilot: shoal_agent::link::mavlink::AutopilotChoice::Auto,
-        mavlink_no_fence: false,
+        idle_timeout: std::time::Duration::from_secs(10),
+        ..AgentConfig::new(vehicle, vec![endpoint.into()])
     };
     let flag = Arc::clone(&stop);
     Agent {
         stop,
-        handle: std::thread::spawn(move || shoal_agent::run(args, flag)),
+        handle: std::thread::spawn(move || shoal_agent::run(config, flag)),
     }
 }
 

@@ -12,8 +12,9 @@ use std::time::{Duration, Instant};
 use shoal_common::scenario::Scenario;
 use shoal_common::trajectory::Trajectory;
 
-use crate::distributed::{AgentsMode, DistributedOptions};
 use crate::execute::{self, ExecOptions};
+use crate::mission::NetworkOptions;
+use crate::planning::generated::scenario_text;
 
 /// `shoal-coordinator bench-telemetry`.
 #[derive(Debug, Clone, clap::Args)]
@@ -49,7 +50,7 @@ pub fn command(args: &BenchTelemetryArgs, stop: &AtomicBool) -> anyhow::Result<i
     if !(args.hz.is_finite() && args.hz > 0.0 && args.seconds.is_finite() && args.seconds > 5.0) {
         anyhow::bail!("--hz must be positive and --seconds over 5");
     }
-    let text = crate::commands::generate::scenario_text(args.vehicles, 0, 1);
+    let text = scenario_text(args.vehicles, 0, 1);
     let mut scenario = Scenario::parse(&text, std::path::Path::new("<bench-telemetry scenario>"))?;
     scenario.name = "bench-telemetry".into();
     let n = scenario.vehicles.len();
@@ -68,19 +69,16 @@ pub fn command(args: &BenchTelemetryArgs, stop: &AtomicBool) -> anyhow::Result<i
     let arrival = plans.iter().map(Trajectory::arrival).fold(0.0, f64::max);
     let time_scale = arrival / args.seconds;
     std::fs::create_dir_all(&args.out)?;
-    let distributed = DistributedOptions {
-        mission: format!("bench-telemetry-{}", std::process::id()),
-        agents: AgentsMode::Embedded,
-        listen: vec!["tcp/127.0.0.1:0".into()],
-        routers: Vec::new(),
-        security: Default::default(),
+    // Embedded agents on a free loopback port; a minute to join, for 128 of them.
+    let mut distributed = NetworkOptions {
         join_timeout: Duration::from_secs(60),
-        round_timeout: Duration::from_secs(10),
-        agent_bin: None,
-        log_dir: args.out.join("logs"),
-        health_file: None,
-        agent_args: vec!["--position-noise".into(), "1".into()],
-    };
+        ..NetworkOptions::default()
+    }
+    .for_mission(
+        format!("bench-telemetry-{}", std::process::id()),
+        args.out.join("logs"),
+    );
+    distributed.agent_args = vec!["--position-noise".into(), "1".into()];
     let options = ExecOptions {
         time_scale,
         telemetry_hz: args.hz,

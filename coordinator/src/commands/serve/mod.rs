@@ -18,34 +18,33 @@ use std::sync::Arc;
 use std::time::Duration;
 
 use anyhow::Context as _;
-use clap::Parser;
 use shoal_common::scenario::DataDir;
+use shoal_common::wire::flags::{ZenohListen, ZenohSecurityArgs};
 use shoal_common::wire::{codec, session, topics};
 use zenoh::Wait;
 
-use crate::commands::run::{self, RunArgs};
+use crate::distributed::AgentsMode;
+use crate::mission::{run_mission, MissionOptions, NetworkOptions, RunOptions};
 
+mod environment;
 mod queue;
+mod refusal;
 mod submission;
 
 use queue::Queue;
+use refusal::Refusal;
 use submission::{accept, check_size, Rules};
 pub use submission::{Receipt, Submission};
 
 /// `shoal-coordinator serve`.
 #[derive(Debug, Clone, clap::Args)]
 pub struct ServeArgs {
-    /// Endpoint(s) to listen on (comma-separated).
-    #[arg(
-        long,
-        env = "SHOAL_LISTEN",
-        value_delimiter = ',',
-        default_value = "tcp/127.0.0.1:7447"
-    )]
-    pub listen: Vec<String>,
+    /// Where the serving router listens.
+    #[command(flatten)]
+    pub listen: ZenohListen,
     /// How clients and agents authenticate (listening beyond loopback needs it, or --insecure).
     #[command(flatten)]
-    pub zenoh: shoal_common::wire::flags::ZenohSecurityArgs,
+    pub zenoh: ZenohSecurityArgs,
     /// Where each mission's files go (`<out>/<mission>/`).
     #[arg(long, env = "SHOAL_OUT", default_value = "missions")]
     pub out: PathBuf,
@@ -60,12 +59,6 @@ pub struct ServeArgs {
     /// submission is refused rather than holding the queue.
     #[arg(long, env = "SHOAL_MAX_MISSION_HOURS", default_value_t = 6.0)]
     pub max_mission_hours: f64,
-}
-
-#[derive(Parser)]
-struct Wrapper {
-    #[command(flatten)]
-    run: RunArgs,
 }
 
 /// The operator's rules from the flags.
@@ -95,15 +88,14 @@ fn answer(
     payload: Option<&zenoh::bytes::ZBytes>,
     rules: &Rules,
     queue: &Queue,
-) -> Result<String, String> {
+) -> Result<String, Refusal> {
     // The size before copying or decoding anything.
     check_size(payload.map_or(0, |p| p.len()))?;
     let bytes = payload
         .map(|p| p.to_bytes().into_owned())
         .unwrap_or_default();
     let checked = catch_unwind(AssertUnwindSafe(|| accept(&bytes, rules)));
-    let a = checked
-        .map_err(|_| "submission: could not be checked (the server logged why)".to_string())??;
+    let a = checked.map_err(|_| Refusal::Unchecked)??;
     queue.offer(a.mission.clone(), a.submission)?;
     Ok(a.mission)
 }
@@ -112,6 +104,7 @@ fn answer(
 pub fn command(args: &ServeArgs, shutdown: Arc<AtomicBool>) -> anyhow::Result<i32> {
     let rules = rules(args)?;
     let listen: Vec<String> = args
+        .listen
         .listen
         .iter()
         .map(|e| crate::distributed::network::resolve_port_zero(e))
@@ -136,7 +129,7 @@ pub fn command(args: &ServeArgs, shutdown: Arc<AtomicBool>) -> anyhow::Result<i3
                 Err(why) => {
                     count.fetch_add(1, Ordering::Relaxed);
                     tracing::warn!("refused a submission: {why}");
-                    submission::refused(why)
+                    submission::refused(why.to_string())
                 }
             };
             if let Ok(b) = codec::encode_json(&receipt) {
@@ -217,38 +210,91 @@ fn run_one(
     let file = dir.join("scenario.toml");
     std::fs::write(&file, &s.scenario_toml)
         .with_context(|| format!("cannot write {}", file.display()))?;
-    // `--flag=value` throughout and the scenario after `--`: no value is read as a flag.
-    let mut argv: Vec<String> = vec![
-        "run".into(),
-        format!("--out={}", dir.display()),
-        format!("--mission={mission}"),
-        format!("--router={}", link.endpoint),
-        // Explicit, so that serve's own SHOAL_LISTEN / SHOAL_AGENTS never reach the mission.
-        "--listen=tcp/127.0.0.1:0".into(),
-        "--agents=embedded".into(),
-        "--quiet".into(),
-    ];
-    if s.in_process {
-        argv.push("--in-process".into());
-    }
-    for (flag, v) in [
-        ("--time-scale", s.time_scale.map(|v| v.to_string())),
-        ("--telemetry-hz", s.telemetry_hz.map(|v| v.to_string())),
-        ("--iterations", s.iterations.map(|v| v.to_string())),
-        ("--seed", s.seed.map(|v| v.to_string())),
-    ] {
-        if let Some(v) = v {
-            argv.push(format!("{flag}={v}"));
-        }
-    }
-    argv.extend(["--".into(), file.display().to_string()]);
-    let mut run = Wrapper::try_parse_from(&argv)
-        .map_err(|e| anyhow::anyhow!("cannot build the run: {e}"))?
-        .run;
-    run.plan.link_security = Some(link.security.clone());
+    let options = mission_options(link, mission, s, file, dir.clone())?;
     eprintln!(
         "mission {mission}: planning and executing (files in {})",
         dir.display()
     );
-    run::command(&run, Arc::clone(shutdown))
+    Ok(if run_mission(&options, Arc::clone(shutdown))? {
+        crate::commands::exit::EXIT_FEASIBLE
+    } else {
+        crate::commands::exit::EXIT_VIOLATIONS
+    })
+}
+
+/// What a submitted mission runs with: its own settings, serve's output directory, embedded
+/// agents on a free loopback port linked to the serving router with its identity, no progress
+/// output; every other setting is `run`'s default unless the `SHOAL_*` variable `run` reads for
+/// it is set in serve's environment ([`environment::overlay`]), as it always was.
+fn mission_options(
+    link: &Link,
+    mission: &str,
+    s: &Submission,
+    scenario: PathBuf,
+    out: PathBuf,
+) -> anyhow::Result<RunOptions> {
+    let mut options = RunOptions {
+        mission: MissionOptions {
+            scenario,
+            out,
+            overrides: Default::default(),
+            quiet: true,
+            in_process: false,
+            network: Some(NetworkOptions {
+                mission: Some(mission.to_string()),
+                // Explicit, so that serve's own SHOAL_LISTEN / SHOAL_AGENTS never reach the
+                // mission.
+                agents: AgentsMode::Embedded,
+                listen: vec!["tcp/127.0.0.1:0".into()],
+                routers: vec![link.endpoint.clone()],
+                security: link.security.clone(),
+                ..NetworkOptions::default()
+            }),
+        },
+        execution: Default::default(),
+    };
+    environment::overlay(&mut options)?;
+    let (m, e) = (&mut options.mission, &mut options.execution);
+    m.in_process |= s.in_process;
+    m.overrides.iterations = s.iterations.or(m.overrides.iterations);
+    m.overrides.seed = s.seed.or(m.overrides.seed);
+    e.time_scale = s.time_scale.unwrap_or(e.time_scale);
+    e.telemetry_hz = s.telemetry_hz.unwrap_or(e.telemetry_hz);
+    Ok(options)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A submission's own settings and serve's decisions reach the mission as options, with
+    /// `run`'s defaults for the rest (no `SHOAL_*` variable set in the test's environment).
+    #[test]
+    fn a_submission_becomes_run_options_without_an_argv() -> anyhow::Result<()> {
+        let link = Link {
+            endpoint: "tcp/127.0.0.1:7447".into(),
+            security: Default::default(),
+        };
+        let s = Submission {
+            version: 1,
+            scenario_toml: String::new(),
+            mission: None,
+            time_scale: Some(50.0),
+            telemetry_hz: None,
+            iterations: Some(7),
+            seed: None,
+            in_process: true,
+        };
+        let o = mission_options(&link, "m-1", &s, "m/scenario.toml".into(), "m".into())?;
+        let (m, e) = (&o.mission, &o.execution);
+        assert!(m.in_process && m.quiet);
+        assert_eq!((m.overrides.iterations, m.overrides.seed), (Some(7), None));
+        assert_eq!((e.time_scale, e.telemetry_hz), (50.0, 2.0));
+        let n = m.network()?;
+        assert_eq!(n.mission.as_deref(), Some("m-1"));
+        assert_eq!(n.agents, AgentsMode::Embedded);
+        assert_eq!(n.listen, ["tcp/127.0.0.1:0"]);
+        assert_eq!(n.routers, ["tcp/127.0.0.1:7447"]);
+        Ok(())
+    }
 }

@@ -9,6 +9,7 @@ use std::time::Duration;
 
 use shoal_common::limits;
 
+use super::refusal::QueueError;
 use super::submission::Submission;
 
 /// Shared by the submission callback (which offers) and the serving loop (which takes).
@@ -48,21 +49,16 @@ impl Queue {
 
     /// Puts `mission` at the back, or says why not: the queue is full, or the id is waiting,
     /// running or already has a directory under `out`.
-    pub fn offer(&self, mission: String, s: Submission) -> Result<(), String> {
+    pub fn offer(&self, mission: String, s: Submission) -> Result<(), QueueError> {
         let mut state = self.lock();
         let taken = state.running.as_deref() == Some(mission.as_str())
             || state.waiting.iter().any(|(m, _)| *m == mission)
             || self.out.join(&mission).symlink_metadata().is_ok();
         if taken {
-            return Err(format!(
-                "submission: mission id {mission:?} is already taken (queued, running or run before): choose another"
-            ));
+            return Err(QueueError::Taken(mission));
         }
         if state.waiting.len() >= limits::MAX_QUEUED_MISSIONS {
-            return Err(format!(
-                "queue full: {} missions waiting (try again later)",
-                state.waiting.len()
-            ));
+            return Err(QueueError::Full(state.waiting.len()));
         }
         state.waiting.push_back((mission, s));
         self.offered.notify_one();
@@ -117,9 +113,10 @@ mod tests {
         for i in 0..limits::MAX_QUEUED_MISSIONS {
             assert_eq!(q.offer(format!("m{i}"), sub()), Ok(()));
         }
+        assert_eq!(q.offer("m8".into(), sub()), Err(QueueError::Full(8)));
         assert_eq!(
-            q.offer("m8".into(), sub()),
-            Err("queue full: 8 missions waiting (try again later)".into())
+            QueueError::Full(8).to_string(),
+            "queue full: 8 missions waiting (try again later)"
         );
         // Taking one makes room for one.
         assert_eq!(q.take(Duration::ZERO).map(|(m, _)| m), Some("m0".into()));
@@ -138,7 +135,11 @@ mod tests {
         assert_eq!(q.offer("b".into(), sub()), Ok(()));
         assert_eq!(q.take(Duration::ZERO).map(|(m, _)| m), Some("a".into()));
         for taken in ["a", "b", "done"] {
-            let e = q.offer(taken.into(), sub()).err().unwrap_or_default();
+            let e = q
+                .offer(taken.into(), sub())
+                .err()
+                .map(|e| e.to_string())
+                .unwrap_or_default();
             assert!(e.contains(&format!("{taken:?} is already taken")), "{e}");
         }
         // Once the running mission ends, its id is free only if it left no directory.

@@ -11,6 +11,10 @@ use shoal_common::limits;
 use shoal_common::scenario::{DataDir, Scenario};
 use shoal_common::wire::{codec, topics};
 
+use super::refusal::Refusal;
+// Mission seconds per wall second when a submission sets none: `run`'s default.
+use crate::mission::options::DEFAULT_TIME_SCALE;
+
 /// A mission submitted on `shoal/submit`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -71,22 +75,16 @@ pub struct Accepted {
     pub submission: Submission,
 }
 
-/// Mission seconds per wall second when a submission sets none (as `run`'s default).
-const DEFAULT_TIME_SCALE: f64 = 1.0;
-
 /// Names the submitted scenario in errors: it has no file of its own.
 const SUBMITTED: &str = "<submitted scenario>";
 
 /// Checks a submission's bytes; the mission id and the checked submission, or why not.
-pub fn accept(bytes: &[u8], rules: &Rules) -> Result<Accepted, String> {
+pub fn accept(bytes: &[u8], rules: &Rules) -> Result<Accepted, Refusal> {
     check_size(bytes.len())?;
     let mut s: Submission =
-        codec::decode_json(bytes).map_err(|e| format!("not a submission: {e}"))?;
+        codec::decode_json(bytes).map_err(|e| Refusal::Malformed(e.to_string()))?;
     if s.version != 1 {
-        return Err(format!(
-            "submission version {} (this coordinator reads 1)",
-            s.version
-        ));
+        return Err(Refusal::Version(s.version));
     }
     check_rates(&s)?;
     if let Some(n) = s.iterations {
@@ -97,14 +95,14 @@ pub fn accept(bytes: &[u8], rules: &Rules) -> Result<Accepted, String> {
         Path::new(SUBMITTED),
         rules.data_dir.as_ref(),
     )
-    .map_err(|e| e.to_string())?;
+    .map_err(|e| Refusal::Scenario(e.to_string()))?;
     check_evaluations(&scenario, s.iterations)?;
     check_wall_time(&scenario, &s, rules.max_wall_s)?;
     let mission = match &s.mission {
         Some(m) => m.clone(),
         None => crate::distributed::default_mission_id(&scenario),
     };
-    topics::check_id("mission", &mission).map_err(|e| format!("submission: {e}"))?;
+    topics::check_id("mission", &mission).map_err(|e| Refusal::MissionId(e.to_string()))?;
     s.scenario_toml = text;
     Ok(Accepted {
         mission,
@@ -113,29 +111,27 @@ pub fn accept(bytes: &[u8], rules: &Rules) -> Result<Accepted, String> {
 }
 
 /// Refuses more than [`limits::MAX_SUBMISSION_BYTES`] before anything is decoded.
-pub fn check_size(bytes: usize) -> Result<(), String> {
+pub fn check_size(bytes: usize) -> Result<(), Refusal> {
     if bytes > limits::MAX_SUBMISSION_BYTES {
-        return Err(format!(
-            "submission: {bytes} bytes is over the limit {}",
-            limits::MAX_SUBMISSION_BYTES
-        ));
+        return Err(Refusal::TooLarge(bytes));
     }
     Ok(())
 }
 
 /// `time_scale` and `telemetry_hz` within their ranges.
-fn check_rates(s: &Submission) -> Result<(), String> {
+fn check_rates(s: &Submission) -> Result<(), Refusal> {
     for (field, v, range) in [
         ("time_scale", s.time_scale, limits::TIME_SCALE),
         ("telemetry_hz", s.telemetry_hz, limits::TELEMETRY_HZ),
     ] {
         if let Some(v) = v {
             if !range.contains(&v) {
-                return Err(format!(
-                    "submission: {field} = {v} is outside {} to {}",
-                    range.start(),
-                    range.end()
-                ));
+                return Err(Refusal::OutOfRange {
+                    field,
+                    value: v,
+                    min: *range.start(),
+                    max: *range.end(),
+                });
             }
         }
     }
@@ -143,18 +139,16 @@ fn check_rates(s: &Submission) -> Result<(), String> {
 }
 
 /// `value` of submission `field` at most `max`.
-fn check_at_most(field: &str, value: u128, max: u128) -> Result<(), String> {
+fn check_at_most(field: &'static str, value: u128, max: u128) -> Result<(), Refusal> {
     if value > max {
-        return Err(format!(
-            "submission: {field} = {value} is over the limit {max}"
-        ));
+        return Err(Refusal::OverLimit { field, value, max });
     }
     Ok(())
 }
 
 /// Particles × populations × iterations × vehicles within [`limits::MAX_EVALUATIONS`], with
 /// the submission's iterations in place of the scenario's when it sets them.
-fn check_evaluations(scenario: &Scenario, iterations: Option<usize>) -> Result<(), String> {
+fn check_evaluations(scenario: &Scenario, iterations: Option<usize>) -> Result<(), Refusal> {
     let o = &scenario.optimizer;
     let iterations = iterations.unwrap_or(o.iterations);
     let product = [
@@ -166,28 +160,29 @@ fn check_evaluations(scenario: &Scenario, iterations: Option<usize>) -> Result<(
     .iter()
     .fold(1u128, |p, &n| p.saturating_mul(n as u128));
     if product > limits::MAX_EVALUATIONS {
-        return Err(format!(
-            "submission: particles × populations × iterations × vehicles = {} × {} × {} × {} = {product} is over the limit {}",
-            o.particles,
-            o.populations.max(1),
+        return Err(Refusal::Evaluations {
+            particles: o.particles,
+            populations: o.populations.max(1),
             iterations,
-            scenario.vehicles.len(),
-            limits::MAX_EVALUATIONS
-        ));
+            vehicles: scenario.vehicles.len(),
+            product,
+        });
     }
     Ok(())
 }
 
 /// Mission time / time scale within `max_wall_s`: a slow replay of a long mission would hold
 /// the queue for everyone behind it.
-fn check_wall_time(scenario: &Scenario, s: &Submission, max_wall_s: f64) -> Result<(), String> {
+fn check_wall_time(scenario: &Scenario, s: &Submission, max_wall_s: f64) -> Result<(), Refusal> {
     let scale = s.time_scale.unwrap_or(DEFAULT_TIME_SCALE);
     let wall = scenario.fleet.mission_time_s / scale;
     if wall.is_nan() || wall > max_wall_s {
-        return Err(format!(
-            "submission: fleet.mission_time_s / time_scale = {} s / {scale} = {wall:.0} s of wall time is over this server's limit {max_wall_s:.0} s (--max-mission-hours)",
-            scenario.fleet.mission_time_s
-        ));
+        return Err(Refusal::WallTime {
+            mission_s: scenario.fleet.mission_time_s,
+            scale,
+            wall_s: wall,
+            max_wall_s,
+        });
     }
     Ok(())
 }
@@ -230,7 +225,7 @@ mod tests {
     fn refusal_with(v: Value, rules: &Rules) -> String {
         match accept(v.to_string().as_bytes(), rules) {
             Ok(a) => panic!("accepted {}", a.mission),
-            Err(e) => e,
+            Err(e) => e.to_string(),
         }
     }
 
@@ -239,7 +234,7 @@ mod tests {
     }
 
     #[test]
-    fn a_valid_submission_is_accepted_with_its_scenario_unchanged() -> Result<(), String> {
+    fn a_valid_submission_is_accepted_with_its_scenario_unchanged() -> Result<(), Refusal> {
         let ok = json!({"version": 1, "scenario_toml": BASE, "mission": "m-1", "time_scale": 50.0, "iterations": 5});
         let a = accept(ok.to_string().as_bytes(), &rules())?;
         assert_eq!(a.mission, "m-1");
@@ -252,7 +247,7 @@ mod tests {
     fn an_oversized_submission_is_refused_before_it_is_decoded() {
         let big = vec![b'x'; limits::MAX_SUBMISSION_BYTES + 1];
         assert_eq!(
-            accept(&big, &rules()).err(),
+            accept(&big, &rules()).err().map(|e| e.to_string()),
             Some("submission: 1048577 bytes is over the limit 1048576".into())
         );
     }
@@ -261,6 +256,7 @@ mod tests {
     fn malformed_and_other_version_submissions_say_why() {
         assert!(accept(b"not json", &rules())
             .err()
+            .map(|e| e.to_string())
             .unwrap_or_default()
             .contains("not a submission"));
         assert!(refusal(json!({"version": 2, "scenario_toml": ""})).contains("version 2"));

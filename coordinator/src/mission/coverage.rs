@@ -1,7 +1,7 @@
 //! `run` on a `[coverage]` mission (seed 002): the coverage plan, then its execution by the
 //! agents' vehicles like any other plan ([`crate::execute`]).
 //!
-//! - **Planning** is `plan`'s ([`crate::commands::plan_args::plan_coverage_mission`]) without its closed-loop
+//! - **Planning** is `plan`'s ([`super::plan::plan_coverage_mission`]) without its closed-loop
 //!   tracking simulation: under `run` the agents' vehicles drive the path, so simulating it
 //!   first would only double the time. `plan.json` then has no `tracking` figures; the
 //!   execution's are in `execution.json`.
@@ -28,20 +28,21 @@ use shoal_common::scenario::Scenario;
 use shoal_common::trajectory::Trajectory;
 
 use super::executable::{executable, Executable};
-use crate::commands::plan_args::PlanArgs;
+use super::options::MissionOptions;
+use super::plan::plan_coverage_mission;
 use crate::distributed::DistributedOptions;
 
-/// Plans `scenario`'s coverage into `--out` and returns what the agents execute; `None` (after
+/// Plans `scenario`'s coverage into the mission's output directory and returns what the agents execute; `None` (after
 /// saying why) when the plan is not to be executed.
 pub fn plan(
-    p: &PlanArgs,
+    m: &MissionOptions,
     scenario: &Scenario,
     options: &DistributedOptions,
     separation_buffer_m: f64,
     shutdown: &Arc<AtomicBool>,
 ) -> anyhow::Result<Option<Executable>> {
     let Some(settings) = scenario.coverage.as_ref() else {
-        bail!("{}: no [coverage] table", p.scenario.display());
+        bail!("{}: no [coverage] table", m.scenario.display());
     };
     let mut planning = scenario.clone();
     if let Some(c) = planning.coverage.as_mut() {
@@ -54,10 +55,7 @@ pub fn plan(
             planning.fleet.d_min_m, scenario.fleet.d_min_m, separation_buffer_m
         );
     }
-    let planned =
-        crate::commands::plan_args::plan_coverage_mission(p, &planning, shutdown, || {
-            Ok(options.clone())
-        })?;
+    let planned = plan_coverage_mission(m, &planning, shutdown, || Ok(options.clone()))?;
     if !executable(planned.feasible, shutdown) {
         return Ok(None);
     }
@@ -75,7 +73,7 @@ pub fn plan(
             )
         })
         .collect();
-    let dir = p.scenario.parent().unwrap_or(Path::new("."));
+    let dir = m.scenario.parent().unwrap_or(Path::new("."));
     let scenario = for_agents(scenario, &trajectories, dir)?;
     let common_arrival_s = trajectories
         .iter()
