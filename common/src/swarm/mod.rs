@@ -15,7 +15,7 @@
 //!
 //! The items of `core` and the solver modules are re-exported here, so `swarm::Executor` and
 //! `swarm::pso::Pso` are the short paths. Adding an optimizer is one file in `solvers/` and
-//! one catalog entry.
+//! one catalog entry (docs/guide/new-optimizer.md).
 
 /// Implements [`VelocityCapped`] for solvers with a `max_velocity_fraction` field. Defined
 /// before `solvers` so every solver file can use it on itself.
