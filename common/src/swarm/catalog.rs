@@ -15,6 +15,7 @@ use super::core::population::{Coefficients, Schedule};
 use super::core::{Problem, Solver, VelocityCapped};
 use super::solvers::acopso::AcoPso;
 use super::solvers::cbpso::Cbpso;
+use super::solvers::cfpso::CfPso;
 use super::solvers::depso::DePso;
 use super::solvers::epapso::EpaPso;
 use super::solvers::ipso::Ipso;
@@ -59,6 +60,8 @@ pub enum Algorithm {
     LdiwPso,
     /// Seed 003's LCPSO baseline (eq. (4)–(10)).
     Lcpso,
+    /// Constriction-factor PSO of Clerc and Kennedy (2002), χ ≈ 0.7298, c1 = c2 = 2.05.
+    CfPso,
 }
 
 impl Algorithm {
@@ -80,10 +83,12 @@ impl Algorithm {
             Algorithm::DePso => "de-pso",
             Algorithm::LdiwPso => "ldiw-pso",
             Algorithm::Lcpso => "lcpso",
+            Algorithm::CfPso => "cf-pso",
         }
     }
-    /// Every algorithm: seed 004 Table 5's order, then seed 000 Table 8's, seed 001's, seed 003's.
-    pub const ALL: [Algorithm; 15] = [
+    /// Every algorithm: seed 004 Table 5's order, then seed 000 Table 8's, seed 001's, seed 003's,
+    /// then the variants from the wider literature.
+    pub const ALL: [Algorithm; 16] = [
         Algorithm::AmpPso,
         Algorithm::APso,
         Algorithm::MpPso,
@@ -99,6 +104,7 @@ impl Algorithm {
         Algorithm::DePso,
         Algorithm::LdiwPso,
         Algorithm::Lcpso,
+        Algorithm::CfPso,
     ];
     /// True for seed 001's single-AUV energy planners, which plan on the energy cost rather
     /// than the fleet fitness.
@@ -160,9 +166,11 @@ pub fn family(algorithm: Algorithm) -> Family {
         A::AmpPso | A::MpPso => Family::Fleet {
             multi_population: true,
         },
-        A::Pso | A::APso | A::Ipso | A::Spso | A::Cbpso | A::Nspso | A::AcoPso => Family::Fleet {
-            multi_population: false,
-        },
+        A::Pso | A::APso | A::Ipso | A::Spso | A::Cbpso | A::Nspso | A::AcoPso | A::CfPso => {
+            Family::Fleet {
+                multi_population: false,
+            }
+        }
         A::EpaPso | A::MPso => Family::Energy {
             path_length_only: false,
         },
@@ -302,6 +310,7 @@ pub fn with_solver<P: Problem, V: SolverVisitor<P>>(
         Algorithm::DePso => visitor.visit(DePso::table5(m, seed).capped(cap)),
         Algorithm::LdiwPso => visitor.visit(LdiwPso::table5(m, seed).capped(cap)),
         Algorithm::Lcpso => visitor.visit(Lcpso::table5(m, seed).capped(cap)),
+        Algorithm::CfPso => visitor.visit(CfPso::clerc_kennedy(m, seed).capped(cap)),
     }
 }
 

@@ -4,6 +4,7 @@
 
 pub mod acopso;
 pub mod cbpso;
+pub mod cfpso;
 pub mod depso;
 pub mod epapso;
 pub mod ipso;
