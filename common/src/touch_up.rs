@@ -37,8 +37,8 @@ use rand::{Rng, SeedableRng};
 
 use crate::cost::FleetModel;
 use crate::geometry::Vec3;
-use crate::swarm::multi::{stream_seed, MultiPso};
-use crate::swarm::population::{Particle, Population, Schedule};
+use crate::swarm::multi::MultiPso;
+use crate::swarm::population::{stream_seed, Particle, Population, Schedule};
 use crate::swarm::pso::PsoState;
 use crate::swarm::{Executor, Problem, Progress, Solver, SolverState};
 use crate::vehicle_problem::VehicleProblem;

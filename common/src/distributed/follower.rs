@@ -10,10 +10,11 @@ use std::sync::Arc;
 
 use super::{Chromosome, Context};
 use crate::cost::FleetModel;
-use crate::scenario::{Algorithm, OptimizerSettings};
-use crate::swarm::multi::{stream_seed, SEED004_VELOCITY_CAP};
+use crate::scenario::OptimizerSettings;
+use crate::swarm::catalog;
+use crate::swarm::multi::SEED004_VELOCITY_CAP;
 use crate::swarm::parallel;
-use crate::swarm::population::{Limits, Particle, Population, Schedule};
+use crate::swarm::population::{stream_seed, Limits, Particle, Population, Schedule};
 use crate::swarm::{Problem, Progress};
 use crate::vehicle_problem::VehicleProblem;
 
@@ -41,10 +42,7 @@ impl FollowerSettings {
         FollowerSettings {
             populations: o.distributed.agent_populations,
             particles: o.particles,
-            schedule: match o.algorithm {
-                Algorithm::AmpPso | Algorithm::APso => Schedule::Adaptive,
-                _ => Schedule::TABLE5_FIXED,
-            },
+            schedule: catalog::schedule(o.algorithm),
             max_velocity_fraction: o.velocity_cap(SEED004_VELOCITY_CAP),
             threads: o.threads,
             seed: o.seed,

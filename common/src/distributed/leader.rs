@@ -13,9 +13,9 @@ use std::sync::Arc;
 use super::{Chromosome, Context};
 use crate::cost::FleetModel;
 use crate::scenario::OptimizerSettings;
-use crate::swarm::multi::{stream_seed, SEED004_VELOCITY_CAP};
+use crate::swarm::multi::{move_leader, SEED004_VELOCITY_CAP};
 use crate::swarm::parallel;
-use crate::swarm::population::{trusted_best, update, Limits, Particle, Population, Schedule};
+use crate::swarm::population::{stream_seed, trusted_best, Limits, Particle, Population, Schedule};
 use crate::swarm::{Problem, Progress};
 
 /// The leader population and the best fleet plan so far.
@@ -138,42 +138,23 @@ impl Leader {
         } else {
             (self.leader.elite_x.clone(), self.leader.elite_cost)
         };
-        let leader_best = trusted_best(
+        let moved = move_leader(
             model,
-            self.leader.particles.iter().chain(immigrants.iter()),
-            &lx,
-            lc,
+            &mut self.leader,
+            &mut immigrants,
+            (&lx, lc),
+            &f_gbest,
+            c,
+            &self.limits,
+            self.threads,
         );
-        let l_gbest = match leader_best {
-            Some(b) => {
-                self.evaluations += b.evaluations;
-                improved |= self.offer(&b.x, b.cost);
-                b.x
-            }
-            None => f_gbest.clone(),
-        };
-        let rng = &mut self.leader.rng;
-        let mut movers: Vec<&mut Particle> = self
-            .leader
-            .particles
-            .iter_mut()
-            .chain(immigrants.iter_mut())
-            .collect();
-        for p in movers.iter_mut() {
-            update(p, &l_gbest, Some(&f_gbest), c, &self.limits, rng);
+        self.evaluations += moved.evaluations;
+        if let Some(b) = &moved.gbest {
+            improved |= self.offer(&b.x, b.cost);
         }
-        parallel::for_each_mut(&mut movers, self.threads, |p| p.evaluate(model));
-        self.evaluations += movers.len() as u64;
         for p in self.leader.particles.iter().chain(immigrants.iter()) {
             improved |= keep_better(&mut self.best_x, &mut self.best_cost, &p.x, p.cost);
         }
-        for im in &immigrants {
-            if im.cost < self.leader.elite_cost {
-                self.leader.elite_cost = im.cost;
-                self.leader.elite_x.clone_from(&im.x);
-            }
-        }
-        self.evaluations += self.leader.refresh(model);
         improved |= self.offer(&self.leader.elite_x.clone(), self.leader.elite_cost);
         self.exchanges += 1;
         // (c) every immigrant's chromosomes go home.

@@ -1,6 +1,6 @@
 //! Functions with known optima for the optimizers' convergence tests.
 
-use super::Problem;
+use super::core::Problem;
 
 /// Shifted sphere `Σ (x_d − s_d)²` on `[-10, 10]^n`: minimum 0 at `s`.
 pub struct ShiftedSphere {

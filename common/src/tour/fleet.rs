@@ -7,23 +7,14 @@ use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
 
 use crate::geometry::Vec3;
-use crate::scenario::{Algorithm, FirstPointMode, Scenario};
-use crate::swarm::multi::stream_seed;
+use crate::scenario::{FirstPointMode, Scenario};
+use crate::swarm::catalog::{leg_algorithm, LegAlgorithm};
+use crate::swarm::population::stream_seed;
 
 use super::cages::{inspection_points, Cage, FirstPoint, InspectionPoint};
 use super::order::SwapPso;
-use super::plan::{plan_tour, LegAlgorithm, LegSettings, TourPlan, TourSettings};
+use super::plan::{plan_tour, LegSettings, TourPlan, TourSettings};
 use super::split::{short_tour, split_points};
-
-/// The leg swarm of an algorithm (`None` for the algorithms that do not plan tours).
-pub fn leg_algorithm(a: Algorithm) -> Option<LegAlgorithm> {
-    match a {
-        Algorithm::DePso => Some(LegAlgorithm::DePso),
-        Algorithm::LdiwPso => Some(LegAlgorithm::LdiwPso),
-        Algorithm::Lcpso => Some(LegAlgorithm::Lcpso),
-        _ => None,
-    }
-}
 
 /// Everything needed to plan any vehicle's tour of a scenario.
 #[derive(Debug, Clone)]
@@ -242,12 +233,5 @@ mod tests {
         assert_eq!((first, second), (vec![2, 3], vec![0, 1]));
         // One vehicle takes everything.
         assert_eq!(shares(&points, &bases[..1]), vec![vec![0, 1, 2, 3]]);
-    }
-
-    #[test]
-    fn only_tour_algorithms_have_a_leg_swarm() {
-        assert_eq!(leg_algorithm(Algorithm::DePso), Some(LegAlgorithm::DePso));
-        assert_eq!(leg_algorithm(Algorithm::Lcpso), Some(LegAlgorithm::Lcpso));
-        assert_eq!(leg_algorithm(Algorithm::AmpPso), None);
     }
 }

@@ -20,12 +20,13 @@ mod order;
 mod plan;
 mod split;
 
+pub use crate::swarm::catalog::{leg_algorithm, LegAlgorithm};
 pub use cages::{
     cage_group_a, cage_group_b, inspection_points, paper_base, paper_bounds, Cage, FirstPoint,
     InspectionPoint, MONITOR_STANDOFF_M,
 };
 pub use figures::TourFigures;
-pub use fleet::{leg_algorithm, shares, FleetTours, NoTours};
+pub use fleet::{shares, FleetTours, NoTours};
 pub use leg::{
     feasible, intersections, path_length, safety_spheres, segment_hits, LegProblem, Sphere,
     CHORD_WEIGHT, HIT_PENALTY_M,
@@ -34,8 +35,7 @@ pub use order::{
     distance_matrix, open_order_length, swap_sequence, tour_length, two_opt, Ordered, SwapPso,
 };
 pub use plan::{
-    plan_leg, plan_tour, summed_curve, Leg, LegAlgorithm, LegSettings, TourPlan, TourSettings,
-    LEG_CLEARANCE_M,
+    plan_leg, plan_tour, summed_curve, Leg, LegSettings, TourPlan, TourSettings, LEG_CLEARANCE_M,
 };
 pub use split::{short_tour, split_points};
 

@@ -9,40 +9,15 @@ use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
 
 use crate::geometry::Vec3;
-use crate::swarm::depso::DePso;
-use crate::swarm::lcpso::Lcpso;
-use crate::swarm::ldiwpso::LdiwPso;
-use crate::swarm::multi::stream_seed;
-use crate::swarm::{Executor, Outcome, SolverState, Termination, VelocityCapped};
+use crate::swarm::catalog::{with_solver, LegAlgorithm, SolverSettings, SolverVisitor};
+use crate::swarm::population::stream_seed;
+use crate::swarm::{Executor, Solver, SolverState, Termination};
 
 /// Clearance the leg planner keeps from a cage's surface, metres. The seed treats the AUV as a
 /// point and the cage sphere itself as the obstacle; 1 m of margin stays well inside the 5 m
 /// standoff of the inspection points ([`MONITOR_STANDOFF_M`](super::MONITOR_STANDOFF_M)), so
 /// those remain reachable.
 pub const LEG_CLEARANCE_M: f64 = 1.0;
-
-/// The swarm that plans the legs (the three algorithms of seed 003 Table 6).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum LegAlgorithm {
-    /// DE-PSO, §IV-A, eq. (14)–(20).
-    DePso,
-    /// LDIW-PSO, eq. (3).
-    LdiwPso,
-    /// LCPSO, eq. (4)–(10).
-    Lcpso,
-}
-
-impl LegAlgorithm {
-    /// The solver's name ("de-pso", "ldiw-pso", "lcpso").
-    pub fn name(&self) -> &'static str {
-        match self {
-            LegAlgorithm::DePso => "de-pso",
-            LegAlgorithm::LdiwPso => "ldiw-pso",
-            LegAlgorithm::Lcpso => "lcpso",
-        }
-    }
-}
 
 /// Budgets and geometry of one leg's optimisation.
 #[derive(Debug, Clone, PartialEq)]
@@ -172,21 +147,14 @@ pub fn plan_leg(
             cost,
         };
     }
-    let mut ex = Executor::new(settings.iterations);
-    ex.stop = stop.cloned();
-    let m = settings.particles;
-    let cap = settings.velocity_cap;
-    let run = match algorithm {
-        LegAlgorithm::DePso => {
-            best_of(ex.run(problem, &mut DePso::table5(m, seed).capped(cap), |_| {}))
-        }
-        LegAlgorithm::LdiwPso => {
-            best_of(ex.run(problem, &mut LdiwPso::table5(m, seed).capped(cap), |_| {}))
-        }
-        LegAlgorithm::Lcpso => {
-            best_of(ex.run(problem, &mut Lcpso::table5(m, seed).capped(cap), |_| {}))
-        }
-    };
+    let mut executor = Executor::new(settings.iterations);
+    executor.stop = stop.cloned();
+    let solver = SolverSettings::single(settings.particles, seed, settings.velocity_cap);
+    let run = with_solver(
+        algorithm.algorithm(),
+        &solver,
+        LegRunner { problem, executor },
+    );
     let path = problem.path(&run.best);
     let (swarm_cost, straight_cost) = (problem.path_cost(&path), problem.path_cost(&straight));
     let (path, cost) = if swarm_cost <= straight_cost {
@@ -215,14 +183,25 @@ struct LegRun {
     convergence: Vec<f64>,
 }
 
-/// The best position of a finished run, the evaluations it made, whether it was stopped and
-/// its convergence curve.
-fn best_of<S: SolverState>(run: Outcome<S>) -> LegRun {
-    LegRun {
-        best: run.state.best_position().to_vec(),
-        evaluations: run.state.evaluations(),
-        interrupted: run.termination == Termination::Interrupted,
-        convergence: run.convergence,
+/// Runs the leg swarm the catalog builds and keeps the best position of the finished run, the
+/// evaluations it made, whether it was stopped and its convergence curve.
+struct LegRunner<'a> {
+    /// The leg.
+    problem: &'a LegProblem,
+    /// Its iteration budget and stop flag.
+    executor: Executor,
+}
+
+impl SolverVisitor<LegProblem> for LegRunner<'_> {
+    type Output = LegRun;
+    fn visit<S: Solver<LegProblem>>(self, mut solver: S) -> LegRun {
+        let run = self.executor.run(self.problem, &mut solver, |_| {});
+        LegRun {
+            best: run.state.best_position().to_vec(),
+            evaluations: run.state.evaluations(),
+            interrupted: run.termination == Termination::Interrupted,
+            convergence: run.convergence,
+        }
     }
 }
 

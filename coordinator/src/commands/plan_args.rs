@@ -36,8 +36,8 @@ pub struct PlanArgs {
     pub seed: Option<u64>,
     /// Optimizer: amp-pso, a-pso, mp-pso, pso (seed 004); ipso, spso, cbpso, nspso, aco-pso
     /// (seed 000); epa-pso, pso-length, m-pso (seed 001, one AUV, with --in-process); de-pso,
-    /// ldiw-pso, lcpso (seed 003 inspection tours, in process or by the agents);
-    /// overrides the scenario's.
+    /// ldiw-pso, lcpso (seed 003 inspection tours, in process or by the agents); cf-pso
+    /// (Clerc and Kennedy 2002, with --in-process); overrides the scenario's.
     #[arg(long, env = "SHOAL_ALGORITHM")]
     pub algorithm: Option<Algorithm>,
     /// Iterations (overrides the scenario's).

@@ -8,36 +8,20 @@ use std::sync::Arc;
 use shoal_common::energy::problem::{EnergyProblem, Objective};
 use shoal_common::plan::{assess, FleetFigures, Plan};
 use shoal_common::scenario::{Algorithm, Scenario};
-use shoal_common::swarm::epapso::EpaPso;
-use shoal_common::swarm::population::{Coefficients, Schedule};
-use shoal_common::swarm::pso::Pso;
-use shoal_common::swarm::{Executor, IterationReport, Termination, VelocityCapped};
+use shoal_common::swarm::catalog::{family, Family};
+use shoal_common::swarm::{Executor, IterationReport, Termination};
 use shoal_common::trajectory::Trajectory;
 
-use crate::planning::solver::{run_solver, RunResult};
+use crate::planning::solver::{run_algorithm, RunResult};
 
-/// The PSO both baselines use: Clerc and Kennedy's constricted coefficients (ω = 0.729,
-/// c1 = c2 = 1.494), the usual "plain PSO" — seed 001 does not list its baseline's settings.
-pub fn baseline_pso(particles: usize, seed: u64) -> Pso {
-    Pso {
-        particles,
-        schedule: Schedule::Fixed(Coefficients {
-            w: 0.729,
-            c1: 1.494,
-            c2: 1.494,
-            c3: 0.0,
-        }),
-        max_velocity_fraction: 0.2,
-        seed,
-    }
-}
-
-/// The objective an algorithm plans with.
+/// The objective an algorithm plans with: the path length alone for seed 001's length
+/// baseline, the full cost of eq. (6) otherwise.
 pub fn objective_of(algorithm: Algorithm) -> Objective {
-    if algorithm == Algorithm::PsoLength {
-        Objective::Length
-    } else {
-        Objective::Full
+    match family(algorithm) {
+        Family::Energy {
+            path_length_only: true,
+        } => Objective::Length,
+        _ => Objective::Full,
     }
 }
 
@@ -57,20 +41,7 @@ pub fn plan(
         stop,
         ..Executor::default()
     };
-    let run = match o.algorithm {
-        Algorithm::EpaPso => run_solver(
-            &problem,
-            EpaPso::table2(o.particles, o.seed).capped(o.max_velocity_fraction),
-            &executor,
-            observe,
-        ),
-        _ => run_solver(
-            &problem,
-            baseline_pso(o.particles, o.seed).capped(o.max_velocity_fraction),
-            &executor,
-            observe,
-        ),
-    };
+    let run = run_algorithm(&problem, o, &executor, observe);
     to_plan(scenario, &problem, run)
 }
 

@@ -5,18 +5,13 @@ use std::sync::Arc;
 
 use shoal_common::cost::FleetModel;
 use shoal_common::plan::{assess, notices, Plan};
-use shoal_common::scenario::{Algorithm, Scenario};
-use shoal_common::swarm::acopso::AcoPso;
-use shoal_common::swarm::cbpso::Cbpso;
-use shoal_common::swarm::ipso::Ipso;
-use shoal_common::swarm::multi::{MultiPso, SEED004_VELOCITY_CAP};
-use shoal_common::swarm::nspso::Nspso;
-use shoal_common::swarm::population::Schedule;
-use shoal_common::swarm::pso::Pso;
-use shoal_common::swarm::{Executor, IterationReport, Termination, VelocityCapped};
+use shoal_common::scenario::Scenario;
+use shoal_common::swarm::catalog::{family, Family};
+use shoal_common::swarm::multi::SEED004_VELOCITY_CAP;
+use shoal_common::swarm::{Executor, IterationReport, Termination};
 use shoal_common::touch_up::{touch_up, TouchUp, TouchUpSettings};
 
-use super::solver::run_solver;
+use super::solver::run_algorithm;
 pub use super::solver::RunResult;
 
 /// Plans `scenario` in this process with the optimizer its settings name. `stop` ends the run
@@ -33,60 +28,14 @@ pub fn plan_in_process(
         stop,
         ..Executor::default()
     };
-    let multi = |schedule| MultiPso {
-        populations: o.populations,
-        particles: o.particles,
-        leader_particles: o.leader_particles,
-        exchange_every: o.exchange_every,
-        schedule,
-        max_velocity_fraction: o.velocity_cap(SEED004_VELOCITY_CAP),
-        threads: o.threads,
-        seed: o.seed,
-    };
-    let single = |schedule| Pso {
-        particles: o.particles,
-        schedule,
-        max_velocity_fraction: o.velocity_cap(SEED004_VELOCITY_CAP),
-        seed: o.seed,
-    };
-    // Seed 000's solvers keep their own cap unless the scenario sets one.
-    let (cap, m, seed) = (o.max_velocity_fraction, o.particles, o.seed);
-    let run = match o.algorithm {
-        Algorithm::AmpPso => run_solver(&model, multi(Schedule::Adaptive), &executor, observe),
-        Algorithm::MpPso => run_solver(&model, multi(Schedule::TABLE5_FIXED), &executor, observe),
-        Algorithm::APso => run_solver(&model, single(Schedule::Adaptive), &executor, observe),
-        Algorithm::Pso => run_solver(&model, single(Schedule::TABLE5_FIXED), &executor, observe),
-        Algorithm::Ipso => run_solver(
-            &model,
-            Ipso::table8(m, seed).capped(cap),
-            &executor,
-            observe,
-        ),
-        Algorithm::Spso => run_solver(&model, Pso::spso(m, seed).capped(cap), &executor, observe),
-        Algorithm::Cbpso => run_solver(
-            &model,
-            Cbpso::table8(m, seed).capped(cap),
-            &executor,
-            observe,
-        ),
-        Algorithm::Nspso => run_solver(
-            &model,
-            Nspso::table8(m, seed).capped(cap),
-            &executor,
-            observe,
-        ),
-        Algorithm::AcoPso => run_solver(
-            &model,
-            AcoPso::table8(m, seed).capped(cap),
-            &executor,
-            observe,
-        ),
+    let run = match family(o.algorithm) {
+        Family::Fleet { .. } => run_algorithm(&model, o, &executor, observe),
         // Seed 001's planners plan one AUV on the energy cost, not the fleet fitness.
-        Algorithm::EpaPso | Algorithm::PsoLength | Algorithm::MPso => {
+        Family::Energy { .. } => {
             return crate::planning::energy::plan(scenario, executor.stop.clone(), observe)
         }
         // Seed 003's planners plan inspection tours, leg by leg.
-        Algorithm::DePso | Algorithm::LdiwPso | Algorithm::Lcpso => {
+        Family::Tour(_) => {
             return crate::planning::tour::plan(scenario, executor.stop.clone(), observe)
         }
     };
@@ -207,6 +156,7 @@ fn touch_up_notice(scenario: &Scenario, t: &TouchUp, cleared: bool) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use shoal_common::scenario::Algorithm;
     use std::path::Path;
 
     fn dsmv(cap: Option<f64>) -> Scenario {

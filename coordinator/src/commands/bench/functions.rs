@@ -14,20 +14,14 @@ use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
 use anyhow::{bail, Context};
 use shoal_common::benchfns::{self, Benchmark};
-use shoal_common::swarm::acopso::AcoPso;
-use shoal_common::swarm::cbpso::Cbpso;
-use shoal_common::swarm::depso::DePso;
-use shoal_common::swarm::epapso::EpaPso;
-use shoal_common::swarm::ipso::Ipso;
-use shoal_common::swarm::lcpso::Lcpso;
-use shoal_common::swarm::ldiwpso::LdiwPso;
-use shoal_common::swarm::multi::MultiPso;
-use shoal_common::swarm::nspso::Nspso;
-use shoal_common::swarm::pso::Pso;
-use shoal_common::swarm::{Executor, Solver, SolverState, VelocityCapped};
+use shoal_common::scenario;
+use shoal_common::swarm::catalog::{with_solver, MultiSizes, SolverSettings, SolverVisitor};
+use shoal_common::swarm::{Executor, Solver, SolverState};
 
 mod markdown;
+mod report;
 pub use markdown::{markdown, number, HIT_TOLERANCE};
+pub use report::{Cell, FunctionInfo, Report, LATE_SHARE, MULTI_POPULATIONS};
 
 /// `shoal-coordinator bench-functions`.
 #[derive(Debug, Clone, clap::Args)]
@@ -94,9 +88,6 @@ pub struct RunResult {
     pub still_improving: bool,
 }
 
-/// Share of the iterations at the end of a run [`still_improving`] looks at.
-pub const LATE_SHARE: f64 = 0.1;
-
 /// True when a run's best improved over the last [`LATE_SHARE`] of its iterations by more than
 /// 1e-9 of max(1, |best|): the budget, not the optimizer, ended it, and more iterations would
 /// likely give a better best (Kowalik at Table 4's budget is the case in point). The floor of 1
@@ -112,121 +103,131 @@ pub fn still_improving(convergence: &[f64]) -> bool {
     before - end > 1e-9 * end.abs().max(1.0)
 }
 
-/// An optimizer the suite can run.
+/// An optimizer the suite can run: a catalog algorithm and its legend line.
 #[derive(Debug, Clone, Copy)]
 pub struct Algorithm {
     /// Name on the command line and in the tables.
     pub name: &'static str,
     /// Settings, for the legend.
     pub about: &'static str,
+    /// The algorithm the catalog builds the solver of.
+    pub algorithm: scenario::Algorithm,
+}
+
+impl Algorithm {
     /// One run on a function with a seed.
-    pub run: fn(&dyn Benchmark, RunSettings, u64) -> RunResult,
+    pub fn run(&self, f: &dyn Benchmark, settings: RunSettings, seed: u64) -> RunResult {
+        let solver = SolverSettings {
+            particles: settings.particles,
+            multi: split(settings.particles),
+            threads: 1,
+            seed,
+            velocity_cap: settings.velocity_cap,
+        };
+        let run = BenchRun {
+            f,
+            iterations: settings.iterations,
+        };
+        with_solver(self.algorithm, &solver, run)
+    }
 }
 
 /// Every optimizer Shoal has, in table order (seed 000's five, seed 004's four, seed 001's
-/// EPA-PSO, seed 003's three). A new
-/// solver is one line here.
+/// EPA-PSO, seed 003's three). A new solver is one line here, once it is in the catalog.
 pub fn solvers() -> Vec<Algorithm> {
-    let a = |name, about, run| Algorithm { name, about, run };
+    let a = |algorithm: scenario::Algorithm, about| Algorithm {
+        name: algorithm.as_str(),
+        about,
+        algorithm,
+    };
     vec![
         a(
-            "ipso",
+            scenario::Algorithm::Ipso,
             "seed 000 IPSO, Table 4: c1, c2 2 → 0.5, ω ∈ [0.4, 0.9] by fitness, p = 5 %",
-            |f, s, seed| run(f, s, Ipso::table8(s.particles, seed)),
         ),
         a(
-            "spso",
+            scenario::Algorithm::Spso,
             "seed 000 SPSO, Table 4: ω = 0.5, c1 = c2 = 2",
-            |f, s, seed| run(f, s, Pso::spso(s.particles, seed)),
         ),
         a(
-            "cbpso",
+            scenario::Algorithm::Cbpso,
             "seed 000 CBPSO, Table 4: chaotic start (μ = 4), ω 0.9 → 0.4, c1 = c2 = 2",
-            |f, s, seed| run(f, s, Cbpso::table8(s.particles, seed)),
         ),
         a(
-            "nspso",
+            scenario::Algorithm::Nspso,
             "seed 000 NSPSO, Table 4: ω 0.9 → 0.4, c1 = c2 = 2, one objective",
-            |f, s, seed| run(f, s, Nspso::table8(s.particles, seed)),
         ),
         a(
-            "aco-pso",
+            scenario::Algorithm::AcoPso,
             "seed 000 ACO-PSO, Table 4: SPSO + continuous ant colony (α = 1, β = 5, ρ = 0.5)",
-            |f, s, seed| run(f, s, AcoPso::table8(s.particles, seed)),
         ),
         a(
-            "pso",
+            scenario::Algorithm::Pso,
             "seed 004 PSO, Table 5 coefficients: ω = 0.15, c1 = c2 = 1.5",
-            |f, s, seed| run(f, s, Pso::classic(s.particles, seed)),
         ),
         a(
-            "a-pso",
+            scenario::Algorithm::APso,
             "seed 004 A-PSO: eq. (7) adaptive coefficients, one population",
-            |f, s, seed| run(f, s, Pso::adaptive(s.particles, seed)),
         ),
         a(
-            "mp-pso",
+            scenario::Algorithm::MpPso,
             "seed 004 MP-PSO: Table 5 coefficients, M split as below",
-            |f, s, seed| run(f, s, split(MultiPso::mp(seed), s.particles)),
         ),
         a(
-            "amp-pso",
+            scenario::Algorithm::AmpPso,
             "seed 004 AMP-PSO: eq. (7)–(8), M split as below",
-            |f, s, seed| run(f, s, split(MultiPso::amp(seed), s.particles)),
         ),
         a(
-            "epa-pso",
+            scenario::Algorithm::EpaPso,
             "seed 001 EPA-PSO, Table 2: velocity jump, eq. (16) schedule, eq. (17) restarts",
-            |f, s, seed| run(f, s, EpaPso::table2(s.particles, seed)),
         ),
         a(
-            "ldiw-pso",
+            scenario::Algorithm::LdiwPso,
             "seed 003 LDIW-PSO, Table 5: ω 0.9 → 0.4, c1 = 2, c2 = 1.5",
-            |f, s, seed| run(f, s, LdiwPso::table5(s.particles, seed)),
         ),
         a(
-            "lcpso",
+            scenario::Algorithm::Lcpso,
             "seed 003 LCPSO, Table 5: logistic-chaos inertia (eq. 4–10)",
-            |f, s, seed| run(f, s, Lcpso::table5(s.particles, seed)),
         ),
         a(
-            "de-pso",
+            scenario::Algorithm::DePso,
             "seed 003 DE-PSO, Table 5: PSO move + DE/best/1/bin (F = 0.8, CR = 0.6); 2 evaluations per particle per iteration",
-            |f, s, seed| run(f, s, DePso::table5(s.particles, seed)),
         ),
     ]
 }
 
-/// Follower populations of the multi-population solvers in this suite.
-pub const MULTI_POPULATIONS: usize = 5;
-
 /// Sizes a multi-population solver to about `m` particles in all, so it gets the same budget as
 /// the single-population ones instead of Table 5's 20 × 50 + 20: five followers of ⌊m/6⌋
-/// particles and a leader with the rest (m = 30: 5 × 5 + 5). Each iteration also moves the five
-/// immigrants, so it costs m + 5 evaluations (35 instead of 30). One thread: the suite runs
-/// whole runs in parallel instead.
-pub fn split(mut m: MultiPso, particles: usize) -> MultiPso {
-    m.populations = MULTI_POPULATIONS;
-    m.particles = (particles / (MULTI_POPULATIONS + 1)).max(2);
-    m.leader_particles = particles
-        .saturating_sub(MULTI_POPULATIONS * m.particles)
-        .max(1);
-    m.threads = 1;
-    m
+/// particles and a leader with the rest (m = 30: 5 × 5 + 5), exchanging every iteration. Each
+/// iteration also moves the five immigrants, so it costs m + 5 evaluations (35 instead of 30).
+/// One thread: the suite runs whole runs in parallel instead.
+pub fn split(particles: usize) -> MultiSizes {
+    let each = (particles / (MULTI_POPULATIONS + 1)).max(2);
+    MultiSizes {
+        populations: MULTI_POPULATIONS,
+        particles: each,
+        leader_particles: particles.saturating_sub(MULTI_POPULATIONS * each).max(1),
+        exchange_every: 1,
+    }
 }
 
-/// One run of `solver` on `f` with the suite's budget and velocity cap.
-fn run<'a, S: Solver<&'a dyn Benchmark> + VelocityCapped>(
+/// One run of the visited solver on `f` with the suite's budget.
+struct BenchRun<'a> {
+    /// The function.
     f: &'a dyn Benchmark,
-    settings: RunSettings,
-    solver: S,
-) -> RunResult {
-    let mut solver = solver.capped(settings.velocity_cap);
-    let out = Executor::new(settings.iterations).run(&f, &mut solver, |_| {});
-    RunResult {
-        best: out.state.best_cost(),
-        evaluations: out.state.evaluations(),
-        still_improving: still_improving(&out.convergence),
+    /// Iterations t_max.
+    iterations: usize,
+}
+
+impl<'a> SolverVisitor<&'a dyn Benchmark> for BenchRun<'a> {
+    type Output = RunResult;
+    fn visit<S: Solver<&'a dyn Benchmark>>(self, mut solver: S) -> RunResult {
+        let out = Executor::new(self.iterations).run(&self.f, &mut solver, |_| {});
+        RunResult {
+            best: out.state.best_cost(),
+            evaluations: out.state.evaluations(),
+            still_improving: still_improving(&out.convergence),
+        }
     }
 }
 
@@ -256,68 +257,6 @@ pub struct RunReport<'a> {
     pub run: usize,
     /// Its best cost.
     pub best: f64,
-}
-
-/// One (function, algorithm) cell: the best cost of every finished run, in run order.
-#[derive(Debug, Clone, Default, PartialEq)]
-pub struct Cell {
-    /// Best cost of each run.
-    pub values: Vec<f64>,
-    /// Evaluations of each run.
-    pub evaluations: Vec<u64>,
-    /// Whether each run was still improving when its budget ended ([`still_improving`]).
-    pub still_improving: Vec<bool>,
-}
-
-/// A function of the suite as the report shows it.
-#[derive(Debug, Clone, PartialEq)]
-pub struct FunctionInfo {
-    /// Command-line key.
-    pub key: String,
-    /// `f1`…`f12`, `F6`.
-    pub label: String,
-    /// Display name.
-    pub name: String,
-    /// Dimensions.
-    pub dim: usize,
-    /// Known optimum f*.
-    pub optimum: f64,
-    /// One of f1–f8, whose dimension is `--dim` (the others have a fixed one).
-    pub scalable: bool,
-}
-
-/// Everything the suite measured.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Report {
-    /// The command's settings.
-    pub runs: usize,
-    /// Particles M.
-    pub particles: usize,
-    /// Iterations t_max.
-    pub iterations: usize,
-    /// Base seed.
-    pub seed: u64,
-    /// Velocity cap given to every solver (`None`: each solver's own).
-    pub velocity_cap: Option<f64>,
-    /// Functions, in table order.
-    pub functions: Vec<FunctionInfo>,
-    /// Algorithm names, in table order.
-    pub algorithms: Vec<&'static str>,
-    /// The algorithms' settings, for the legend.
-    pub about: Vec<&'static str>,
-    /// `cells[function][algorithm]`.
-    pub cells: Vec<Vec<Cell>>,
-    /// False if the run was interrupted before every run finished.
-    pub complete: bool,
-}
-
-impl Report {
-    /// The cell of function `key` and algorithm `name`.
-    pub fn cell(&self, key: &str, name: &str) -> Option<&Cell> {
-        let f = self.functions.iter().position(|f| f.key == key)?;
-        let a = self.algorithms.iter().position(|a| *a == name)?;
-        self.cells.get(f)?.get(a)
-    }
 }
 
 /// Runs the suite `args` describes; `progress` is called after every run, from worker threads.
@@ -381,7 +320,7 @@ pub fn bench_functions(
             }
             let (fi, ai, r) = (k / (na * nr), (k / nr) % na, k % nr);
             let seed = run_seed(args.seed, table_index[fi], r);
-            let result = (algorithms[ai].run)(functions[fi].as_ref(), settings, seed);
+            let result = algorithms[ai].run(functions[fi].as_ref(), settings, seed);
             progress(&RunReport {
                 done: done.fetch_add(1, Ordering::Relaxed) + 1,
                 total,

@@ -6,7 +6,7 @@ use std::fmt::Write as _;
 
 use shoal_common::stats;
 
-use super::{Cell, FunctionInfo, Report, LATE_SHARE, MULTI_POPULATIONS};
+use super::report::{Cell, FunctionInfo, Report, LATE_SHARE, MULTI_POPULATIONS};
 
 /// A number for the tables: six significant digits between 10⁻³ and 10⁵ (so Branin's 0.397887
 /// and Six-Hump Camel's −1.03163 read as in the paper), scientific otherwise.

@@ -1,7 +1,7 @@
 //! LCPSO, seed 003 §III-A-3 (after Nkwanyana and Wang): the inertia weight blends a linearly
 //! decreasing weight `w^l` (eq. (5)) and a chaotic one `w^c` (eq. (6)–(8)) driven by the logistic
 //! map `u ← ρ u (1 − u)` (eq. (4)), as `w^ζ = ζ (w^l + w^c)` (eq. (9)), and particles move by
-//! eq. (10) (the shared update of [`super::population::update`] with ω = w^ζ).
+//! eq. (10) (the shared update of [`update`](crate::swarm::core::population::update) with ω = w^ζ).
 //!
 //! Choices the seed leaves open:
 //! - ζ is not given. With ω_max = 0.9 and ω_min = 0.4, `w^l + w^c` runs from `1.4 + 0.4u` down to
@@ -15,9 +15,9 @@
 use rand::rngs::StdRng;
 use rand::Rng;
 
-use super::population::{Coefficients, Limits, Population};
 use super::pso::PsoState;
-use super::{Problem, Progress, Solver, SolverState};
+use crate::swarm::core::population::{Coefficients, Limits, Population};
+use crate::swarm::core::{Problem, Progress, Solver, SolverState};
 
 /// The LCPSO solver.
 #[derive(Debug, Clone)]
@@ -137,11 +137,13 @@ impl<P: Problem> Solver<P> for Lcpso {
     }
 }
 
+velocity_capped!(Lcpso);
+
 #[cfg(test)]
 mod tests {
-    use super::super::testfns::ShiftedSphere;
-    use super::super::Executor;
     use super::*;
+    use crate::swarm::core::Executor;
+    use crate::swarm::testfns::ShiftedSphere;
     use approx::assert_abs_diff_eq;
     use rand::SeedableRng;
 

@@ -23,7 +23,7 @@
 use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
 
-use super::{Problem, Progress, Solver, SolverState};
+use crate::swarm::core::{Problem, Progress, Solver, SolverState};
 
 /// The EPA-PSO solver, with Table 2's settings by default.
 #[derive(Debug, Clone)]
@@ -291,11 +291,13 @@ impl<P: Problem> Solver<P> for EpaPso {
     }
 }
 
+velocity_capped!(EpaPso);
+
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::swarm::core::Executor;
     use crate::swarm::testfns::{Rastrigin, ShiftedSphere};
-    use crate::swarm::Executor;
 
     #[test]
     fn constriction_of_table_2() {

@@ -34,8 +34,8 @@
 use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
 
-use super::population::{update, Coefficients, Limits, Particle};
-use super::{Problem, Progress, Solver, SolverState};
+use crate::swarm::core::population::{update, Coefficients, Limits, Particle};
+use crate::swarm::core::{Problem, Progress, Solver, SolverState};
 
 /// The NSPSO solver (Table 4 / Table 8 settings).
 #[derive(Debug, Clone)]
@@ -340,11 +340,13 @@ impl<P: Problem> Solver<P> for Nspso {
     }
 }
 
+velocity_capped!(Nspso);
+
 #[cfg(test)]
 mod tests {
-    use super::super::testfns::{Rastrigin, ShiftedSphere};
-    use super::super::Executor;
     use super::*;
+    use crate::swarm::core::Executor;
+    use crate::swarm::testfns::{Rastrigin, ShiftedSphere};
     use approx::assert_abs_diff_eq;
 
     /// Two objectives: a 4-point first front, a dominated point, and one dominated by it.

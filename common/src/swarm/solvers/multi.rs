@@ -7,8 +7,11 @@
 //! global best o_f_gbest (Fig. 5b); the updated immigrants then return to their own follower
 //! population and replace its worst particle (Fig. 5c).
 
-use super::population::{trusted_best, update, Limits, Particle, Population, Schedule};
-use super::{parallel, Problem, Progress, Solver, SolverState};
+use crate::swarm::core::population::{
+    stream_seed, trusted_best, update, Coefficients, Limits, Particle, Population, Schedule,
+    TrustedBest,
+};
+use crate::swarm::core::{parallel, Problem, Progress, Solver, SolverState};
 
 /// Velocity cap of seed 004's solvers, as a fraction of each dimension's range: eq. (7) starts
 /// ω at 2, which diverges without a limit; 0.1 is the common PSO choice (docs/AMP-PSO.md).
@@ -57,11 +60,6 @@ impl MultiPso {
             ..MultiPso::amp(seed)
         }
     }
-}
-
-/// Seed of population `k`: distinct streams from one user seed.
-pub fn stream_seed(seed: u64, k: u64) -> u64 {
-    seed ^ (k + 1).wrapping_mul(0x9E37_79B9_7F4A_7C15)
 }
 
 /// State of a multi-population run.
@@ -163,33 +161,17 @@ impl MultiPso {
                 .chain(immigrants.iter().map(|p| (&p.x, p.cost)))
                 .min_by(|a, b| a.1.total_cmp(&b.1))
                 .map_or((Vec::new(), f64::INFINITY), |(x, c)| (x.clone(), c));
-        let leader_best = trusted_best(
+        let moved = move_leader(
             problem,
-            state.leader.particles.iter().chain(immigrants.iter()),
-            &l_elite_x,
-            l_elite_cost,
+            &mut state.leader,
+            &mut immigrants,
+            (&l_elite_x, l_elite_cost),
+            &f_gbest,
+            c,
+            &state.limits,
+            threads,
         );
-        evaluations += leader_best.as_ref().map_or(0, |b| b.evaluations);
-        let leader_gbest = leader_best.map_or_else(|| f_gbest.clone(), |b| b.x);
-        let rng = &mut state.leader.rng;
-        let mut movers: Vec<&mut Particle> = state
-            .leader
-            .particles
-            .iter_mut()
-            .chain(immigrants.iter_mut())
-            .collect();
-        for p in movers.iter_mut() {
-            update(p, &leader_gbest, Some(&f_gbest), c, &state.limits, rng);
-        }
-        parallel::for_each_mut(&mut movers, threads, |p| p.evaluate(problem));
-        evaluations += movers.len() as u64;
-        for im in &immigrants {
-            if im.cost < state.leader.elite_cost {
-                state.leader.elite_cost = im.cost;
-                state.leader.elite_x.clone_from(&im.x);
-            }
-        }
-        evaluations += state.leader.refresh(problem);
+        evaluations += moved.evaluations;
         // (c) the updated immigrants return home and replace the worst particle there.
         for (pop, immigrant) in state.followers.iter_mut().zip(immigrants) {
             let worst = pop.worst();
@@ -201,6 +183,62 @@ impl MultiPso {
         });
         evaluations + state.followers.iter().map(|p| p.evaluations).sum::<u64>() - before
     }
+}
+
+/// What [`move_leader`] did: the attractor the movers followed, when one was trusted, and the
+/// evaluations it cost.
+#[derive(Debug, Clone)]
+pub struct LeaderMove {
+    /// The leader's o_gbest the particles moved towards (`None`: they followed o_f_gbest).
+    pub gbest: Option<TrustedBest>,
+    /// Evaluations spent: the attractor's check, the movers, the leader's refresh.
+    pub evaluations: u64,
+}
+
+/// Fig. 5b, the leader update of seed 004 §3.2.2 that the in-process solver and the
+/// coordinator's distributed leader both run: the leader's own particles and the `immigrants`
+/// move by eq. (6) towards the leader's o_gbest (assembled from them, trusted only if it beats
+/// `elite`, the best truly evaluated position they know) and the followers' `f_gbest`. The moves
+/// draw from the leader's RNG in order; the evaluations run on `threads` threads. The
+/// immigrants then count towards the leader's elite and the leader's o_gbest is refreshed.
+#[allow(clippy::too_many_arguments)]
+pub fn move_leader<P: Problem>(
+    problem: &P,
+    leader: &mut Population,
+    immigrants: &mut [Particle],
+    elite: (&[f64], f64),
+    f_gbest: &[f64],
+    c: Coefficients,
+    limits: &Limits,
+    threads: usize,
+) -> LeaderMove {
+    let gbest = trusted_best(
+        problem,
+        leader.particles.iter().chain(immigrants.iter()),
+        elite.0,
+        elite.1,
+    );
+    let mut evaluations = gbest.as_ref().map_or(0, |b| b.evaluations);
+    let attractor = gbest.as_ref().map_or(f_gbest, |b| b.x.as_slice());
+    let rng = &mut leader.rng;
+    let mut movers: Vec<&mut Particle> = leader
+        .particles
+        .iter_mut()
+        .chain(immigrants.iter_mut())
+        .collect();
+    for p in movers.iter_mut() {
+        update(p, attractor, Some(f_gbest), c, limits, rng);
+    }
+    parallel::for_each_mut(&mut movers, threads, |p| p.evaluate(problem));
+    evaluations += movers.len() as u64;
+    for im in immigrants.iter() {
+        if im.cost < leader.elite_cost {
+            leader.elite_cost = im.cost;
+            leader.elite_x.clone_from(&im.x);
+        }
+    }
+    evaluations += leader.refresh(problem);
+    LeaderMove { gbest, evaluations }
 }
 
 impl<P: Problem> Solver<P> for MultiPso {
@@ -252,3 +290,5 @@ impl<P: Problem> Solver<P> for MultiPso {
         state
     }
 }
+
+velocity_capped!(MultiPso);

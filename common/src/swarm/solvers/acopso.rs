@@ -27,9 +27,9 @@
 use rand::rngs::StdRng;
 use rand::Rng;
 
-use super::population::{Coefficients, Population};
 use super::pso::PsoState;
-use super::{Problem, Progress, Solver, SolverState};
+use crate::swarm::core::population::{Coefficients, Population};
+use crate::swarm::core::{Problem, Progress, Solver, SolverState};
 
 /// The ACO-PSO solver (Table 4 / Table 8 settings).
 #[derive(Debug, Clone)]
@@ -279,11 +279,13 @@ impl<P: Problem> Solver<P> for AcoPso {
     }
 }
 
+velocity_capped!(AcoPso);
+
 #[cfg(test)]
 mod tests {
-    use super::super::testfns::{Rastrigin, ShiftedSphere};
-    use super::super::Executor;
     use super::*;
+    use crate::swarm::core::Executor;
+    use crate::swarm::testfns::{Rastrigin, ShiftedSphere};
     use approx::assert_abs_diff_eq;
 
     fn trail(x: f64, cost: f64, tau: f64) -> Trail {

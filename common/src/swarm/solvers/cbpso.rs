@@ -6,9 +6,9 @@
 use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
 
-use super::population::{Coefficients, Particle, Population};
 use super::pso::PsoState;
-use super::{Problem, Progress, Solver};
+use crate::swarm::core::population::{Coefficients, Particle, Population};
+use crate::swarm::core::{Problem, Progress, Solver};
 
 /// The CBPSO solver.
 #[derive(Debug, Clone)]
@@ -97,11 +97,13 @@ impl<P: Problem> Solver<P> for Cbpso {
     }
 }
 
+velocity_capped!(Cbpso);
+
 #[cfg(test)]
 mod tests {
-    use super::super::testfns::ShiftedSphere;
-    use super::super::{Executor, SolverState};
     use super::*;
+    use crate::swarm::core::{Executor, SolverState};
+    use crate::swarm::testfns::ShiftedSphere;
 
     #[test]
     fn the_logistic_map_fills_the_unit_interval() {

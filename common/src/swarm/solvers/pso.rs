@@ -1,8 +1,8 @@
 //! Single-population PSO: classic PSO (fixed ω = 0.15, c1 = c2 = 1.5, seed 004 Table 5) and
 //! A-PSO (the adaptive coefficients of eq. (7)), both updating by eq. (5).
 
-use super::population::{Limits, Population, Schedule};
-use super::{Problem, Progress, Solver, SolverState};
+use crate::swarm::core::population::{Limits, Population, Schedule};
+use crate::swarm::core::{Problem, Progress, Solver, SolverState};
 
 /// Single-population PSO.
 #[derive(Debug, Clone)]
@@ -31,7 +31,7 @@ impl Pso {
     /// SPSO, seed 000's standard PSO baseline (Table 4 / Table 8): ω = 0.5, c1 = c2 = 2.
     pub fn spso(particles: usize, seed: u64) -> Pso {
         Pso {
-            schedule: Schedule::Fixed(super::population::Coefficients {
+            schedule: Schedule::Fixed(crate::swarm::core::population::Coefficients {
                 w: 0.5,
                 c1: 2.0,
                 c2: 2.0,
@@ -131,3 +131,5 @@ impl<P: Problem> Solver<P> for Pso {
         state
     }
 }
+
+velocity_capped!(Pso);

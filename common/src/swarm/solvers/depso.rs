@@ -31,9 +31,9 @@
 use rand::Rng;
 
 use super::ldiwpso::ldiw_move;
-use super::population::Population;
 use super::pso::PsoState;
-use super::{Problem, Progress, Solver};
+use crate::swarm::core::population::Population;
+use crate::swarm::core::{Problem, Progress, Solver};
 
 /// Base vector of the DE mutation.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -190,11 +190,13 @@ impl<P: Problem> Solver<P> for DePso {
     }
 }
 
+velocity_capped!(DePso);
+
 #[cfg(test)]
 mod tests {
-    use super::super::testfns::{Rastrigin, ShiftedSphere};
-    use super::super::{Executor, SolverState};
     use super::*;
+    use crate::swarm::core::{Executor, SolverState};
+    use crate::swarm::testfns::{Rastrigin, ShiftedSphere};
     use approx::assert_abs_diff_eq;
     use rand::SeedableRng;
 

@@ -1,15 +1,15 @@
 //! LDIW-PSO, seed 003 §III-A-2: PSO whose inertia weight falls linearly from `w_ini` to `w_end`
 //! over the run (eq. (3), after Shi and Eberhart), moving by the shared update of
-//! [`super::population::update`]. It is the seed's baseline for leg planning (Table 6) and the
+//! [`update`](crate::swarm::core::population::update). It is the seed's baseline for leg planning (Table 6) and the
 //! inertia schedule DE-PSO reuses.
 //!
 //! The seed gives no separate settings for its baselines; [`LdiwPso::table5`] uses the PSO part of
 //! Table 5 (c1 = 2.0, c2 = 1.5, ω 0.9 → 0.4) so the three leg planners differ only in their
 //! mechanism.
 
-use super::population::Coefficients;
 use super::pso::PsoState;
-use super::{Problem, Progress, Solver};
+use crate::swarm::core::population::Coefficients;
+use crate::swarm::core::{Problem, Progress, Solver};
 
 /// Inertia weight of seed 003 eq. (3): `w(k) = (T_max − T)/T_max · (w_ini − w_end) + w_end`,
 /// with `T / T_max` taken from `progress` (so `w_ini` at the first iteration, approaching `w_end`
@@ -92,11 +92,13 @@ impl<P: Problem> Solver<P> for LdiwPso {
     }
 }
 
+velocity_capped!(LdiwPso);
+
 #[cfg(test)]
 mod tests {
-    use super::super::testfns::ShiftedSphere;
-    use super::super::{Executor, SolverState};
     use super::*;
+    use crate::swarm::core::{Executor, SolverState};
+    use crate::swarm::testfns::ShiftedSphere;
     use approx::assert_abs_diff_eq;
 
     fn at(iteration: usize, max_iterations: usize) -> Progress {

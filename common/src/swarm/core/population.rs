@@ -11,7 +11,15 @@
 use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
 
-use super::{Problem, Progress};
+use super::problem::Problem;
+use super::solver::Progress;
+
+/// Seed of population `k`: distinct streams from one user seed. Every multi-population solver
+/// and the distributed followers and leader draw their streams from it, so a population gets
+/// the same stream in-process and distributed.
+pub fn stream_seed(seed: u64, k: u64) -> u64 {
+    seed ^ (k + 1).wrapping_mul(0x9E37_79B9_7F4A_7C15)
+}
 
 /// One particle: where it is, where it goes, and the best place each block of it has been.
 #[derive(Debug, Clone, PartialEq)]

@@ -18,9 +18,9 @@
 
 use rand::Rng;
 
-use super::population::Particle;
 use super::pso::PsoState;
-use super::{Problem, Progress, Solver};
+use crate::swarm::core::population::Particle;
+use crate::swarm::core::{Problem, Progress, Solver};
 
 /// The IPSO solver (Table 4 / Table 8 defaults).
 #[derive(Debug, Clone)]
@@ -185,11 +185,13 @@ impl<P: Problem> Solver<P> for Ipso {
     }
 }
 
+velocity_capped!(Ipso);
+
 #[cfg(test)]
 mod tests {
-    use super::super::testfns::{Rastrigin, ShiftedSphere};
-    use super::super::{Executor, SolverState};
     use super::*;
+    use crate::swarm::core::{Executor, SolverState};
+    use crate::swarm::testfns::{Rastrigin, ShiftedSphere};
     use approx::assert_abs_diff_eq;
 
     #[test]
