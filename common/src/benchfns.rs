@@ -1,13 +1,13 @@
-//! The benchmark functions of seed 000 §4 (Table 3, f1–f12) and seed 003's Schaffer F6
+//! The benchmark functions of Lu et al. 2023, §4 (Table 3, f1–f12) and Hu et al.'s Schaffer F6
 //! (eq. (26)), each a [`Problem`] with its known optimum value and one location of it, so the
-//! optimizers can be compared as in seed 000 Tables 5 and 6 (`shoal-coordinator bench-functions`).
+//! optimizers can be compared as in Lu et al. 2023, Tables 5 and 6 (`shoal-coordinator bench-functions`).
 //!
-//! Search ranges are the papers' (seed 000 Table 3, seed 003 Table 1), each of which holds a
+//! Search ranges are the papers' (Lu et al. 2023, Table 3, Hu et al. 2023, Table 1), each of which holds a
 //! global minimiser. Formulas are the standard ones where the printed tables are garbled:
 //! - f4 BentCigar: Table 3 prints the optimum at `[1, …, 1]`; `x1² + 10⁶ Σ x_i²` is 0 at the origin.
-//! - f7 Ackley: Table 3 prints only the first term; the full function (seed 003 eq. (23)) is used.
+//! - f7 Ackley: Table 3 prints only the first term; the full function (Hu et al. 2023, eq. (23)) is used.
 //! - f8 "Schaffer": see [`Schwefel`] for the reading and why.
-//! - Schaffer F6: seed 003 eq. (26) prints the denominator unsquared; the standard F6 squares it.
+//! - Schaffer F6: Hu et al. 2023, eq. (26) prints the denominator unsquared; the standard F6 squares it.
 //!   Both are 0 at the origin.
 
 use crate::swarm::Problem;
@@ -18,7 +18,7 @@ pub trait Benchmark: Problem {
     fn key(&self) -> &'static str;
     /// Display name, e.g. `Six-Hump Camel`.
     fn name(&self) -> &'static str;
-    /// Where it comes from: `f1`…`f12` of seed 000 Table 3, `F6` of seed 003.
+    /// Where it comes from: `f1`…`f12` of Lu et al. 2023, Table 3, `F6` of Hu et al. 2023.
     fn label(&self) -> &'static str;
     /// The global minimum value f*.
     fn optimum(&self) -> f64;
@@ -26,7 +26,7 @@ pub trait Benchmark: Problem {
     fn optimum_at(&self) -> Vec<f64>;
 }
 
-/// Keys of all functions, in table order (f1–f12, then seed 003's F6).
+/// Keys of all functions, in table order (f1–f12, then Hu et al.'s F6).
 pub const KEYS: [&str; 13] = [
     "sphere",
     "tablet",
@@ -268,7 +268,7 @@ impl Griewank {
 benchmark!(Griewank, "griewank", "Griewank", "f6", optimum: 0.0, at: |s| vec![0.0; s.dim()]);
 
 /// f7 Ackley `−20 exp(−0.2 √(Σ x_i²/D)) − exp(Σ cos(2π x_i)/D) + 20 + e` on [−32, 32]^D: 0 at
-/// the origin. Table 3 prints only the first term; this is the standard function (seed 003
+/// the origin. Table 3 prints only the first term; this is the standard function (Hu et al. 2023
 /// eq. (23)).
 #[derive(Debug, Clone)]
 pub struct Ackley(pub Domain);
@@ -295,7 +295,7 @@ pub const SCHWEFEL_X: f64 = 420.968_746_359_982_1;
 /// `−x* sin √x*`: the per-dimension minimum of `−x sin √|x|`, negated (418.98…).
 pub const SCHWEFEL_SHIFT: f64 = 418.982_887_272_433_74;
 
-/// f8, printed as "Schaffer" in seed 000 Table 3, read as **Schwefel 2.26**:
+/// f8, printed as "Schaffer" in Lu et al. 2023, Table 3, read as **Schwefel 2.26**:
 /// `418.9829 D − Σ x_i sin √|x_i|` on [−500, 500]^D, 0 at `(420.9687, …, 420.9687)`.
 ///
 /// Table 3's row is inconsistent: its formula `78.33 + Σ (x⁴ − 16x² + 5x)/D` is a scaled
@@ -305,7 +305,7 @@ pub const SCHWEFEL_SHIFT: f64 = 418.982_887_272_433_74;
 /// Ackley, Griewank, Kowalik, Six-Hump Camel, Branin, Hartman). Three of the four printed facts
 /// and the numbering agree, so Shoal reads f8 as Schwefel 2.26, shifted so that f* = 0 (the
 /// shift is the exact per-dimension minimum, [`SCHWEFEL_SHIFT`], so f(x*) is 0 to rounding).
-/// The name "Schaffer" fits neither; seed 003's Schaffer F6 is [`SchafferF6`].
+/// The name "Schaffer" fits neither; Hu et al.'s Schaffer F6 is [`SchafferF6`].
 #[derive(Debug, Clone)]
 pub struct Schwefel(pub Domain);
 impl Schwefel {
@@ -458,8 +458,8 @@ benchmark!(Hartman6, "hartman6", "Hartman 6-D", "f12", optimum: -3.322_368_011_4
     at: |_s| vec![0.201_689_503_071_596, 0.150_010_682_075_892_7, 0.476_873_967_276_753_8,
         0.275_332_422_141_527_3, 0.311_651_612_840_292_4, 0.657_300_526_605_512_4]);
 
-/// Seed 003's Schaffer F6 (eq. (26)) `0.5 + (sin² √(x1² + x2²) − 0.5) / (1 + 0.001 (x1² + x2²))²`
-/// on [−5, 5]² (seed 003 Table 1): 0 at the origin, ringed by ridges. Eq. (26) prints the
+/// Hu et al.'s Schaffer F6 (eq. (26)) `0.5 + (sin² √(x1² + x2²) − 0.5) / (1 + 0.001 (x1² + x2²))²`
+/// on [−5, 5]² (Hu et al. 2023, Table 1): 0 at the origin, ringed by ridges. Eq. (26) prints the
 /// denominator unsquared; the standard F6 squares it (same f* and x*).
 #[derive(Debug, Clone)]
 pub struct SchafferF6(pub Domain);
@@ -479,7 +479,7 @@ impl Default for SchafferF6 {
         SchafferF6::new()
     }
 }
-benchmark!(SchafferF6, "schaffer-f6", "Schaffer F6 (seed 003)", "F6", optimum: 0.0,
+benchmark!(SchafferF6, "schaffer-f6", "Schaffer F6 (Hu et al. 2023)", "F6", optimum: 0.0,
     at: |_s| vec![0.0, 0.0]);
 
 #[cfg(test)]

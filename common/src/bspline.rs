@@ -1,4 +1,4 @@
-//! Clamped, uniform B-spline curves (seed 000 §2.4, eq. (12)–(13)): the smoothed path of a
+//! Clamped, uniform B-spline curves (Lu et al. 2023, §2.4, eq. (12)–(13)): the smoothed path of a
 //! crawler is the cubic B-spline of its control points, and it is the curve — not the control
 //! polygon — that collision, slope and hazard checks and the reported length use.
 //!
@@ -23,7 +23,7 @@ pub fn clamped_knots(n: usize, k: usize) -> Vec<f64> {
     knots
 }
 
-/// `N_{i,k}(u)` by the Cox–de Boor recursion (seed 000 eq. (13)); a 0/0 term counts as 0.
+/// `N_{i,k}(u)` by the Cox–de Boor recursion (Lu et al. 2023, eq. (13)); a 0/0 term counts as 0.
 /// `N_{i,0}` is 1 on the half-open span `[u_i, u_{i+1})`, and on the last non-empty span also at
 /// its right end, so that the basis sums to 1 on the whole of [0, 1] (the paper's closed spans
 /// would count a knot twice).

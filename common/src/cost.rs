@@ -1,4 +1,4 @@
-//! Fitness of a fleet particle: seed 004 eq. (9)–(12) plus the constraint penalties that make the
+//! Fitness of a fleet particle: Zhi & Zuo 2024, eq. (9)–(12) plus the constraint penalties that make the
 //! constrained problem unconstrained (§3.3.1). Lower is better.
 //!
 //! `F = λ1 Σ F_i(L) + λ2 Σ F_i(D) + λ3 Σ F_i(O) + λ4 Σ F_i(T) + λ5 Σ F_i(S) + W · P` (eq. (12)),
@@ -155,7 +155,7 @@ pub const ARRIVAL_SPREAD_TOLERANCE_S: f64 = 1.0;
 
 /// Penalty for a vehicle whose path is too short to arrive at the common arrival `target` even
 /// at its minimum speed: it arrives at `L / v_min`, early, and the fleet's arrivals are not
-/// synchronised (seed 004 §2.2.2's temporal coupling; eq. (10) only measures the window against
+/// synchronised (Zhi & Zuo 2024, §2.2.2's temporal coupling; eq. (10) only measures the window against
 /// the mission time, not against the time the fleet is timed for). `1 + (target − L / v_min) /
 /// target` when it would arrive early at all, else 0: penalising from zero, not from
 /// [`ARRIVAL_SPREAD_TOLERANCE_S`], keeps the swarm's plans clear of the assessment's threshold
@@ -188,7 +188,7 @@ pub fn hard_penalty(points: &[Vec3], hard: &[Sphere]) -> (f64, usize) {
 /// less than a centimetre above the nearer sample.
 pub const SEABED_STEP_M: f64 = 1.0;
 
-/// Seabed penalty of a swimmer (an AUV over a seabed; seed 004 has none, so Shoal adds it as a
+/// Seabed penalty of a swimmer (an AUV over a seabed; Zhi & Zuo 2024 has none, so Shoal adds it as a
 /// hard constraint like the obstacles): for every leg whose lowest height above the seabed
 /// ([`Terrain::lowest_height_along`], every [`SEABED_STEP_M`]) is under `clearance`,
 /// `1 + shortfall / max(clearance, 1 m)`. Returns the penalty and the number of such legs.
@@ -240,7 +240,7 @@ pub fn turn_penalty(points: &[Vec3], max_turn: f64) -> f64 {
 /// horizontal part counts): the [`turn_penalty`] of the heading change from `heading` to the
 /// path's first leg with a horizontal extent. A replan that starts under way uses it, so the
 /// new path leaves the vehicle's present course within the same per-waypoint limit as every
-/// other turn (seed 004's turn constraint, applied at the start too). A heading with no
+/// other turn (Zhi & Zuo's turn constraint, applied at the start too). A heading with no
 /// horizontal part, or a path without a horizontal leg, adds nothing.
 pub fn entry_turn_penalty(heading: Vec3, points: &[Vec3], max_turn: f64) -> f64 {
     let Some(first) = points.first() else {
@@ -315,7 +315,7 @@ pub struct VehicleTerms {
     pub separation: f64,
     /// Hard-obstacle intrusions (leg × obstacle).
     pub hard_hits: usize,
-    /// A crawler's seed 000 eq. (10) objective (standardised, without penalties), which takes
+    /// A crawler's Lu et al. 2023, eq. (10) objective (standardised, without penalties), which takes
     /// the place of F(L) + F(D) + F(O); `None` for swimmers.
     pub crawler: Option<f64>,
 }
@@ -395,7 +395,7 @@ impl FleetModel {
 
     /// Vehicle `i`'s path from its chromosome: the waypoint polygon for a swimmer; for a
     /// crawler the clamped cubic B-spline through its horizontal waypoints, sampled and draped
-    /// on the seabed (seed 000 eq. (12)–(13)), each sample leg taking the speed gene of the
+    /// on the seabed (Lu et al. 2023, eq. (12)–(13)), each sample leg taking the speed gene of the
     /// control leg it belongs to.
     pub fn decode(&self, i: usize, genes: &[f64]) -> Path {
         let v = &self.scenario.vehicles[i];
@@ -455,7 +455,7 @@ impl FleetModel {
         }
     }
 
-    /// Vehicle `t`'s weighted share of eq. (12). For a crawler, seed 000's eq. (10) objective
+    /// Vehicle `t`'s weighted share of eq. (12). For a crawler, Lu et al.'s eq. (10) objective
     /// stands in for the three path terms and takes their weights: `(λ1 + λ2 + λ3) F_c`.
     pub fn objective_of(&self, t: &VehicleTerms) -> f64 {
         let w = &self.scenario.optimizer.weights;

@@ -1,4 +1,4 @@
-//! A deep-sea mining crawler's path on the seabed (seed 000 §2.3–2.4): the particle is the
+//! A deep-sea mining crawler's path on the seabed (Lu et al. 2023, §2.3–2.4): the particle is the
 //! horizontal position of a few B-spline control points between the start and the goal; the
 //! path is the smoothed clamped cubic B-spline through [start, control points…, goal], sampled
 //! densely and draped on the terrain (z = seabed + sensor height). Every term below is computed
@@ -221,7 +221,7 @@ impl CrawlerModel {
     }
 }
 
-/// What `plan.json` reports of a crawler's path (seed 000 §5.2's figures), recomputed from the
+/// What `plan.json` reports of a crawler's path (Lu et al. 2023, §5.2's figures), recomputed from the
 /// planned trajectory's points.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct CrawlerFigures {

@@ -1,4 +1,4 @@
-//! Ocean currents behind one trait, so the analytic field of seed 001 can be replaced by a real
+//! Ocean currents behind one trait, so the analytic field of Zhang et al. 2022 can be replaced by a real
 //! forecast without touching the cost: the energy terms only ever ask for the current at a point.
 //!
 //! Shoal's z is up and `bounds.max[2]` is the sea surface, so the depth of a point is
@@ -12,7 +12,7 @@ pub trait CurrentField: Send + Sync + std::fmt::Debug {
     fn velocity(&self, p: &Vec3) -> Vec3;
 }
 
-/// Seed 001 eq. (2): a horizontal current whose strength falls linearly with depth,
+/// Zhang et al. 2022, eq. (2): a horizontal current whose strength falls linearly with depth,
 /// `u_c = u_s (ζ_bd − ζ) / ζ_bd`, `v_c = v_s (ζ_bd − ζ) / ζ_bd`, `w_c = 0`, where ζ is the depth
 /// and ζ_bd the map's greatest depth. The paper fixes `u_s = v_s = −1.0` m/s; a scenario may pick
 /// another surface velocity.
@@ -55,7 +55,7 @@ impl CurrentField for StillWater {
     }
 }
 
-/// Seed 001 eq. (3): the velocity over ground is the vehicle's velocity through the water plus
+/// Zhang et al. 2022, eq. (3): the velocity over ground is the vehicle's velocity through the water plus
 /// the current. Shoal plans ground tracks, so the planner goes the other way round: the water
 /// velocity the vehicle must hold to make `ground` over ground is `ground − current`.
 pub fn water_velocity(ground: &Vec3, current: &Vec3) -> Vec3 {

@@ -1,5 +1,5 @@
 //! The fleet planning problem as a swarm [`Problem`]: a particle is every vehicle's chromosome
-//! (seed 004 Fig. 3), its cost the fitness of [`crate::cost`].
+//! (Zhi & Zuo 2024, Fig. 3), its cost the fitness of [`crate::cost`].
 
 use rand::rngs::StdRng;
 use rand::Rng;
@@ -44,7 +44,7 @@ impl Problem for FleetModel {
         e.total
     }
 
-    /// Initial particles (seed 004 §3.1: uniform draws "adjusting the range"). Each vehicle's
+    /// Initial particles (Zhi & Zuo 2024, §3.1: uniform draws "adjusting the range"). Each vehicle's
     /// waypoints are the straight line start→goal bent by three sine harmonics (k = 1, 2, 3) with
     /// uniform random coefficients in ±1/k, and depth changing in proportion to the horizontal
     /// distance travelled; speeds are uniform in the vehicle's range. The bend's size is:

@@ -9,7 +9,7 @@ pub type Vec3 = nalgebra::Vector3<f64>;
 
 /// Parameter `u ∈ [0, 1]` of the point of segment `a→b` closest to `p`.
 ///
-/// Seed 003 eq. (31) writes the segment as a line `a + u (b − a)`; clamping `u` to `[0, 1]` keeps
+/// Hu et al. 2023, eq. (31) writes the segment as a line `a + u (b − a)`; clamping `u` to `[0, 1]` keeps
 /// the test to the segment itself (eq. (33) alone would test the infinite line).
 pub fn closest_param(a: &Vec3, b: &Vec3, p: &Vec3) -> f64 {
     let k = b - a;
@@ -51,7 +51,7 @@ pub const CONTACT_GUARD_M: f64 = 1e-6;
 
 /// True when segment `a→b` comes strictly closer than `radius` to `centre` anywhere along it.
 ///
-/// This is seed 003 eq. (31)–(33) restricted to the segment: the quadratic
+/// This is Hu et al. 2023, eq. (31)–(33) restricted to the segment: the quadratic
 /// `λ1 u² + λ2 u + λ3 − r² = 0` has a root in `[0, 1]` exactly when the clamped closest point lies
 /// inside the sphere. Touching the surface (distance == radius) is not a collision.
 pub fn segment_hits_sphere(a: &Vec3, b: &Vec3, centre: &Vec3, radius: f64) -> bool {
@@ -60,7 +60,7 @@ pub fn segment_hits_sphere(a: &Vec3, b: &Vec3, centre: &Vec3, radius: f64) -> bo
 
 /// Length of the part of segment `a→b` that lies inside the sphere (`centre`, `radius`), metres.
 ///
-/// Solves `|a + u k − c|² = r²` for `u` (seed 003 eq. (32): `λ1 = |k|²`, `λ2 = 2 k·(a − c)`,
+/// Solves `|a + u k − c|² = r²` for `u` (Hu et al. 2023, eq. (32): `λ1 = |k|²`, `λ2 = 2 k·(a − c)`,
 /// `λ3 = |a − c|² − r²`) and clips the root interval to `[0, 1]`.
 pub fn chord_inside_sphere(a: &Vec3, b: &Vec3, centre: &Vec3, radius: f64) -> f64 {
     let k = b - a;
@@ -105,7 +105,7 @@ pub fn fraction_within(d0: &Vec3, d1: &Vec3, limit: f64) -> f64 {
 
 /// Heading change at the corner `a→b→c` in the horizontal plane, radians in `[0, π]`.
 ///
-/// The turn limit of seed 004 §4.1.3 (θ ∈ [−35°, 35°]) is a yaw limit; depth changes are the pitch
+/// The turn limit of Zhi & Zuo 2024, §4.1.3 (θ ∈ [−35°, 35°]) is a yaw limit; depth changes are the pitch
 /// limit's business. A leg with no horizontal extent has no heading and gives no turn.
 pub fn heading_change(a: &Vec3, b: &Vec3, c: &Vec3) -> f64 {
     let (ux, uy) = (b.x - a.x, b.y - a.y);

@@ -1,5 +1,5 @@
 //! Shoal's shared model and algorithms: scenarios, geometry, timed trajectories, the fleet
-//! fitness of seed 004 and the swarm optimizers.
+//! fitness of Zhi & Zuo 2024 and the swarm optimizers.
 
 pub mod benchfns;
 pub mod bspline;

@@ -58,7 +58,7 @@ pub const MAX_PUBLISHED_OBSTACLES: usize = 256;
 /// Obstacles a client may publish per wall second on one mission; past it, dropped and counted.
 pub const MAX_OBSTACLES_PER_S: f64 = 5.0;
 
-/// Inner waypoints (control points) per vehicle: seed 004's Table 4 uses 30, the crawler scenarios
+/// Inner waypoints (control points) per vehicle: Zhi & Zuo's Table 4 uses 30, the crawler scenarios
 /// 3–4; at 1,000 a fleet chromosome of 256 vehicles is a million genes per particle.
 pub const MAX_WAYPOINTS: usize = 1_000;
 
@@ -71,7 +71,7 @@ pub const MAX_PATH_SAMPLES: usize = 100_000;
 pub const MAX_OBSTACLES: usize = 1_000;
 
 /// Cells of one map (a coverage terrain, a seabed grid, the nodes of a current grid): 2,000 ×
-/// 2,000, sixteen times the 500 × 500 cells of seed 002's 1 km map at 2 m. A map keeps about
+/// 2,000, sixteen times the 500 × 500 cells of CPP-DSMV's 1 km map at 2 m. A map keeps about
 /// 40 bytes per cell (height, slope, masks, distance field): 160 MB at the bound.
 pub const MAX_MAP_CELLS: usize = 4_000_000;
 
@@ -109,7 +109,7 @@ pub const MIN_CHECK_STEP_M: f64 = 0.01;
 /// 10^7 is one centimetre steps on the same map.
 pub const MAX_COVERAGE_CHECKS: f64 = 1e7;
 
-/// Widest crawler, metres: deep-sea nodule collectors are 4–12 m wide (seed 002's is 8 m);
+/// Widest crawler, metres: deep-sea nodule collectors are 4–12 m wide (CPP-DSMV's is 8 m);
 /// 50 m is no vehicle that drives on the seabed.
 pub const MAX_VEHICLE_WIDTH_M: f64 = 50.0;
 

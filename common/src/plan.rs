@@ -46,13 +46,13 @@ pub struct VehiclePlan {
     /// Absent for a crawler or without a seabed.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub min_seabed_clearance_m: Option<f64>,
-    /// Crawlers only: the seed 000 figures of the path on the seabed.
+    /// Crawlers only: the Lu et al. 2023 figures of the path on the seabed.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub crawler: Option<crate::crawler::CrawlerFigures>,
-    /// Energy-planned AUVs only: seed 001's figures (q_path, q_e, q_r, q_a, f_f, …).
+    /// Energy-planned AUVs only: Zhang et al.'s figures (q_path, q_e, q_r, q_a, f_f, …).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub energy: Option<crate::energy::EnergyTerms>,
-    /// Inspection tours only: seed 003's figures (visiting order, tour length, path growth).
+    /// Inspection tours only: Hu et al.'s figures (visiting order, tour length, path growth).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub tour: Option<crate::tour::TourFigures>,
 }

@@ -1,4 +1,4 @@
-//! Spatial coupling on *timed* trajectories (seed 004 eq. (1), (11)): the distance between two
+//! Spatial coupling on *timed* trajectories (Zhi & Zuo 2024, eq. (1), (11)): the distance between two
 //! vehicles at the same instant, over the whole mission.
 //!
 //! Both trajectories are piecewise linear in time, so on every interval between consecutive sample

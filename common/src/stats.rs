@@ -1,5 +1,5 @@
 //! Summary statistics and the Wilcoxon rank-sum test used to compare optimizers over repeated
-//! runs, as seed 000 does in Table 5 (best, mean, standard deviation of 50 runs) and Table 6
+//! runs, as Lu et al. 2023 does in Table 5 (best, mean, standard deviation of 50 runs) and Table 6
 //! (Wilcoxon rank-sum p-values of IPSO against each other algorithm).
 
 /// Arithmetic mean; NaN for no data.
@@ -89,7 +89,7 @@ pub struct RankSum {
 /// `p = erfc(|z| / √2)`. This is scipy's `mannwhitneyu(method="asymptotic")` and R's
 /// `wilcox.test(exact = FALSE)`; for n = 50 per side the approximation is what SPSS's
 /// "asymptotic significance" reports too (SPSS, as far as we know, omits the continuity
-/// correction, which moves p by about 1 % of itself at that size; seed 000 Table 6 used SPSS).
+/// correction, which moves p by about 1 % of itself at that size; Lu et al. 2023, Table 6 used SPSS).
 /// If every value is tied, p = 1.
 ///
 /// None when either sample is empty.

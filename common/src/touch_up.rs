@@ -2,7 +2,7 @@
 //! one is re-planned on its own, against the others' timed trajectories as the plan has them
 //! ([`VehicleProblem`], the problem a vehicle agent solves in distributed AMP-PSO), starting
 //! from its own chromosome, and its new chromosome is kept only if the whole fleet's fitness
-//! (seed 004 eq. (12) plus the penalties) gets lower.
+//! (Zhi & Zuo 2024, eq. (12) plus the penalties) gets lower.
 //!
 //! Not part of any seed's algorithm: the paper's swarm ends where it ends. It exists because a
 //! plan the swarm left a few metres inside an obstacle's margin, or half a degree over a pitch

@@ -1,4 +1,4 @@
-//! Particle encoding (seed 004 eq. (3)–(4)) and timed trajectories.
+//! Particle encoding (Zhi & Zuo 2024, eq. (3)–(4)) and timed trajectories.
 //!
 //! A vehicle's chromosome is `M` genes `g_j = (x_j, y_j, z_j, δ_j)`: an inner waypoint and its
 //! status gene. Shoal uses the status gene as the *requested speed* on the leg that ends at
@@ -257,7 +257,7 @@ pub fn required_horizontal_length(vehicle: &Vehicle) -> f64 {
 }
 
 /// Earliest and latest arrival a path allows: `t_min = L / v_max`, `t_max = L / v_min`
-/// (seed 004 eq. (2)), seconds.
+/// (Zhi & Zuo 2024, eq. (2)), seconds.
 pub fn arrival_window(length: f64, vehicle: &Vehicle) -> (f64, f64) {
     (
         length / vehicle.speed_max_mps,
@@ -266,7 +266,7 @@ pub fn arrival_window(length: f64, vehicle: &Vehicle) -> (f64, f64) {
 }
 
 /// The arrival time all vehicles aim for: the mission time when every vehicle can make it, else
-/// the earliest time the slowest-to-arrive vehicle can make (seed 004 §2.2.2: the task "cannot be
+/// the earliest time the slowest-to-arrive vehicle can make (Zhi & Zuo 2024, §2.2.2: the task "cannot be
 /// completed on time"). Never earlier than the mission time.
 pub fn common_arrival(mission_time: f64, earliest: impl IntoIterator<Item = f64>) -> f64 {
     earliest.into_iter().fold(mission_time, f64::max)

@@ -3,7 +3,7 @@
 //! where each agent optimises its own chromosome and the coordinator sends it the fleet's
 //! current best plan as context.
 //!
-//! The terms are the fleet fitness's (seed 004 eq. (9)–(12), see [`crate::cost`]), restricted to
+//! The terms are the fleet fitness's (Zhi & Zuo 2024, eq. (9)–(12), see [`crate::cost`]), restricted to
 //! this vehicle: its own F(L), F(D), F(O), F(T), its hard-obstacle, turn and pitch penalties, and
 //! the coupling with every other vehicle *as the context has it* — F(S) and the whole separation
 //! penalty of each pair it belongs to (the others cannot move out of its way here).

@@ -1,6 +1,6 @@
-//! The terrain of `scenarios/ipso-dsmv.toml` has the character seed 000 §2.1 describes: a
+//! The terrain of `scenarios/ipso-dsmv.toml` has the character Lu et al. 2023, §2.1 describes: a
 //! seamount summit whose slopes are mostly below 5°, with mountains whose flanks are steeper
-//! than 10°; and the fleet model plans a crawler on it as seed 000 §2.4 says (B-spline through
+//! than 10°; and the fleet model plans a crawler on it as Lu et al. 2023, §2.4 says (B-spline through
 //! the control points, draped on the seabed).
 
 use std::path::Path;

@@ -1,4 +1,4 @@
-//! The `[currents]`, `[energy]` and `[inspection]` tables (seeds 001 and 003): the shipped
+//! The `[currents]`, `[energy]` and `[inspection]` tables (Zhang et al. 2022 and Hu et al. 2023): the shipped
 //! scenarios load, and bad values are refused with the file, the field and the value.
 
 use std::path::{Path, PathBuf};
@@ -39,7 +39,7 @@ fn shipped_scenarios_load() {
     let s = s.as_ref();
     assert_eq!(s.map(|s| s.optimizer.algorithm), Some(Algorithm::EpaPso));
     assert_eq!(s.map(|s| s.energy.path_points), Some(500));
-    // Hills alone make a seabed (seed 001 eq. (1)): 45 m at the centre of h1.
+    // Hills alone make a seabed (Zhang et al. 2022, eq. (1)): 45 m at the centre of h1.
     let z = s.and_then(|s| s.terrain()).map(|t| t.elevation(20.0, 20.0));
     assert!(z.is_some_and(|z| z > 45.0 && z < 46.0), "{z:?}");
 }

@@ -1,5 +1,5 @@
 //! Planning benchmarks: one fitness evaluation per scenario, and a whole default-budget AMP-PSO
-//! plan of scenario 3 (seed 004 Table 6's hardest case). Run with `cargo bench -p shoal-coordinator`.
+//! plan of scenario 3 (Zhi & Zuo 2024, Table 6's hardest case). Run with `cargo bench -p shoal-coordinator`.
 
 // `criterion_group!` defines an undocumented `pub fn`; a benchmark binary has no public API.
 #![allow(missing_docs)]

@@ -315,7 +315,7 @@ fn the_loop_keeps_watching_while_a_held_vehicle_replans() -> TestResult {
     let dir = tempfile::tempdir()?;
     let (mut s, plans) = crossing()?;
     // With 8 waypoints the swarm reaches its iteration cap in 250–300 ms, whatever the
-    // budget; with 30 (seed 004's count) it takes 500–700 ms.
+    // budget; with 30 (Zhi & Zuo's count) it takes 500–700 ms.
     s.optimizer.waypoints = 30;
     let (report, log) = execute_with(&s, &plans, 25.0, dir.path(), &|o| {
         o.time_scale = 100.0;

@@ -216,7 +216,7 @@ pub fn check_parsed(scenario: &Scenario, plan: &Plan) -> Report {
             crawler_broken.extend(c.broken);
         }
         if !v.is_crawler() {
-            // An energy plan keeps its own clearance (seed 001); a fleet AUV the seabed's.
+            // An energy plan keeps its own clearance (Zhang et al. 2022); a fleet AUV the seabed's.
             let required = match (&pv.energy, &scenario.energy, &scenario.seabed) {
                 (Some(_), Some(e), _) => e.terrain_clearance_m,
                 (Some(_), None, _) => 2.0,

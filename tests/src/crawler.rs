@@ -1,4 +1,4 @@
-//! The checker's own view of crawlers (seed 000): a crawler's trajectory must lie on the seabed
+//! The checker's own view of crawlers (Lu et al. 2023): a crawler's trajectory must lie on the seabed
 //! (analytic terrain: eq. (2) in scaled coordinates lifted so its lowest point in the bounds is
 //! 0, plus the Gaussian mountains of eq. (3), plus the sensor height) and stay out of every
 //! hazard cylinder (eq. (4)); its reported figures are recomputed here from the samples:
@@ -62,7 +62,7 @@ impl<'a> Seafloor<'a> {
 pub enum Floor<'a> {
     /// Eq. (2) + (3).
     Analytic(Seafloor<'a>),
-    /// Seed 001's hills on a flat floor (no relief).
+    /// Zhang et al.'s hills on a flat floor (no relief).
     Hills(&'a Seabed),
     /// A measured grid, read from its file.
     Measured(&'a Grid),

@@ -1,4 +1,4 @@
-//! The checker's own view of seed 001 (energy-planned AUVs) and seed 003 (cage-inspection tours):
+//! The checker's own view of Zhang et al. 2022 (energy-planned AUVs) and Hu et al. 2023 (cage-inspection tours):
 //! the turning radius, pitch and seabed clearance of an energy plan, and that a tour visits the
 //! inspection points it names, recomputed from the trajectory alone.
 
@@ -9,7 +9,7 @@ use crate::sections::{eight, two, CurrentsSection, EnergySection, PlanEnergy, Pl
 const TOL: f64 = 1e-6;
 
 impl CurrentsSection {
-    /// The current at `p` under seed 001 eq. (2): the surface value scaled by
+    /// The current at `p` under Zhang et al. 2022, eq. (2): the surface value scaled by
     /// `(ζ_bd − ζ) / ζ_bd`, the surface being the top of the box and ζ_bd its height; `None`
     /// for a gridded field.
     fn depth_decay(&self, bounds: &crate::model::Bounds, p: [f64; 3]) -> Option<[f64; 3]> {
@@ -127,7 +127,7 @@ pub fn check_energy(scenario: &Scenario, v: &Vehicle, traj: &[[f64; 4]], e: &Pla
         ));
     }
     // Speed through the water on each timed segment: ground velocity minus the current at the
-    // segment's midpoint (seed 001 eq. (3)), against the vehicle's top speed.
+    // segment's midpoint (Zhang et al. 2022, eq. (3)), against the vehicle's top speed.
     if let Some(currents) = &scenario.currents {
         let mut fastest: Option<f64> = None;
         for w in traj.windows(2) {
@@ -157,7 +157,7 @@ pub fn check_energy(scenario: &Scenario, v: &Vehicle, traj: &[[f64; 4]], e: &Pla
             }
         }
     }
-    // Seabed of Gaussian hills alone (seed 001 eq. (1)); other seabeds are the crawler check's
+    // Seabed of Gaussian hills alone (Zhang et al. 2022, eq. (1)); other seabeds are the crawler check's
     // (`check_swimmer_seabed`).
     if let Some(seabed) = scenario
         .seabed

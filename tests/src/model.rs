@@ -27,13 +27,13 @@ pub struct Scenario {
     /// Crawler cost settings.
     #[serde(default)]
     pub crawler: Option<crate::sections::CrawlerSettings>,
-    /// Energy planner settings (seed 001).
+    /// Energy planner settings (Zhang et al. 2022).
     #[serde(default)]
     pub energy: Option<crate::sections::EnergySection>,
-    /// Inspection tours (seed 003).
+    /// Inspection tours (Hu et al. 2023).
     #[serde(default)]
     pub inspection: Option<crate::sections::InspectionSection>,
-    /// Ocean current (seed 001).
+    /// Ocean current (Zhang et al. 2022).
     #[serde(default)]
     pub currents: Option<crate::sections::CurrentsSection>,
 }
@@ -187,10 +187,10 @@ pub struct PlanVehicle {
     /// Crawlers: reported seabed figures.
     #[serde(default)]
     pub crawler: Option<crate::sections::PlanCrawler>,
-    /// Energy-planned AUVs: reported seed 001 figures.
+    /// Energy-planned AUVs: reported Zhang et al. 2022 figures.
     #[serde(default)]
     pub energy: Option<crate::sections::PlanEnergy>,
-    /// Inspection tours: reported seed 003 figures.
+    /// Inspection tours: reported Hu et al. 2023 figures.
     #[serde(default)]
     pub tour: Option<crate::sections::PlanTour>,
 }

@@ -63,7 +63,7 @@ impl Seabed {
         Ok(())
     }
 
-    /// The sum of the Gaussian hills alone (seed 001 eq. (1), a seabed without `relief`).
+    /// The sum of the Gaussian hills alone (Zhang et al. 2022, eq. (1), a seabed without `relief`).
     pub fn hills_elevation(&self, x: f64, y: f64) -> f64 {
         self.mountains
             .iter()
@@ -87,7 +87,7 @@ pub struct Hazard {
     pub radius_m: f64,
 }
 
-/// `[crawler]` as far as the checker reads it (defaults: seed 000 §5.1).
+/// `[crawler]` as far as the checker reads it (defaults: Lu et al. 2023, §5.1).
 #[derive(Debug, Clone, Deserialize)]
 #[serde(default)]
 pub struct CrawlerSettings {
@@ -155,7 +155,7 @@ pub(crate) fn five() -> f64 {
     5.0
 }
 
-/// `[currents]` as far as the checker reads it: seed 001's depth-decay model (eq. (2)); a
+/// `[currents]` as far as the checker reads it: Zhang et al.'s depth-decay model (eq. (2)); a
 /// gridded field (`model = "grid"`, a file) is not recomputed.
 #[derive(Debug, Clone, Deserialize)]
 pub struct CurrentsSection {

@@ -1,4 +1,4 @@
-//! Area coverage by a mining crawler (seed 002) end to end: the real binary plans a shrunken copy
+//! Area coverage by a mining crawler (CPP-DSMV) end to end: the real binary plans a shrunken copy
 //! of `scenarios/cpp-seabed.toml` and `plan.json` is checked against the paper's figures; the
 //! Hybrid A* baseline runs under the same macro-routing; bad input is refused with the file, the
 //! field and the value.

@@ -1,4 +1,4 @@
-//! Area coverage by several crawlers (seed 002 with a fleet) end to end: the coordinator cuts a
+//! Area coverage by several crawlers (CPP-DSMV with a fleet) end to end: the coordinator cuts a
 //! shrunken `scenarios/cpp-fleet.toml` into strips, one agent per crawler plans its strip, and
 //! the fleet's plan matches the in-process one and keeps `d_min` at every instant. A strip its
 //! agent cannot plan (a heightmap the agent cannot read) is planned by the coordinator.

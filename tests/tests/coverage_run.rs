@@ -1,4 +1,4 @@
-//! Executing a coverage plan end to end (seed 002 under `run`): two crawlers plan their strips
+//! Executing a coverage plan end to end (CPP-DSMV under `run`): two crawlers plan their strips
 //! of a shrunken `cpp-fleet`, their agents drive simulated crawlers along the paths on the
 //! seabed map at 500× real time, each crawler ends at its own finish, the pair keeps d_min,
 //! and `replay` agrees. An obstacle dropped on a crawler's path is driven round on the seabed

@@ -1,5 +1,5 @@
-//! Crawlers on the seabed end to end (seed 000 as a Shoal capability): the DSMV scenario of
-//! §5.1 planned in process by every seed 000 algorithm, and a mixed fleet of two crawlers and an
+//! Crawlers on the seabed end to end (Lu et al. 2023 as a Shoal capability): the DSMV scenario of
+//! §5.1 planned in process by every Lu et al. 2023 algorithm, and a mixed fleet of two crawlers and an
 //! AUV planned in process and by one agent process per vehicle; every plan passes the
 //! independent checker, which re-evaluates the seabed and the hazards itself, a measured
 //! seabed (an ESRI ASCII grid file) included.
@@ -27,7 +27,7 @@ fn crawler<'a>(json: &'a Value, id: &str) -> &'a Value {
 }
 
 #[test]
-fn every_seed000_algorithm_plans_the_dsmv_on_the_seabed() -> TestResult {
+fn every_ipso_plans_the_dsmv_on_the_seabed() -> TestResult {
     for algorithm in ["ipso", "spso", "cbpso", "nspso", "aco-pso"] {
         let dir = tempfile::tempdir()?;
         let json = plan_and_check(

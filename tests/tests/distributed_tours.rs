@@ -1,4 +1,4 @@
-//! Inspection tours planned by the agents (seed 003 with several AUVs): each agent derives its
+//! Inspection tours planned by the agents (Hu et al. 2023 with several AUVs): each agent derives its
 //! share of the inspection points from the scenario and plans its own tour; the coordinator
 //! assembles, times and checks the fleet's plan, and plans a lost agent's tour itself.
 

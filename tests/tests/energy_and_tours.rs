@@ -1,4 +1,4 @@
-//! AUVs in currents (seed 001, EPA-PSO) and cage-inspection tours (seed 003, DE-PSO) end to end:
+//! AUVs in currents (Zhang et al. 2022, EPA-PSO) and cage-inspection tours (Hu et al. 2023, DE-PSO) end to end:
 //! the real binary plans the shipped scenarios and every plan passes the independent checker,
 //! which recomputes the turning radius, pitch and seabed clearance of an energy plan and the
 //! inspection points of a tour from the trajectories.
@@ -26,7 +26,7 @@ fn epa_pso_saves_energy_and_keeps_the_mobility_limits() -> TestResult {
     let epa = plan_and_check("epa-pso", dir.path(), &short)?;
     assert_eq!(key(&epa, "feasible").as_bool(), Some(true));
     let e = &vehicle(&epa, 0)["energy"];
-    // Turning radius and pitch limits kept on every point (seed 001 eq. (5)).
+    // Turning radius and pitch limits kept on every point (Zhang et al. 2022, eq. (5)).
     assert_eq!((num(e, "q_r"), num(e, "q_a")), (0.0, 0.0), "{e}");
     assert!(num(e, "min_turn_radius_m") >= 8.0);
     assert!(num(e, "max_pitch_deg") <= 20.0 && num(e, "min_pitch_deg") >= -20.0);
@@ -164,7 +164,7 @@ fn de_pso_tours_inspect_every_cage_without_touching_one() -> TestResult {
         let growth = num(t, "growth_m");
         assert!(growth >= 0.0 && num(t, "growth_rate") < 0.5, "{group}: {t}");
         assert!((num(t, "tour_length_m") - num(t, "straight_tour_length_m") - growth).abs() < 1e-6);
-        // The order swarm alone evaluates 100 × (2000 + 1) tours (seed 003 Table 3).
+        // The order swarm alone evaluates 100 × (2000 + 1) tours (Hu et al. 2023, Table 3).
         let evaluations = key(&json, "evaluations").as_u64().unwrap_or(0);
         assert!(evaluations >= 100 * 2001, "{group}: {evaluations}");
     }

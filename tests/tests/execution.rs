@@ -211,7 +211,7 @@ fn a_vehicle_that_stops_reporting_is_declared_lost_and_the_rest_arrive() -> Test
 
 #[test]
 fn a_lone_auv_flies_its_energy_plan_in_the_current() -> TestResult {
-    // seed 001's mission keeps no separation (d_min 0): `run` must still have a deviation
+    // Zhang et al.'s mission keeps no separation (d_min 0): `run` must still have a deviation
     // tolerance, and the simulated AUV must turn as tightly as the plan (R_AUV = 8 m) and make
     // the plan's ground speed against the current (before: an error about --deviation; with a
     // tolerance, the AUV swung 24-40 m wide, was replanned 3-8 times, and at its old 1.5 m/s
@@ -239,7 +239,7 @@ fn a_lone_auv_flies_its_energy_plan_in_the_current() -> TestResult {
     assert!(num(v, "min_seabed_clearance_m") > 0.0, "{v}");
 
     // An obstacle on its path: the energy path is repaired (kept, with a way round the
-    // obstacle), not replaced by seed 004's replan, which knows neither the seabed nor R_AUV
+    // obstacle), not replaced by Zhi & Zuo's replan, which knows neither the seabed nor R_AUV
     // (it sent this AUV on an 85-point loop to the edge of the map). The lone vehicle's
     // obstacle keeps the 10 m deviation tolerance as its margin (d_min is 0).
     let out = fleet.dir().join("out-obstacle");

@@ -1,4 +1,4 @@
-//! One mission's planning loop in an agent: the vehicle's follower populations (seed 004
+//! One mission's planning loop in an agent: the vehicle's follower populations (Zhi & Zuo 2024
 //! §3.2.1) step for a round, their best chromosomes go up to the coordinator's leader, and the
 //! migrants (Fig. 5c) and the new context come back. Messages arrive on a channel and leave
 //! through a closure, so this loop knows nothing of the transport (or, later, of the vehicle).

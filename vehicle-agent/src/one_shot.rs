@@ -1,6 +1,6 @@
 //! One-shot missions in an agent: the vehicle's share of the work follows from the scenario
-//! alone, so the agent plans it once — its inspection tour (seed 003) or its coverage strip
-//! (seed 002) — sends it up, and is done. While it plans, a `Stop` from the coordinator or the
+//! alone, so the agent plans it once — its inspection tour (Hu et al. 2023) or its coverage strip
+//! (CPP-DSMV) — sends it up, and is done. While it plans, a `Stop` from the coordinator or the
 //! agent's own shutdown cuts the work short; the result still goes up, marked.
 
 use std::path::Path;
@@ -16,7 +16,7 @@ use shoal_common::wire::coordinator_to_agent::CoordinatorToAgent;
 
 use crate::assignment::{Assignment, MissionReport};
 
-/// A tour mission (seed 003): this vehicle's share of the inspection points follows from the
+/// A tour mission (Hu et al. 2023): this vehicle's share of the inspection points follows from the
 /// scenario alone ([`FleetTours`]), so the agent plans its tour at once, sends it, and is done.
 ///
 /// While it plans, a `Stop` from the coordinator (Ctrl-C there) or the agent's own shutdown
@@ -99,7 +99,7 @@ fn watch_while_planning(
     why
 }
 
-/// A fleet coverage mission (seed 002 with several crawlers): the vehicle's strip follows from
+/// A fleet coverage mission (CPP-DSMV with several crawlers): the vehicle's strip follows from
 /// the scenario alone ([`FleetCoverage`]), so the agent builds the seabed map, plans (and
 /// tracks) its strip, sends it, and is done. A heightmap file is looked up from the agent's
 /// working directory; when it is not there the coordinator plans the strip instead.

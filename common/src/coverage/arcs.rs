@@ -1,4 +1,4 @@
-//! Analytic arc smoothing (seed 002 §2.2.3, "Detour path generation and analytical arc
+//! Analytic arc smoothing (CPP-DSMV, §2.2.3, "Detour path generation and analytical arc
 //! smoothing"; the equations were lost in extraction and are rebuilt here).
 //!
 //! A detour leaves the row, runs parallel to it at a lateral offset `h` past the obstacle box, and

@@ -1,4 +1,4 @@
-//! The online Boustrophedon coverage planner with virtual boundaries (seed 002 §2.2).
+//! The online Boustrophedon coverage planner with virtual boundaries (CPP-DSMV, §2.2).
 //!
 //! Rows run east–west, `2·R_min` apart, from the south edge of the area north; the vehicle
 //! alternates direction and turns between rows on semicircles of radius `R_min`, which stay inside
@@ -33,7 +33,7 @@ use super::path::{CoveragePath, Piece, PieceKind, Pose2};
 use super::rows::RowBook;
 use super::TerrainMap25;
 
-/// Why the planner raised a virtual boundary (seed 002 §2.2.2).
+/// Why the planner raised a virtual boundary (CPP-DSMV, §2.2.2).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum BoundaryReason {
@@ -150,7 +150,7 @@ pub struct Field<'a> {
     pub boxes: Vec<Rect>,
     /// The settings.
     pub params: &'a CoverageParams,
-    /// Whether the boxes are no-go for the path (seed 002's method) or only mark threats on
+    /// Whether the boxes are no-go for the path (CPP-DSMV's method) or only mark threats on
     /// the rows (the Hybrid A* baseline, which only honours the dilated map).
     pub boxes_are_no_go: bool,
     /// `boxes` bucketed by band, for [`Field::point_ok`].
@@ -224,7 +224,7 @@ pub trait DetourPlanner {
     fn detour(&self, field: &Field<'_>, st: &RowState, threat: (Rect, f64, f64)) -> DetourOutcome;
 }
 
-/// Seed 002's detour: coarse polygon around the box on its nearer side, smoothed by tangent arcs.
+/// CPP-DSMV's detour: coarse polygon around the box on its nearer side, smoothed by tangent arcs.
 pub struct ArcDetour;
 
 impl DetourPlanner for ArcDetour {
@@ -313,7 +313,7 @@ pub struct Machine<'f, 'a> {
 }
 
 impl Machine<'_, '_> {
-    /// Runs the Straight / Detour / U-turn machine from `st` (seed 002 §2.2.1–2.2.2).
+    /// Runs the Straight / Detour / U-turn machine from `st` (CPP-DSMV, §2.2.1–2.2.2).
     pub fn sweep(&mut self, mut st: RowState, method: &dyn DetourPlanner) -> SweepEnd {
         let params = self.field.params;
         loop {

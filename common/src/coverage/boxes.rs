@@ -1,4 +1,4 @@
-//! Merged, inflated obstacle bounding boxes `O_new` (seed 002 §2.2 and Figure 6: "the solid red
+//! Merged, inflated obstacle bounding boxes `O_new` (CPP-DSMV, §2.2 and Figure 6: "the solid red
 //! rectangular zones … the fused and inflated bounding boxes", the absolute no-go regions).
 //!
 //! Rebuilt from the text (the equations were lost):

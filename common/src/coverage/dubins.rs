@@ -1,7 +1,7 @@
 //! Dubins paths: the shortest forward-only path between two poses for a vehicle whose turning
 //! radius is at least `R` (Dubins 1957), as exact [`Piece::Arc`]/[`Piece::Line`] pieces.
 //!
-//! The Hybrid A* detour planner (the seed 002 §3 baseline) uses this twice: the Dubins length to
+//! The Hybrid A* detour planner (the CPP-DSMV, §3 baseline) uses this twice: the Dubins length to
 //! the goal is its admissible obstacle-free heuristic (every forward path with `|κ| ≤ 1/R` is at
 //! least that long), and the Dubins path itself is its analytic expansion, the exact last leg that
 //! lands on the goal pose.

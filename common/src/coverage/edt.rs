@@ -1,5 +1,5 @@
 //! Exact Euclidean distance transform of a binary grid and the disc dilation built on it
-//! (seed 002 §2.1: the binarised obstacle map "undergoes morphological dilation" of radius
+//! (CPP-DSMV, §2.1: the binarised obstacle map "undergoes morphological dilation" of radius
 //! `r_dil = W_veh / 2`).
 //!
 //! Algorithm: Felzenszwalb & Huttenlocher, "Distance Transforms of Sampled Functions" (Theory of

@@ -1,4 +1,4 @@
-//! Several crawlers over one area (seed 002 plans one; Shoal's fleet splits the work).
+//! Several crawlers over one area (CPP-DSMV plans one; Shoal's fleet splits the work).
 //!
 //! The area is cut into strips of whole Boustrophedon rows, one per crawler in scenario order
 //! from the south ([`strips`]), so the fleet drives exactly the rows one crawler would. Each strip

@@ -1,5 +1,5 @@
 //! Hybrid A* (Dolgov et al. 2008) for a forward-only tracked crawler with a minimum turning
-//! radius: the search-based detour planner seed 002 §3 compares against, run under the same
+//! radius: the search-based detour planner CPP-DSMV, §3 compares against, run under the same
 //! Boustrophedon macro-routing. The caller asks for a path from a pose before a blocked stretch
 //! of a row to a pose after it (or from a row end to the next row's start when the U-turn is
 //! blocked); this module knows nothing about rows.

@@ -1,4 +1,4 @@
-//! The Hybrid A* baseline detour (seed 002 §3: the search-based method the paper compares
+//! The Hybrid A* baseline detour (CPP-DSMV, §3: the search-based method the paper compares
 //! against "under the identical Boustrophedon macro-routing").
 //!
 //! When a threat crosses the row, a Hybrid A* search ([`super::hybrid_astar`]) runs from a pose

@@ -1,4 +1,4 @@
-//! The figures of seed 002 §3, recomputed from a path and the map alone (Table 2 and Figure 7):
+//! The figures of CPP-DSMV, §3, recomputed from a path and the map alone (Table 2 and Figure 7):
 //! coverage ratio, and the distributions of clearance to impassable terrain (7a), of the slope
 //! under the vehicle (7b) and of the cross-track error (7c).
 //!

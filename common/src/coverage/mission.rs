@@ -1,4 +1,4 @@
-//! One coverage mission end to end (seed 002 §3): build the 2.5D map, plan the Boustrophedon
+//! One coverage mission end to end (CPP-DSMV, §3): build the 2.5D map, plan the Boustrophedon
 //! coverage, simulate its closed-loop tracking, and measure the figures of Table 2 and Figure 7.
 //! The `plan` command, the `bench-coverage` command and the tests all run this.
 
@@ -66,7 +66,7 @@ pub struct TrackingReport {
 /// Everything a coverage mission measured (`plan.json`'s `coverage` object).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct CoverageReport {
-    /// `arcs` (seed 002's method) or `hybrid-a-star` (the baseline).
+    /// `arcs` (CPP-DSMV's method) or `hybrid-a-star` (the baseline).
     pub method: DetourMethod,
     /// Seed of the synthetic seabed (absent for a heightmap).
     pub terrain_seed: Option<u64>,

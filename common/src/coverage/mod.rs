@@ -1,7 +1,7 @@
-//! Coverage path planning for deep-sea mining crawlers (seed 002): the first slice, the 2.5D
+//! Coverage path planning for deep-sea mining crawlers (CPP-DSMV): the first slice, the 2.5D
 //! terrain map of §2.1.
 //!
-//! Seed 002 plans in three layers: (1) perception and pre-processing, which turns the 3D seabed
+//! CPP-DSMV plans in three layers: (1) perception and pre-processing, which turns the 3D seabed
 //! into 2.5D kinematic constraints; (2) a Boustrophedon state machine (Straight / Detour / U-turn)
 //! with virtual boundaries and analytic arc smoothing, rows `2·R_min` apart; (3) closed-loop
 //! tracking (terrain-adaptive EKF and variable-weight MPC) under terrain disturbances. This module

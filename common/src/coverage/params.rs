@@ -1,4 +1,4 @@
-//! The coverage planner's settings (seed 002 §2.2, Table 1 — whose values were lost; each default
+//! The coverage planner's settings (CPP-DSMV, §2.2, Table 1 — whose values were lost; each default
 //! says where it comes from).
 
 use serde::{Deserialize, Serialize};
@@ -9,7 +9,7 @@ use super::Terrain25Error;
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum DetourMethod {
-    /// Seed 002's method: merged inflated boxes, coarse polygon, analytic tangent arcs, virtual
+    /// CPP-DSMV's method: merged inflated boxes, coarse polygon, analytic tangent arcs, virtual
     /// boundaries.
     #[default]
     Arcs,
@@ -22,7 +22,7 @@ pub enum DetourMethod {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct CoverageParams {
-    /// `R_min`, metres. Rows are `2·R_min` apart (seed 002 §2.2.1). Default 5 m: a ~12 m, 8 m wide
+    /// `R_min`, metres. Rows are `2·R_min` apart (CPP-DSMV, §2.2.1). Default 5 m: a ~12 m, 8 m wide
     /// tracked collector skid-steers about a point a little outside its inner track; heavier
     /// turning tears the sediment, which is why the paper bounds curvature at all.
     pub min_turn_radius_m: f64,

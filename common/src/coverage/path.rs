@@ -1,4 +1,4 @@
-//! The geometry a coverage path is made of (seed 002 §2.2): straight lines and circular arcs,
+//! The geometry a coverage path is made of (CPP-DSMV, §2.2): straight lines and circular arcs,
 //! each tagged with the planner state that produced it, and the dense samples (position,
 //! heading, curvature, arc length) that the clearance checks, the coverage count and the tracking
 //! layer read.
@@ -43,7 +43,7 @@ impl Pose2 {
     }
 }
 
-/// Which state of the planner's machine produced a piece of path (seed 002 §2.2.1).
+/// Which state of the planner's machine produced a piece of path (CPP-DSMV, §2.2.1).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum PieceKind {

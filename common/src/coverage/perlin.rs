@@ -1,4 +1,4 @@
-//! Seeded 2D gradient noise for the "minor undulation" of the seabed sediment (seed 002 §2.1:
+//! Seeded 2D gradient noise for the "minor undulation" of the seabed sediment (CPP-DSMV, §2.1:
 //! "the base undulations are modeled using continuous Perlin noise"; §3: the 1000 m × 1000 m
 //! test map integrates Perlin noise with Gaussian functions).
 //!

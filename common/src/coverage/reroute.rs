@@ -1,6 +1,6 @@
 //! A crawler's way round an obstacle that appears while it drives (`shoal-coordinator run`).
 //!
-//! A coverage crawler (seed 002) lives on the seabed map: it may only drive where the planner
+//! A coverage crawler (CPP-DSMV) lives on the seabed map: it may only drive where the planner
 //! let it, at least the safety clearance from impassable ground and inside the area, and it
 //! turns no tighter than its minimum radius. When a new hard obstacle blocks part of its
 //! remaining path, the way round is searched on that same predicate, with the obstacle's

@@ -1,7 +1,7 @@
-//! The seeded synthetic seabed of seed 002 §2.1 / §3 and the crawler limits that turn it into a
+//! The seeded synthetic seabed of CPP-DSMV, §2.1 / §3 and the crawler limits that turn it into a
 //! 2.5D map.
 //!
-//! Elevation (seed 002 §2.1, equation lost in extraction, rebuilt from the text "base undulations
+//! Elevation (CPP-DSMV, §2.1, equation lost in extraction, rebuilt from the text "base undulations
 //! modeled using continuous Perlin noise … superimposed with localized Gaussian peaks and pits"):
 //!
 //! ```text
@@ -11,7 +11,7 @@
 //! with `U` the octave Perlin sum of [`super::perlin::FractalNoise`] (`|U| ≤ A`), seamounts
 //! `(cᵢ, hᵢ, σᵢ)` and trenches `(cⱼ, dⱼ, σⱼ)`. `σ` is the standard deviation of the isotropic
 //! Gaussian (height `h·e^{−1/2}` at one σ; steepest flank `h/σ·e^{−1/2}` at `r = σ`). Note this is
-//! *not* the `exp(−u² − v²)` "spread" convention of seed 000's [`crate::terrain::Mountain`].
+//! *not* the `exp(−u² − v²)` "spread" convention of Lu et al.'s [`crate::terrain::Mountain`].
 //! Features are summed, not max-combined, so slopes stay continuous where they overlap.
 
 use rand::rngs::StdRng;
@@ -21,7 +21,7 @@ use serde::{Deserialize, Serialize};
 use super::perlin::FractalNoise;
 use super::terrain25_error::Terrain25Error;
 
-/// Perlin undulation of the sediment, `U(x, y)` (seed 002 §2.1 "minor undulations", treated as a
+/// Perlin undulation of the sediment, `U(x, y)` (CPP-DSMV, §2.1 "minor undulations", treated as a
 /// posture disturbance, never as an obstacle).
 ///
 /// Defaults: `A = 1.5 m`, `λ = 100 m`, 4 octaves, persistence 0.5. They keep `U` *minor* by
@@ -105,7 +105,7 @@ impl Default for RandomGaussians {
     }
 }
 
-/// A seeded synthetic seabed (seed 002 §3: "1000 m × 1000 m … Perlin noise algorithms with
+/// A seeded synthetic seabed (CPP-DSMV, §3: "1000 m × 1000 m … Perlin noise algorithms with
 /// Gaussian distribution functions").
 ///
 /// Defaults: the paper's 1000 m × 1000 m square from the origin, 2 m cells, the default
@@ -151,7 +151,7 @@ impl Default for TerrainSpec {
     }
 }
 
-/// The crawler's limits that turn elevation into the 2.5D constraint map (seed 002 §2.1).
+/// The crawler's limits that turn elevation into the 2.5D constraint map (CPP-DSMV, §2.1).
 ///
 /// Defaults:
 /// - `critical_slope_deg = 15°`. A heavy tracked collector on soft abyssal clay (undrained shear
@@ -182,7 +182,7 @@ impl Default for TraversalLimits {
 }
 
 impl TraversalLimits {
-    /// `r_dil = W_veh / 2`, metres (seed 002 §2.1).
+    /// `r_dil = W_veh / 2`, metres (CPP-DSMV, §2.1).
     pub fn dilation_radius_m(&self) -> f64 {
         self.vehicle_width_m / 2.0
     }

@@ -1,6 +1,6 @@
 //! The whole coverage plan: sweeps of the Boustrophedon machine, chained by transits.
 //!
-//! A single Boustrophedon sweep (seed 002 §2.2) covers the rows it can reach by turning from one
+//! A single Boustrophedon sweep (CPP-DSMV, §2.2) covers the rows it can reach by turning from one
 //! into the next; stretches cut off by a large box (beyond its virtual boundary) or above a dead
 //! end are left behind. The paper stops there. Shoal goes on: it sends the vehicle to the first
 //! stretch no sweep has covered (south to north, west to east) along a transit planned by Hybrid A*

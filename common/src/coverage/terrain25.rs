@@ -1,4 +1,4 @@
-//! The 2.5D terrain map of seed 002 §2.1: elevation → slope → impassable cells → no-go cells
+//! The 2.5D terrain map of CPP-DSMV, §2.1: elevation → slope → impassable cells → no-go cells
 //! dilated by half the vehicle width, plus the distance to the nearest impassable cell.
 //!
 //! Lattice: cell `(i, j)` (column i along x, row j along y, row 0 south) has its centre at
@@ -6,7 +6,7 @@
 //! (`index = j·nx + i`), the layout of [`HeightGrid`]. Every per-cell value is the value *at the
 //! centre*.
 //!
-//! Equations (seed 002 §2.1; the printed ones were lost, these are the standard forms its text
+//! Equations (CPP-DSMV, §2.1; the printed ones were lost, these are the standard forms its text
 //! describes):
 //!
 //! 1. Discrete gradient. Interior central differences
@@ -26,7 +26,7 @@
 //!
 //! The minor undulation `U` (the Perlin part) is *not* an obstacle: it is kept queryable
 //! ([`TerrainMap25::undulation_at`], [`TerrainMap25::undulation_gradient_at`]) for the tracking
-//! layer, which treats it as a posture disturbance (seed 002 §2.1 and §2.3).
+//! layer, which treats it as a posture disturbance (CPP-DSMV, §2.1 and §2.3).
 
 use std::path::Path;
 
@@ -44,7 +44,7 @@ enum Undulation {
     Synthetic(Box<SyntheticSeabed>),
 }
 
-/// The 2.5D constraint map (seed 002 §2.1). Built once; every field is derived from the
+/// The 2.5D constraint map (CPP-DSMV, §2.1). Built once; every field is derived from the
 /// elevation, so the fields are read through accessors and cannot drift apart.
 #[derive(Debug, Clone, PartialEq)]
 pub struct TerrainMap25 {

@@ -1,4 +1,4 @@
-//! One vehicle's follower populations (seed 004 §3.2.1): each moves by eq. (5) with the
+//! One vehicle's follower populations (Zhi & Zuo 2024, §3.2.1): each moves by eq. (5) with the
 //! coefficients of eq. (7) (AMP-PSO) or fixed ones (MP-PSO), on that vehicle's chromosome alone,
 //! scored against the other vehicles as the current [`Context`] has them.
 //!
@@ -12,7 +12,7 @@ use super::{Chromosome, Context};
 use crate::cost::FleetModel;
 use crate::scenario::OptimizerSettings;
 use crate::swarm::catalog;
-use crate::swarm::multi::SEED004_VELOCITY_CAP;
+use crate::swarm::multi::AMP_PSO_VELOCITY_CAP;
 use crate::swarm::parallel;
 use crate::swarm::population::{stream_seed, Limits, Particle, Population, Schedule};
 use crate::swarm::{Problem, Progress};
@@ -43,7 +43,7 @@ impl FollowerSettings {
             populations: o.distributed.agent_populations,
             particles: o.particles,
             schedule: catalog::schedule(o.algorithm),
-            max_velocity_fraction: o.velocity_cap(SEED004_VELOCITY_CAP),
+            max_velocity_fraction: o.velocity_cap(AMP_PSO_VELOCITY_CAP),
             threads: o.threads,
             seed: o.seed,
         }

@@ -1,4 +1,4 @@
-//! The coordinator's leader population (seed 004 §3.2.2, Fig. 5): whole-fleet particles, scored
+//! The coordinator's leader population (Zhi & Zuo 2024, §3.2.2, Fig. 5): whole-fleet particles, scored
 //! on the fleet fitness (eq. 12) with the coupling between every pair of vehicles.
 //!
 //! One exchange: the followers' best chromosomes immigrate (5a) — the k-th immigrant is the
@@ -13,7 +13,7 @@ use std::sync::Arc;
 use super::{Chromosome, Context};
 use crate::cost::FleetModel;
 use crate::scenario::OptimizerSettings;
-use crate::swarm::multi::{move_leader, SEED004_VELOCITY_CAP};
+use crate::swarm::multi::{move_leader, AMP_PSO_VELOCITY_CAP};
 use crate::swarm::parallel;
 use crate::swarm::population::{stream_seed, trusted_best, Limits, Particle, Population, Schedule};
 use crate::swarm::{Problem, Progress};
@@ -44,7 +44,7 @@ impl Leader {
             o.leader_particles.max(1),
             stream_seed(o.seed, o.populations as u64),
         );
-        let limits = Limits::of(model.as_ref(), o.velocity_cap(SEED004_VELOCITY_CAP));
+        let limits = Limits::of(model.as_ref(), o.velocity_cap(AMP_PSO_VELOCITY_CAP));
         Leader {
             evaluations: leader.evaluations,
             best_x: leader.elite_x.clone(),

@@ -1,4 +1,4 @@
-//! Distributed AMP-PSO (seed 004 §3.2–3.3 split over processes), without any transport: the
+//! Distributed AMP-PSO (Zhi & Zuo 2024, §3.2–3.3 split over processes), without any transport: the
 //! planning loops the vehicle agents and the coordinator run, as plain state machines, so the
 //! network code only carries their messages and a test can drive them without a network.
 //!

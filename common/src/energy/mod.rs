@@ -1,7 +1,7 @@
-//! Seed 001's cost of an AUV path in a current (eq. (4)–(13), (18)): length, energy, turning
+//! Zhang et al.'s cost of an AUV path in a current (eq. (4)–(13), (18)): length, energy, turning
 //! radius and pitch, with the self-adjusting weights of eq. (8), (12) and (13).
 //!
-//! A path here is the dense polyline the AUV flies (seed 001 Table 2: n_p = 500 points), the
+//! A path here is the dense polyline the AUV flies (Zhang et al. 2022, Table 2: n_p = 500 points), the
 //! sampled B-spline of the particle's control points (see [`problem`]). Units: metres, seconds,
 //! degrees; the resistance of eq. (4) is read in newtons, so energies are joules.
 //!
@@ -33,7 +33,7 @@ use crate::current::{water_velocity, CurrentField};
 use crate::geometry::Vec3;
 use crate::terrain::Terrain;
 
-/// Seed 001 eq. (4): longitudinal resistance `X_R = 0.0783 θ² − 0.0753 θ + 5.3` at pitch θ
+/// Zhang et al. 2022, eq. (4): longitudinal resistance `X_R = 0.0783 θ² − 0.0753 θ + 5.3` at pitch θ
 /// (degrees), newtons. Thrust equals resistance (§2.2: constant ground speed).
 pub fn resistance(pitch_deg: f64) -> f64 {
     0.0783 * pitch_deg * pitch_deg - 0.0753 * pitch_deg + 5.3
@@ -103,7 +103,7 @@ impl Default for Weights {
 /// Everything the cost needs to know about the water and the vehicle.
 #[derive(Debug, Clone)]
 pub struct EnergyModel {
-    /// Seabed (seed 001 eq. (1) hills, or any Shoal terrain); `None`: open water.
+    /// Seabed (Zhang et al. 2022, eq. (1) hills, or any Shoal terrain); `None`: open water.
     pub terrain: Option<Terrain>,
     /// Height the path keeps above the seabed, metres.
     pub terrain_clearance_m: f64,
@@ -119,7 +119,7 @@ pub struct EnergyModel {
     pub weights: Weights,
 }
 
-/// The seed 001 figures of one path.
+/// The Zhang et al. 2022 figures of one path.
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 pub struct EnergyTerms {
     /// q_path, eq. (7): length, metres.
@@ -204,9 +204,9 @@ impl EnergyModel {
                 let c = self.current.velocity(&(0.5 * (w[0] + w[1])));
                 let water = water_velocity(&ground, &c);
                 let x = resistance(pitch);
-                // seed 001 eq. (10), times Δt.
+                // Zhang et al. 2022, eq. (10), times Δt.
                 e_t = (x * water.norm()).abs() * dt;
-                // seed 001 eq. (11), times Δt.
+                // Zhang et al. 2022, eq. (11), times Δt.
                 let (cw, cc) = (water.norm(), c.norm());
                 if cw > 0.0 && cc > 0.0 {
                     let cos = water.dot(&c) / (cw * cc);

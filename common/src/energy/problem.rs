@@ -1,7 +1,7 @@
-//! One AUV's energy-saving path as a swarm [`Problem`] (seed 001 §3).
+//! One AUV's energy-saving path as a swarm [`Problem`] (Zhang et al. 2022, §3).
 //!
 //! A particle holds the x, y, z of `control_points` free control points; with the start and the
-//! goal they define a clamped cubic B-spline (the smoothing of seed 000 eq. (12)–(13)) sampled
+//! goal they define a clamped cubic B-spline (the smoothing of Lu et al. 2023, eq. (12)–(13)) sampled
 //! into the n_p path points the costs are measured on. A spline, not a polygon, because the
 //! turning-radius limit of eq. (5) needs a path whose curvature is defined at every point.
 //!
@@ -37,7 +37,7 @@ pub enum Objective {
 pub struct Evaluation {
     /// The sampled path.
     pub path: Vec<Vec3>,
-    /// Seed 001 figures.
+    /// Zhang et al. 2022 figures.
     pub terms: EnergyTerms,
     /// Eq. (6), normalised (see [`EnergyProblem::scales`]).
     pub weighted: f64,
@@ -79,7 +79,7 @@ pub enum NotPlannable {
     #[error("the scenario has no vehicle {0}")]
     NoVehicle(usize),
     /// The planner's model (Zhang et al. 2022) is an AUV's: a crawler has no pitch or currents.
-    #[error("{id} is a {kind:?}: the energy-saving planner (seed 001) plans AUVs")]
+    #[error("{id} is a {kind:?}: the energy-saving planner (Zhang et al. 2022) plans AUVs")]
     NotAnAuv {
         /// The vehicle's id.
         id: String,

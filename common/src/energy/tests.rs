@@ -1,4 +1,4 @@
-//! Hand-computed checks of every seed 001 cost term.
+//! Hand-computed checks of every Zhang et al. 2022 cost term.
 
 use std::sync::Arc;
 

@@ -55,7 +55,7 @@ pub struct SimSettings {
     /// Integration step, seconds of mission time (default 0.2).
     pub step_s: f64,
     /// Turning radius, metres. Default 20 m: a mid-size survey AUV at 1.5 m/s, yaw rate ≈ 4°/s;
-    /// 2.5 × the 8 m of seed 001 Table 2, so the simulator is conservative (a plan it can
+    /// 2.5 × the 8 m of Zhang et al. 2022, Table 2, so the simulator is conservative (a plan it can
     /// follow, a nimbler vehicle can too), while 35° turns at waypoints tens of metres apart
     /// cost only a few metres of corner cutting.
     pub turn_radius_m: f64,

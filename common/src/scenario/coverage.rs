@@ -1,4 +1,4 @@
-//! The `[coverage]` table: area coverage by a mining crawler (seed 002). Its presence makes
+//! The `[coverage]` table: area coverage by a mining crawler (CPP-DSMV). Its presence makes
 //! `plan` run the coverage pipeline — 2.5D map, Boustrophedon planner, closed-loop tracking —
 //! instead of a swarm.
 

@@ -1,4 +1,4 @@
-//! The `[inspection]` table: which net cages an AUV tour inspects and how (seed 003 §II–V).
+//! The `[inspection]` table: which net cages an AUV tour inspects and how (Hu et al. 2023, §II–V).
 //!
 //! The cages themselves are the scenario's hard obstacles (`[[obstacles]]`, kind `hard`): their
 //! `radius_m` is the cage, their `inflation_m` the clearance every leg keeps from it.
@@ -12,7 +12,7 @@ pub enum FirstPointMode {
     /// Facing the fleet's base (the mean of the vehicles' starts): reproducible without a seed.
     #[default]
     TowardBase,
-    /// Seed 003 §II: a random azimuth per cage, from the optimizer's seed.
+    /// Hu et al. 2023, §II: a random azimuth per cage, from the optimizer's seed.
     Random,
 }
 

@@ -41,25 +41,25 @@ pub struct Scenario {
     /// Which optimizer and with what budget.
     #[serde(default)]
     pub optimizer: OptimizerSettings,
-    /// The seabed crawlers drive on (seed 000 §2.2); required when a vehicle is a crawler.
+    /// The seabed crawlers drive on (Lu et al. 2023, §2.2); required when a vehicle is a crawler.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub seabed: Option<Seabed>,
-    /// Soft-substrate zones crawlers must not enter, vertical cylinders (seed 000 eq. (4)).
+    /// Soft-substrate zones crawlers must not enter, vertical cylinders (Lu et al. 2023, eq. (4)).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub hazards: Vec<Hazard>,
-    /// Settings of the crawler cost (seed 000 eq. (5)–(11)).
+    /// Settings of the crawler cost (Lu et al. 2023, eq. (5)–(11)).
     #[serde(default)]
     pub crawler: CrawlerSettings,
-    /// The ocean current (seed 001 eq. (2)); absent: still water.
+    /// The ocean current (Zhang et al. 2022, eq. (2)); absent: still water.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub currents: Option<Currents>,
-    /// Settings of the energy-saving planner (seed 001, Table 2).
+    /// Settings of the energy-saving planner (Zhang et al. 2022, Table 2).
     #[serde(default)]
     pub energy: EnergySettings,
-    /// Cage-inspection tours (seed 003); required by the tour planners.
+    /// Cage-inspection tours (Hu et al. 2023); required by the tour planners.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub inspection: Option<InspectionSettings>,
-    /// Area coverage by a mining crawler (seed 002); its presence makes `plan` cover an area.
+    /// Area coverage by a mining crawler (CPP-DSMV); its presence makes `plan` cover an area.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub coverage: Option<CoverageSettings>,
 }
@@ -74,7 +74,7 @@ pub struct Bounds {
     pub max: [f64; 3],
 }
 
-/// How an obstacle affects a vehicle (seed 004 §2.1).
+/// How an obstacle affects a vehicle (Zhi & Zuo 2024, §2.1).
 #[derive(Debug, Clone, Copy, Serialize, Deserialize, PartialEq, Eq)]
 #[serde(rename_all = "lowercase")]
 pub enum ObstacleKind {
@@ -84,7 +84,7 @@ pub enum ObstacleKind {
     Soft,
 }
 
-/// A sphere with a safety inflation margin (seed 004 Fig. 1).
+/// A sphere with a safety inflation margin (Zhi & Zuo 2024, Fig. 1).
 #[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct Obstacle {
@@ -96,7 +96,7 @@ pub struct Obstacle {
     pub centre: [f64; 3],
     /// Physical radius, metres.
     pub radius_m: f64,
-    /// Safety margin added to the radius, metres (seed 004 Table 4: d_hard = d_soft = 50 m).
+    /// Safety margin added to the radius, metres (Zhi & Zuo 2024, Table 4: d_hard = d_soft = 50 m).
     pub inflation_m: f64,
 }
 
@@ -137,11 +137,11 @@ pub struct Vehicle {
     pub speed_min_mps: f64,
     /// Fastest speed on any leg, m/s.
     pub speed_max_mps: f64,
-    /// Largest heading change at a waypoint, degrees (seed 004: 35°).
+    /// Largest heading change at a waypoint, degrees (Zhi & Zuo 2024: 35°).
     pub max_turn_deg: f64,
-    /// Largest |pitch| of a leg, degrees (seed 004: 20°).
+    /// Largest |pitch| of a leg, degrees (Zhi & Zuo 2024: 20°).
     pub max_pitch_deg: f64,
-    /// Turning radius when executing, metres (the simulated vehicle's). Absent: seed 001's
+    /// Turning radius when executing, metres (the simulated vehicle's). Absent: Zhang et al.'s
     /// R_AUV (`energy.min_turn_radius_m`) in an energy mission, whose planner keeps to it, else
     /// the simulator's default of 20 m, a mid-size survey AUV.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -159,7 +159,7 @@ impl Vehicle {
     }
 }
 
-/// Fleet coupling (seed 004 §2.2.2).
+/// Fleet coupling (Zhi & Zuo 2024, §2.2.2).
 #[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct Fleet {
@@ -265,9 +265,9 @@ impl Scenario {
     }
 
     /// The turning radius vehicle `i` executes with, metres: its own `turn_radius_m`, else for
-    /// a seed 001 energy mission the R_AUV its plan was made for (`energy.min_turn_radius_m`:
+    /// a Zhang et al. 2022 energy mission the R_AUV its plan was made for (`energy.min_turn_radius_m`:
     /// the plan's climbing turns are that tight, and a wider-turning vehicle cannot fly them),
-    /// for a seed 002 coverage crawler the R_min its U-turns and detour arcs were planned with
+    /// for a CPP-DSMV coverage crawler the R_min its U-turns and detour arcs were planned with
     /// (`coverage.planner.min_turn_radius_m`), else `None` (the simulator's default).
     pub fn execution_turn_radius_m(&self, i: usize) -> Option<f64> {
         let v = self.vehicles.get(i)?;
@@ -282,7 +282,7 @@ impl Scenario {
     }
 
     /// The seabed a swimming vehicle must keep off, with the height it keeps above it: an
-    /// energy mission's `energy.terrain_clearance_m` (seed 001), else `seabed.auv_clearance_m`;
+    /// energy mission's `energy.terrain_clearance_m` (Zhang et al. 2022), else `seabed.auv_clearance_m`;
     /// `None` without a seabed.
     pub fn swimmer_seabed(&self) -> Option<(&crate::terrain::Terrain, f64)> {
         let terrain = self.seabed.as_ref()?.terrain.as_ref()?;

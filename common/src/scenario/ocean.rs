@@ -1,5 +1,5 @@
 //! The `[currents]` and `[energy]` tables: the water an AUV flies through and the constants of
-//! seed 001's energy-saving planner.
+//! Zhang et al.'s energy-saving planner.
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -17,7 +17,7 @@ use crate::limits;
 #[derive(Debug, Clone, Copy, Serialize, Deserialize, PartialEq, Eq, Default)]
 #[serde(rename_all = "kebab-case")]
 pub enum CurrentModel {
-    /// Seed 001 eq. (2): horizontal, strongest at the surface, zero at the map's greatest depth.
+    /// Zhang et al. 2022, eq. (2): horizontal, strongest at the surface, zero at the map's greatest depth.
     #[default]
     DepthDecay,
     /// A gridded field (a forecast or a survey) read from `file`, interpolated trilinearly and
@@ -29,7 +29,7 @@ pub enum CurrentModel {
 ///
 /// ```toml
 /// [currents]
-/// model = "depth-decay"                # seed 001 eq. (2)
+/// model = "depth-decay"                # Zhang et al. 2022, eq. (2)
 /// surface_velocity_mps = [-1.0, -1.0]
 /// ```
 ///
@@ -46,7 +46,7 @@ pub struct Currents {
     /// The model (default `depth-decay`).
     #[serde(default)]
     pub model: CurrentModel,
-    /// `depth-decay` only (and required there): `(u, v)` at the surface, m/s (seed 001 eq. (2):
+    /// `depth-decay` only (and required there): `(u, v)` at the surface, m/s (Zhang et al. 2022, eq. (2):
     /// −1.0 each).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub surface_velocity_mps: Option<[f64; 2]>,
@@ -175,7 +175,7 @@ impl Currents {
     }
 }
 
-/// `[energy]`: seed 001's planner constants (Table 2 by default).
+/// `[energy]`: Zhang et al.'s planner constants (Table 2 by default).
 #[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields, default)]
 pub struct EnergySettings {

@@ -9,7 +9,7 @@ use crate::limits::{MAX_ITERATIONS, MAX_PARTICLES, MAX_POPULATIONS, MAX_THREADS,
 // The algorithm names are the swarm catalog's: it alone maps them to solvers.
 pub use crate::swarm::catalog::Algorithm;
 
-/// Optimizer budget and objective weights. Defaults are seed 004 Table 5 and §4.1.4.
+/// Optimizer budget and objective weights. Defaults are Zhi & Zuo 2024, Table 5 and §4.1.4.
 #[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields, default)]
 pub struct OptimizerSettings {
@@ -37,8 +37,8 @@ pub struct OptimizerSettings {
     pub penalty_weight: f64,
     /// Velocity limit per dimension as a fraction of that dimension's range, for whichever
     /// algorithm plans. Unset, each algorithm keeps its own ([`OptimizerSettings::velocity_cap`]):
-    /// 0.1 for seed 004's (eq. (7) starts ω at 2, which diverges without a limit), 0.2 for
-    /// seeds 000, 001 and 003's.
+    /// 0.1 for Zhi & Zuo's (eq. (7) starts ω at 2, which diverges without a limit), 0.2 for
+    /// Lu et al.'s, Zhang et al.'s and Hu et al.'s.
     pub max_velocity_fraction: Option<f64>,
     /// Worker threads for population steps (results do not depend on it).
     pub threads: usize,

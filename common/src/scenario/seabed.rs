@@ -1,5 +1,5 @@
 //! The `[seabed]`, `[[hazards]]` and `[crawler]` tables of a scenario: the terrain crawlers drive
-//! on (seed 000 eq. (1)–(4)) and the settings of their cost (eq. (5)–(11), §5.1).
+//! on (Lu et al. 2023, eq. (1)–(4)) and the settings of their cost (eq. (5)–(11), §5.1).
 
 use std::path::{Path, PathBuf};
 
@@ -33,7 +33,7 @@ pub struct Seabed {
 }
 
 /// `seabed.auv_clearance_m`'s default: 2 m, the altitude a DVL-aided survey AUV holds when it
-/// follows the bottom (none of the seeds gives one; seed 001's energy missions also keep 2 m),
+/// follows the bottom (none of the seeds gives one; Zhang et al.'s energy missions also keep 2 m),
 /// and well above the ±1 m position noise of the simulated fixes.
 pub const AUV_CLEARANCE_M: f64 = 2.0;
 
@@ -73,7 +73,7 @@ fn one_metre() -> f64 {
     1.0
 }
 
-/// Settings of the crawler cost; defaults are seed 000 §2.3.5 and §5.1.
+/// Settings of the crawler cost; defaults are Lu et al. 2023, §2.3.5 and §5.1.
 #[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields, default)]
 pub struct CrawlerSettings {
@@ -207,7 +207,7 @@ impl Seabed {
                 return Err(bad(
                     "seabed".into(),
                     "{}".into(),
-                    "needs a `relief` table (with optional `mountains`), `mountains` alone (hills on a flat floor, seed 001 eq. (1)) or a `grid` file",
+                    "needs a `relief` table (with optional `mountains`), `mountains` alone (hills on a flat floor, Zhang et al. 2022, eq. (1)) or a `grid` file",
                 ))
             }
         });

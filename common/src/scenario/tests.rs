@@ -220,13 +220,13 @@ fn a_vehicle_executes_with_its_own_turn_radius_else_the_radius_its_plan_was_made
         "max_pitch_deg = 20.0\nturn_radius_m = 12.5",
     ))?;
     assert_eq!(own.execution_turn_radius_m(0), Some(12.5));
-    // The shipped seed 001 mission: R_AUV = 8 m (Table 2) is what its plan turns on.
+    // The shipped Zhang et al. 2022 mission: R_AUV = 8 m (Table 2) is what its plan turns on.
     let epa = Scenario::parse(
         include_str!("../../../scenarios/epa-pso.toml"),
         Path::new("scenarios/epa-pso.toml"),
     )?;
     assert_eq!(epa.execution_turn_radius_m(0), Some(8.0));
-    // The shipped seed 002 mission: its U-turns are semicircles of R_min = 5 m.
+    // The shipped CPP-DSMV mission: its U-turns are semicircles of R_min = 5 m.
     let cpp = Scenario::parse(
         include_str!("../../../scenarios/cpp-seabed.toml"),
         Path::new("scenarios/cpp-seabed.toml"),
@@ -254,11 +254,11 @@ fn a_goal_on_top_of_its_start_is_named() {
     assert!(parse(&text).is_ok());
 }
 
-/// The shipped seed 004 scenarios hold Tables 2–4 (one table unit 100 m, radii in km, 1–3
+/// The shipped Zhi & Zuo 2024 scenarios hold Tables 2–4 (one table unit 100 m, radii in km, 1–3
 /// knots), each scenario the obstacles and AUVs §4.1.2 adds to the one before (scenario 3 with
 /// HObs#4, which the table lists and the text never adds).
 #[test]
-fn the_shipped_amp_pso_scenarios_are_seed_004_tables_2_to_4() -> Result<(), ScenarioError> {
+fn the_shipped_amp_pso_scenarios_are_amp_pso_tables_2_to_4() -> Result<(), ScenarioError> {
     let obstacles = [
         ("HObs#1", ObstacleKind::Hard, [10.0, 10.0, 10.0], 0.3),
         ("SObs#1", ObstacleKind::Soft, [8.0, 2.0, 12.0], 0.2),

@@ -184,7 +184,7 @@ impl Scenario {
             return Err(bad(
                 "optimizer.algorithm".into(),
                 format!("{:?}", algorithm.as_str()),
-                "plans inspection tours (seed 003): add an [inspection] table",
+                "plans inspection tours (Hu et al. 2023): add an [inspection] table",
             ));
         }
         if algorithm.is_energy_planner() {
@@ -193,7 +193,7 @@ impl Scenario {
                     "optimizer.algorithm".into(),
                     format!("{:?}", algorithm.as_str()),
                     &format!(
-                        "plans one AUV (seed 001); this scenario has {} vehicles",
+                        "plans one AUV (Zhang et al. 2022); this scenario has {} vehicles",
                         self.vehicles.len()
                     ),
                 ));

@@ -21,7 +21,7 @@ use super::solvers::epapso::EpaPso;
 use super::solvers::ipso::Ipso;
 use super::solvers::lcpso::Lcpso;
 use super::solvers::ldiwpso::LdiwPso;
-use super::solvers::multi::{MultiPso, SEED004_VELOCITY_CAP};
+use super::solvers::multi::{MultiPso, AMP_PSO_VELOCITY_CAP};
 use super::solvers::nspso::Nspso;
 use super::solvers::pso::Pso;
 
@@ -29,7 +29,7 @@ use super::solvers::pso::Pso;
 #[derive(Debug, Clone, Copy, Serialize, Deserialize, PartialEq, Eq, Default)]
 #[serde(rename_all = "kebab-case")]
 pub enum Algorithm {
-    /// Adaptive multi-population PSO (seed 004).
+    /// Adaptive multi-population PSO (Zhi & Zuo 2024).
     #[default]
     AmpPso,
     /// Classic single-population PSO with fixed coefficients (Table 5).
@@ -38,27 +38,27 @@ pub enum Algorithm {
     MpPso,
     /// Single-population PSO with the adaptive coefficients of eq. (7) (Table 5).
     APso,
-    /// Improved PSO of seed 000 (eq. (19)–(26), Table 8).
+    /// Improved PSO of Lu et al. 2023 (eq. (19)–(26), Table 8).
     Ipso,
-    /// Standard PSO of seed 000 Table 8 (c1 = c2 = 2, w = 0.5).
+    /// Standard PSO of Lu et al. 2023, Table 8 (c1 = c2 = 2, w = 0.5).
     Spso,
-    /// Chaos-initialised PSO of seed 000 Table 8.
+    /// Chaos-initialised PSO of Lu et al. 2023, Table 8.
     Cbpso,
-    /// Non-dominated sorting PSO of seed 000 Table 8.
+    /// Non-dominated sorting PSO of Lu et al. 2023, Table 8.
     Nspso,
-    /// Ant-colony / PSO hybrid of seed 000 Table 8.
+    /// Ant-colony / PSO hybrid of Lu et al. 2023, Table 8.
     AcoPso,
-    /// Energy-saving PSO of seed 001 (eq. (14)–(17), Table 2), one AUV in a current.
+    /// Energy-saving PSO of Zhang et al. 2022 (eq. (14)–(17), Table 2), one AUV in a current.
     EpaPso,
-    /// Seed 001's baseline: PSO minimising the path length alone.
+    /// Zhang et al.'s baseline: PSO minimising the path length alone.
     PsoLength,
-    /// Seed 001's M-PSO: the same PSO on the full cost of eq. (6).
+    /// Zhang et al.'s M-PSO: the same PSO on the full cost of eq. (6).
     MPso,
-    /// Seed 003's DE-PSO cage-inspection tours (eq. (14)–(20), Table 5).
+    /// Hu et al.'s DE-PSO cage-inspection tours (eq. (14)–(20), Table 5).
     DePso,
-    /// Seed 003's LDIW-PSO baseline (eq. (3)).
+    /// Hu et al.'s LDIW-PSO baseline (eq. (3)).
     LdiwPso,
-    /// Seed 003's LCPSO baseline (eq. (4)–(10)).
+    /// Hu et al.'s LCPSO baseline (eq. (4)–(10)).
     Lcpso,
     /// Constriction-factor PSO of Clerc and Kennedy (2002), χ ≈ 0.7298, c1 = c2 = 2.05.
     CfPso,
@@ -86,7 +86,7 @@ impl Algorithm {
             Algorithm::CfPso => "cf-pso",
         }
     }
-    /// Every algorithm: seed 004 Table 5's order, then seed 000 Table 8's, seed 001's, seed 003's,
+    /// Every algorithm: Zhi & Zuo 2024, Table 5's order, then Lu et al. 2023, Table 8's, Zhang et al.'s, Hu et al.'s,
     /// then the variants from the wider literature.
     pub const ALL: [Algorithm; 16] = [
         Algorithm::AmpPso,
@@ -106,12 +106,12 @@ impl Algorithm {
         Algorithm::Lcpso,
         Algorithm::CfPso,
     ];
-    /// True for seed 001's single-AUV energy planners, which plan on the energy cost rather
+    /// True for Zhang et al.'s single-AUV energy planners, which plan on the energy cost rather
     /// than the fleet fitness.
     pub fn is_energy_planner(self) -> bool {
         matches!(family(self), Family::Energy { .. })
     }
-    /// True for seed 003's inspection-tour planners (the leg swarm is the algorithm).
+    /// True for Hu et al.'s inspection-tour planners (the leg swarm is the algorithm).
     pub fn is_tour_planner(self) -> bool {
         matches!(family(self), Family::Tour(_))
     }
@@ -145,17 +145,17 @@ impl std::str::FromStr for Algorithm {
 /// Which planner an algorithm runs under: the problem it optimises.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Family {
-    /// Seed 004's and seed 000's fleet planners, on the fleet fitness of seed 004 eq. (12).
+    /// Zhi & Zuo's and Lu et al.'s fleet planners, on the fleet fitness of Zhi & Zuo 2024, eq. (12).
     Fleet {
         /// Followers and a leader (AMP-PSO, MP-PSO): the algorithms a distributed run splits.
         multi_population: bool,
     },
-    /// Seed 001's single-AUV planners, on the energy cost.
+    /// Zhang et al.'s single-AUV planners, on the energy cost.
     Energy {
         /// The baseline that minimises the path length alone rather than eq. (6).
         path_length_only: bool,
     },
-    /// Seed 003's inspection tours: the algorithm is the swarm that plans each leg.
+    /// Hu et al.'s inspection tours: the algorithm is the swarm that plans each leg.
     Tour(LegAlgorithm),
 }
 
@@ -183,7 +183,7 @@ pub fn family(algorithm: Algorithm) -> Family {
     }
 }
 
-/// The swarm that plans the legs of a tour (the three algorithms of seed 003 Table 6).
+/// The swarm that plans the legs of a tour (the three algorithms of Hu et al. 2023, Table 6).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum LegAlgorithm {
@@ -261,7 +261,7 @@ pub struct SolverSettings {
 
 impl SolverSettings {
     /// A single-population run of `particles` particles (the multi-population sizes are
-    /// seed 004 Table 5's, on one thread).
+    /// Zhi & Zuo 2024, Table 5's, on one thread).
     pub fn single(particles: usize, seed: u64, velocity_cap: Option<f64>) -> SolverSettings {
         let amp = MultiPso::amp(seed);
         SolverSettings {
@@ -314,7 +314,7 @@ pub fn with_solver<P: Problem, V: SolverVisitor<P>>(
     }
 }
 
-/// AMP-PSO or MP-PSO with the settings' sizes; seed 004's cap unless the settings set one.
+/// AMP-PSO or MP-PSO with the settings' sizes; Zhi & Zuo's cap unless the settings set one.
 fn multi(algorithm: Algorithm, s: &SolverSettings) -> MultiPso {
     MultiPso {
         populations: s.multi.populations,
@@ -322,14 +322,14 @@ fn multi(algorithm: Algorithm, s: &SolverSettings) -> MultiPso {
         leader_particles: s.multi.leader_particles,
         exchange_every: s.multi.exchange_every,
         schedule: schedule(algorithm),
-        max_velocity_fraction: s.velocity_cap.unwrap_or(SEED004_VELOCITY_CAP),
+        max_velocity_fraction: s.velocity_cap.unwrap_or(AMP_PSO_VELOCITY_CAP),
         threads: s.threads,
         seed: s.seed,
     }
 }
 
-/// The PSO both of seed 001's baselines use: Clerc and Kennedy's constricted coefficients
-/// (ω = 0.729, c1 = c2 = 1.494), the usual "plain PSO" — seed 001 does not list its baseline's
+/// The PSO both of Zhang et al.'s baselines use: Clerc and Kennedy's constricted coefficients
+/// (ω = 0.729, c1 = c2 = 1.494), the usual "plain PSO" — Zhang et al. 2022 does not list its baseline's
 /// settings.
 pub fn baseline_pso(particles: usize, seed: u64) -> Pso {
     Pso {

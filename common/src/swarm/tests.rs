@@ -1,4 +1,4 @@
-//! Tests across solvers: the executor's budgets, and the seed 004 solvers against each other.
+//! Tests across solvers: the executor's budgets, and the Zhi & Zuo 2024 solvers against each other.
 
 use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
@@ -50,10 +50,10 @@ fn adaptive_and_multi_population_optimizers_converge_on_the_shifted_sphere() {
 fn classic_pso_converges_in_low_dimension_and_stalls_in_high() {
     // Table 5's ω = 0.15 is a greedy setting: fine on a 3-D bowl...
     assert_converged("pso", 3, solve(Pso::classic(50, 7), 3, 300));
-    // Seed 000's SPSO (ω = 0.5, c1 = c2 = 2) on the same bowl.
+    // Lu et al.'s SPSO (ω = 0.5, c1 = c2 = 2) on the same bowl.
     assert_converged("spso", 3, solve(Pso::spso(30, 7), 3, 300));
     // ...but it loses its momentum before reaching the optimum in 10-D, the premature
-    // convergence seed 004 §4.2 reports for classic PSO; A-PSO on the same budget does not.
+    // convergence Zhi & Zuo 2024, §4.2 reports for classic PSO; A-PSO on the same budget does not.
     let (pso, _) = solve(Pso::classic(50, 7), 10, 300);
     let (apso, _) = solve(Pso::adaptive(50, 7), 10, 300);
     assert!(pso > 1e3 * apso.max(1e-12), "pso {pso} a-pso {apso}");

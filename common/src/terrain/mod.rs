@@ -1,4 +1,4 @@
-//! Seabed terrain for crawlers (seed 000 §2.2): analytic relief with Gaussian mountains, or a
+//! Seabed terrain for crawlers (Lu et al. 2023, §2.2): analytic relief with Gaussian mountains, or a
 //! measured height grid loaded from CSV / ESRI ASCII; plus soft-substrate hazard cylinders.
 //!
 //! Frame: x east, y north, z up (metres). A crawler drives *on* the seabed, so the z of its path is
@@ -11,7 +11,7 @@ use crate::geometry::Vec3;
 mod grid;
 pub use grid::{HeightGrid, Problem, TerrainError};
 
-/// Constants `a…g` of the base relief, seed 000 eq. (2). The paper does not give values: they are
+/// Constants `a…g` of the base relief, Lu et al. 2023, eq. (2). The paper does not give values: they are
 /// data of the terrain, supplied by the scenario.
 ///
 /// Eq. (2) read literally in metres (`sin(y + a)` with unit amplitude and a 6.3 m wavelength) has
@@ -70,7 +70,7 @@ impl BaseRelief {
         low
     }
 
-    /// `Z1(x, y)`, seed 000 eq. (2), in the scaled coordinates above.
+    /// `Z1(x, y)`, Lu et al. 2023, eq. (2), in the scaled coordinates above.
     pub fn elevation(&self, x: f64, y: f64) -> f64 {
         let (x, y) = (x / self.length_scale_m, y / self.length_scale_m);
         let r = x.hypot(y);
@@ -104,7 +104,7 @@ impl BaseRelief {
     }
 }
 
-/// One Gaussian mountain of seed 000 eq. (3). Spreads must be positive (a zero spread yields NaN).
+/// One Gaussian mountain of Lu et al. 2023, eq. (3). Spreads must be positive (a zero spread yields NaN).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Mountain {
@@ -124,7 +124,7 @@ impl Mountain {
         (u, v, self.height_m * (-u * u - v * v).exp())
     }
 
-    /// This mountain's term of `Z2`, seed 000 eq. (3).
+    /// This mountain's term of `Z2`, Lu et al. 2023, eq. (3).
     pub fn elevation(&self, x: f64, y: f64) -> f64 {
         self.parts(x, y).2
     }
@@ -139,7 +139,7 @@ impl Mountain {
     }
 }
 
-/// A soft-substrate hazard zone, the vertical cylinder `T_k` of seed 000 eq. (4).
+/// A soft-substrate hazard zone, the vertical cylinder `T_k` of Lu et al. 2023, eq. (4).
 ///
 /// A crawler rides on the seabed and is therefore always within the cylinder's vertical span:
 /// only the horizontal clearance ([`hazard_clearance`]) matters for it. `height_m` is kept for
@@ -160,7 +160,7 @@ pub struct Hazard {
 /// The seabed a crawler drives on.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Terrain {
-    /// Seed 000 model: elevation `Z1 + Z2` (eq. (2) + eq. (3)). The paper's MATLAB tradition takes
+    /// Lu et al. 2023 model: elevation `Z1 + Z2` (eq. (2) + eq. (3)). The paper's MATLAB tradition takes
     /// `max(Z1, Z2)`; we add instead, which keeps the slope continuous where a mountain meets the
     /// base relief (a `max` has a crease there that a slope limit would see as a step).
     Analytic {
@@ -169,14 +169,14 @@ pub enum Terrain {
         /// Mountains summed into `Z2`, eq. (3).
         mountains: Vec<Mountain>,
     },
-    /// Seed 001 eq. (1): Gaussian hills on a flat floor at z = 0, no base relief.
+    /// Zhang et al. 2022, eq. (1): Gaussian hills on a flat floor at z = 0, no base relief.
     Hills(Vec<Mountain>),
     /// Measured bathymetry, bilinearly interpolated.
     Grid(HeightGrid),
 }
 
 impl Terrain {
-    /// Seabed elevation at `(x, y)`, metres (seed 000 eq. (2) + (3), or the grid).
+    /// Seabed elevation at `(x, y)`, metres (Lu et al. 2023, eq. (2) + (3), or the grid).
     pub fn elevation(&self, x: f64, y: f64) -> f64 {
         match self {
             Terrain::Analytic { base, mountains } => {
@@ -260,7 +260,7 @@ impl Terrain {
     }
 }
 
-/// Horizontal clearance of segment `a→b` from hazard `h` (seed 000 eq. (4)): distance from the
+/// Horizontal clearance of segment `a→b` from hazard `h` (Lu et al. 2023, eq. (4)): distance from the
 /// exact closest point of the segment to the centre, minus the radius. Negative means the segment
 /// enters the cylinder.
 pub fn hazard_clearance(h: &Hazard, a: [f64; 2], b: [f64; 2]) -> f64 {

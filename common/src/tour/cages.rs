@@ -1,4 +1,4 @@
-//! Spherical net cages and their inspection points (seed 003 §II, Table 4).
+//! Spherical net cages and their inspection points (Hu et al. 2023, §II, Table 4).
 //!
 //! Units: Table 4 prints bare numbers (centres around 100–600, radii 45–80) with no unit; the
 //! simulation is an abstract MATLAB space. Shoal reads one table unit as one metre, so the
@@ -32,7 +32,7 @@ impl Cage {
     }
 }
 
-/// Cage group A of seed 003 Table 4 (one table unit = one metre).
+/// Cage group A of Hu et al. 2023, Table 4 (one table unit = one metre).
 pub fn cage_group_a() -> Vec<Cage> {
     vec![
         Cage::new("A1", 300.0, 400.0, 460.0, 50.0),
@@ -43,7 +43,7 @@ pub fn cage_group_a() -> Vec<Cage> {
     ]
 }
 
-/// Cage group B of seed 003 Table 4: group A's centres with other radii.
+/// Cage group B of Hu et al. 2023, Table 4: group A's centres with other radii.
 pub fn cage_group_b() -> Vec<Cage> {
     vec![
         Cage::new("B1", 300.0, 400.0, 460.0, 75.0),
@@ -84,7 +84,7 @@ pub struct InspectionPoint {
 /// monitoring sphere (the second is always its mirror through the centre).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum FirstPoint {
-    /// Seed 003 §II: "a monitoring point was randomly selected" — a uniform azimuth per cage from
+    /// Hu et al. 2023, §II: "a monitoring point was randomly selected" — a uniform azimuth per cage from
     /// this seed.
     Random {
         /// RNG seed.
@@ -97,7 +97,7 @@ pub enum FirstPoint {
     Azimuth(f64),
 }
 
-/// Two inspection points per cage (seed 003 §II): on the horizontal plane through the centre, at
+/// Two inspection points per cage (Hu et al. 2023, §II): on the horizontal plane through the centre, at
 /// distance `R + standoff_m` from it, the second the mirror of the first through the centre.
 /// The points of cage `k` are entries `2k` and `2k + 1`.
 ///

@@ -1,4 +1,4 @@
-//! What `plan.json` reports about an inspection tour (seed 003 Table 6 measures).
+//! What `plan.json` reports about an inspection tour (Hu et al. 2023, Table 6 measures).
 
 use serde::{Deserialize, Serialize};
 

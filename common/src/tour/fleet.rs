@@ -1,4 +1,4 @@
-//! A fleet's inspection job (seed 003 for several AUVs): which cages, which points, which AUV
+//! A fleet's inspection job (Hu et al. 2023 for several AUVs): which cages, which points, which AUV
 //! visits which points, and the settings every tour is planned with. It is a pure function of
 //! the scenario, so the coordinator and every agent derive the same job from the same file and
 //! each agent can plan its own share without being told more than the scenario.

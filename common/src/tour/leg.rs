@@ -1,4 +1,4 @@
-//! One leg of an inspection tour as a [`Problem`] (seed 003 §IV-C): the path from one point to
+//! One leg of an inspection tour as a [`Problem`] (Hu et al. 2023, §IV-C): the path from one point to
 //! the next through `n` intermediate waypoints, the shortest one (eq. (27)–(28)) whose segments
 //! stay clear of every cage sphere (eq. (29)–(33)).
 //!
@@ -56,7 +56,7 @@ pub fn safety_spheres(cages: &[Cage], clearance_m: f64) -> Vec<Sphere> {
         .collect()
 }
 
-/// How many spheres segment `a→b` enters (seed 003 eq. (31)–(33) on the segment, with the
+/// How many spheres segment `a→b` enters (Hu et al. 2023, eq. (31)–(33) on the segment, with the
 /// contact guard so a graze counts).
 pub fn segment_hits(a: &Vec3, b: &Vec3, spheres: &[Sphere]) -> usize {
     spheres
@@ -77,7 +77,7 @@ pub fn feasible(path: &[Vec3], spheres: &[Sphere]) -> bool {
     intersections(path, spheres) == 0
 }
 
-/// Length of a polyline (seed 003 eq. (27)–(28)), metres.
+/// Length of a polyline (Hu et al. 2023, eq. (27)–(28)), metres.
 pub fn path_length(path: &[Vec3]) -> f64 {
     path.windows(2).map(|w| (w[1] - w[0]).norm()).sum()
 }
@@ -136,7 +136,7 @@ impl LegProblem {
         Vec3::new(at(k), at(n + k), at(2 * n + k))
     }
 
-    /// Seed 003 eq. (30), obstacle case: a point inside a sphere is moved radially onto its
+    /// Hu et al. 2023, eq. (30), obstacle case: a point inside a sphere is moved radially onto its
     /// surface (2 guards outside, so the point itself is clear); a point at the very centre
     /// moves up (+z). A few passes settle overlapping spheres; the point stays in the box.
     pub fn repair_point(&self, p: Vec3) -> Vec3 {

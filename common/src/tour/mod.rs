@@ -1,4 +1,4 @@
-//! Cage-inspection tours, seed 003 (Hu et al. 2023): an AUV leaves a base, visits two inspection
+//! Cage-inspection tours, Hu et al. 2023 (Hu et al. 2023): an AUV leaves a base, visits two inspection
 //! points on opposite sides of every spherical net cage and returns, on the shortest path that
 //! never touches a cage.
 //!

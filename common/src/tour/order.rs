@@ -1,4 +1,4 @@
-//! Visiting order: the swap-operator PSO of seed 003 §III-B (eq. (11)–(13), Table 3) for a
+//! Visiting order: the swap-operator PSO of Hu et al. 2023, §III-B (eq. (11)–(13), Table 3) for a
 //! closed tour from the base (node 0) through every other node and back.
 //!
 //! A particle is a permutation of the nodes 1..n; its velocity is a swap sequence (a list of
@@ -41,7 +41,7 @@ pub fn open_order_length(dist: &[Vec<f64>], order: &[usize]) -> f64 {
     sum + dist_at(dist, prev, 0)
 }
 
-/// Length of the node sequence `tour` as given (seed 003 eq. (27) on a distance matrix).
+/// Length of the node sequence `tour` as given (Hu et al. 2023, eq. (27) on a distance matrix).
 pub fn tour_length(dist: &[Vec<f64>], tour: &[usize]) -> f64 {
     tour.windows(2).map(|w| dist_at(dist, w[0], w[1])).sum()
 }
@@ -110,7 +110,7 @@ pub fn swap_sequence(from: &[usize], to: &[usize]) -> Vec<(usize, usize)> {
     swaps
 }
 
-/// The swap-operator PSO (seed 003 §III-B).
+/// The swap-operator PSO (Hu et al. 2023, §III-B).
 #[derive(Debug, Clone)]
 pub struct SwapPso {
     /// Population size M (Table 3: 100).
@@ -231,7 +231,7 @@ impl SwapPso {
                     }
                 }
                 for (target, keep) in [(&pbest[i], self.c1), (&gbest, self.c2)] {
-                    // seed 003 eq. (11) / (12)
+                    // Hu et al. 2023, eq. (11) / (12)
                     for s in swap_sequence(x, target) {
                         if rng.random::<f64>() < keep {
                             x.swap(s.0, s.1);
@@ -256,7 +256,7 @@ impl SwapPso {
                     gbest.clone_from(x);
                 }
             }
-            // seed 003 eq. (13)
+            // Hu et al. 2023, eq. (13)
             w -= (w - 0.01) / m as f64;
         }
         (gbest, evaluations, false)

@@ -1,5 +1,5 @@
 //! The two layers put together: the visiting order, then every leg by a continuous swarm, with
-//! the settings of both and the plan they give (seed 003 §III–IV, Tables 3, 5 and 6).
+//! the settings of both and the plan they give (Hu et al. 2023, §III–IV, Tables 3, 5 and 6).
 
 use super::cages::{Cage, InspectionPoint};
 use super::leg::{intersections, path_length, safety_spheres, LegProblem};
@@ -36,7 +36,7 @@ pub struct LegSettings {
 }
 
 impl LegSettings {
-    /// Seed 003 Table 5.
+    /// Hu et al. 2023, Table 5.
     pub fn table5() -> LegSettings {
         LegSettings {
             particles: 60,
@@ -62,7 +62,7 @@ pub struct TourSettings {
 }
 
 impl TourSettings {
-    /// Seed 003's settings: Table 3 for the order, Table 5 for the legs.
+    /// Hu et al.'s settings: Table 3 for the order, Table 5 for the legs.
     pub fn paper() -> TourSettings {
         TourSettings {
             order: SwapPso::table3(0),
@@ -72,7 +72,7 @@ impl TourSettings {
     }
 }
 
-/// A planned inspection tour with the measures of seed 003 Table 6.
+/// A planned inspection tour with the measures of Hu et al. 2023, Table 6.
 #[derive(Debug, Clone, PartialEq)]
 pub struct TourPlan {
     /// Visiting order: indices into the inspection points (the base is implicit at both ends).
@@ -226,7 +226,7 @@ pub fn summed_curve<'a>(parts: impl IntoIterator<Item = (&'a [f64], f64)> + Clon
         .collect()
 }
 
-/// Plans a closed inspection tour from `base` through every point of `points` (seed 003 §V).
+/// Plans a closed inspection tour from `base` through every point of `points` (Hu et al. 2023, §V).
 ///
 /// The order comes from the swap-operator PSO on straight-line distances (seeded with
 /// `stream_seed(seed, 0)`); leg `k` is planned by [`plan_leg`] with `stream_seed(seed, k + 1)`,

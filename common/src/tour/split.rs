@@ -1,4 +1,4 @@
-//! Sharing the inspection points among several AUVs with balanced tours (not in seed 003, which
+//! Sharing the inspection points among several AUVs with balanced tours (not in Hu et al. 2023, which
 //! plans one vehicle; Shoal's fleets need it).
 //!
 //! 1. Sweep: the points are sorted by their horizontal bearing from the base and the circle is cut

@@ -118,7 +118,7 @@ fn a_raised_stop_still_gives_a_complete_tour_from_the_initial_swarms() {
     assert!((1..=pts.len() as u64 + 1).contains(&legs), "{legs}");
 }
 
-/// Seed 003 §V-B at full Table 3 / Table 5 budgets on both groups (slow in a debug build:
+/// Hu et al. 2023, §V-B at full Table 3 / Table 5 budgets on both groups (slow in a debug build:
 /// `cargo test -p shoal-common --lib tour::tests::paper_budgets -- --ignored --nocapture`).
 #[test]
 #[ignore = "full Table 5 budgets; run on demand"]

@@ -11,7 +11,7 @@ use crate::tour::TourPlan;
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub enum AgentToCoordinator {
     /// The best chromosome of each of the agent's follower populations after exchange round
-    /// `round`'s iterations (seed 004 Fig. 5a), for the leader.
+    /// `round`'s iterations (Zhi & Zuo 2024, Fig. 5a), for the leader.
     Elites {
         /// Mission id.
         mission: String,
@@ -48,7 +48,7 @@ pub enum AgentToCoordinator {
         /// The vehicle.
         vehicle: String,
     },
-    /// Tour missions (seed 003): the inspection tour the agent planned for its share of the
+    /// Tour missions (Hu et al. 2023): the inspection tour the agent planned for its share of the
     /// points. Sent once, before `Done`.
     Tour {
         /// Mission id.
@@ -73,7 +73,7 @@ pub enum AgentToCoordinator {
         /// The tour's convergence curve, [`TourPlan::convergence`] (protocol version 5).
         convergence: Vec<f64>,
     },
-    /// Fleet coverage missions (seed 002 with several crawlers): the plan of the agent's strip
+    /// Fleet coverage missions (CPP-DSMV with several crawlers): the plan of the agent's strip
     /// (its figures and its exact path). Sent once, before `Done`.
     Coverage {
         /// Mission id.

@@ -26,7 +26,7 @@ pub enum CoordinatorToAgent {
         /// The plan.
         context: WireContext,
     },
-    /// Updated immigrants returning to the agent's followers (seed 004 Fig. 5c), one per
+    /// Updated immigrants returning to the agent's followers (Zhi & Zuo 2024, Fig. 5c), one per
     /// follower population, after exchange `round`.
     Migrants {
         /// Mission id.

@@ -74,7 +74,7 @@ impl<T> Envelope<T> {
     }
 }
 
-/// One vehicle's chromosome on the wire: its genes and its velocity (seed 004 Fig. 5: what an
+/// One vehicle's chromosome on the wire: its genes and its velocity (Zhi & Zuo 2024, Fig. 5: what an
 /// emigrant carries up to the leader and a migrant carries back).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct WireChromosome {

@@ -1,5 +1,5 @@
 //! `shoal-coordinator compare`: every algorithm on every scenario over several seeds, as a
-//! markdown table like seed 004's Figures 7, 9 and 11 (run time, collisions, fitness), with the
+//! markdown table like Zhi & Zuo's Figures 7, 9 and 11 (run time, collisions, fitness), with the
 //! significance rows and, for crawlers, the gap to a reference path.
 
 use std::path::PathBuf;

@@ -71,15 +71,15 @@ pub enum Command {
     Health(health::HealthArgs),
 
     // -- Benchmarks --
-    /// Run the benchmark-function suite (seed 000 Table 3–6).
+    /// Run the benchmark-function suite (Lu et al. 2023, Table 3–6).
     BenchFunctions(bench::functions::BenchFunctionsArgs),
-    /// Compare PSO (length only), M-PSO and EPA-PSO on one AUV in a current (seed 001 Table 3).
+    /// Compare PSO (length only), M-PSO and EPA-PSO on one AUV in a current (Zhang et al. 2022, Table 3).
     BenchEnergy(bench::energy::BenchEnergyArgs),
-    /// Compare LDIW-PSO, LCPSO and DE-PSO on cage-inspection tours (seed 003 Table 6).
+    /// Compare LDIW-PSO, LCPSO and DE-PSO on cage-inspection tours (Hu et al. 2023, Table 6).
     BenchCages(bench::cages::BenchCagesArgs),
     /// Measure the coordinator's CPU use and telemetry latency with N simulated vehicles.
     BenchTelemetry(bench::telemetry::BenchTelemetryArgs),
-    /// Compare seed 002's arc-smoothed Boustrophedon with the Hybrid A* baseline on seeded maps
+    /// Compare CPP-DSMV's arc-smoothed Boustrophedon with the Hybrid A* baseline on seeded maps
     /// (coverage, planning time, clearance, cross-track error; Table 2 and Figure 7).
     BenchCoverage(bench::coverage::BenchCoverageArgs),
 }

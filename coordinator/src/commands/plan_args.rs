@@ -34,9 +34,9 @@ pub struct PlanArgs {
     /// RNG seed (overrides the scenario's).
     #[arg(long, env = "SHOAL_SEED")]
     pub seed: Option<u64>,
-    /// Optimizer: amp-pso, a-pso, mp-pso, pso (seed 004); ipso, spso, cbpso, nspso, aco-pso
-    /// (seed 000); epa-pso, pso-length, m-pso (seed 001, one AUV, with --in-process); de-pso,
-    /// ldiw-pso, lcpso (seed 003 inspection tours, in process or by the agents); cf-pso
+    /// Optimizer: amp-pso, a-pso, mp-pso, pso (Zhi & Zuo 2024); ipso, spso, cbpso, nspso, aco-pso
+    /// (Lu et al. 2023); epa-pso, pso-length, m-pso (Zhang et al. 2022, one AUV, with --in-process); de-pso,
+    /// ldiw-pso, lcpso (Hu et al. 2023 inspection tours, in process or by the agents); cf-pso
     /// (Clerc and Kennedy 2002, with --in-process); overrides the scenario's.
     #[arg(long, env = "SHOAL_ALGORITHM")]
     pub algorithm: Option<Algorithm>,

@@ -1,6 +1,6 @@
 //! Distributed planning (`plan` without `--in-process`): the coordinator embeds a Zenoh router,
 //! the vehicle agents run their vehicles' follower populations, and the coordinator holds the
-//! leader population (seed 004 §3.2, split over processes as
+//! leader population (Zhi & Zuo 2024, §3.2, split over processes as
 //! [`shoal_common::distributed`] describes).
 //!
 //! - [`network`]: the router, the mission's keys, decoding and counting bad messages;
@@ -155,7 +155,7 @@ pub fn plan_distributed(
     Ok(plan)
 }
 
-/// Plans a fleet coverage mission (seed 002 with several crawlers): each agent plans its own
+/// Plans a fleet coverage mission (CPP-DSMV with several crawlers): each agent plans its own
 /// strip of `map`; a strip whose agent fails is planned here. Returns the strips' plans in
 /// scenario order and the network figures.
 pub fn plan_strips_distributed(

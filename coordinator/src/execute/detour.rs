@@ -14,7 +14,7 @@
 //! than its clearance plus one layer above the seabed are blocked, and shortcuts keep the
 //! clearance plus [`SEABED_MARGIN_M`] all along (sampled as the planner's cost samples it).
 //!
-//! The way must be one the vehicle can fly: its pitch limit (±20° in seed 004) is built into
+//! The way must be one the vehicle can fly: its pitch limit (±20° in Zhi & Zuo 2024) is built into
 //! the grid. Layers are `cell · tan(φ_max)` apart (a little less; a cell at most), every move
 //! goes one cell sideways and at most one layer up or down, so no grid move is steeper than the
 //! limit; a shortcut is taken only when it is no steeper either.
@@ -216,7 +216,7 @@ fn flyable(scenario: &Scenario, a: &Vec3, b: &Vec3, max_pitch: f64, seabed: Keep
 /// swimmer keeps off, [`keep_off`]), no steeper than `max_pitch_deg` (see the module doc): the
 /// corners of the shortened grid path, from `from` to `to`. `None` when the grid has no way, or
 /// once `stop` is raised (a held vehicle's retry yielding, `replan_queue`: the search takes a
-/// few hundred milliseconds on seed 004's scenarios).
+/// few hundred milliseconds on Zhi & Zuo's scenarios).
 pub fn detour(
     scenario: &Scenario,
     from: Vec3,

@@ -446,11 +446,11 @@ pub struct VehicleFigures {
     /// through it); absent for a crawler, or without a seabed.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub min_seabed_clearance_m: Option<f64>,
-    /// Closest a crawler's executed track came to a soft-substrate hazard (seed 000 eq. (4)),
+    /// Closest a crawler's executed track came to a soft-substrate hazard (Lu et al. 2023, eq. (4)),
     /// horizontally, metres (negative: inside it); absent for an AUV, or without hazards.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub min_hazard_clearance_m: Option<f64>,
-    /// A coverage crawler (seed 002): the closest its executed track came to impassable ground
+    /// A coverage crawler (CPP-DSMV): the closest its executed track came to impassable ground
     /// of its seabed map (a cell centre), metres; absent otherwise.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub min_ground_clearance_m: Option<f64>,

@@ -1,4 +1,4 @@
-//! What coverage crawlers (seed 002 under `run`) did on their seabed map: how close each
+//! What coverage crawlers (CPP-DSMV under `run`) did on their seabed map: how close each
 //! executed track came to impassable ground (cells steeper than the critical slope, dilated by
 //! half the vehicle width: the planner kept `safety_clearance_m` from them), how many metres of
 //! it lay on such ground, and how much of the area the executed swaths covered. The plan's

@@ -139,10 +139,10 @@ impl Job {
             ground: self.ground.as_deref(),
             stop: Some(Arc::clone(&self.stop)),
         };
-        // A tour must still pass its remaining inspection points, an energy plan (seed 001)
+        // A tour must still pass its remaining inspection points, an energy plan (Zhang et al. 2022)
         // keeps the path its cost chose over the seabed, its turning radius and the current,
-        // and a coverage crawler (seed 002) must still drive its remaining rows, none of which
-        // seed 004's replan models: all three are repaired, not replanned.
+        // and a coverage crawler (CPP-DSMV) must still drive its remaining rows, none of which
+        // Zhi & Zuo's replan models: all three are repaired, not replanned.
         let algorithm = self.scenario.optimizer.algorithm;
         if algorithm.is_tour_planner()
             || algorithm.is_energy_planner()

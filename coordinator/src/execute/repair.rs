@@ -1,7 +1,7 @@
 //! Repairing the rest of an inspection tour while the fleet drives. A tour's path is
 //! not "any way to the goal": it must still pass every remaining inspection point in order, so
 //! the point-to-point replan of [`super::replan`] would be wrong for it. The same holds for an
-//! energy plan (seed 001), whose path points were chosen for the seabed, the AUV's turning
+//! energy plan (Zhang et al. 2022), whose path points were chosen for the seabed, the AUV's turning
 //! radius and the current, none of which the replan models. A repair keeps the
 //! rest of the tour and changes only what must change:
 //!
@@ -18,7 +18,7 @@
 //! approach are flown a little slower or faster ([`RETIMINGS`]), the later ones making up the
 //! difference, and the first timing that keeps the buffer is taken, else the first that keeps
 //! d_min (as [`super::replan`] prefers the buffer but never holds for it alone).
-//! A coverage crawler (seed 002) is repaired the same way, but its way round a blocked run
+//! A coverage crawler (CPP-DSMV) is repaired the same way, but its way round a blocked run
 //! must stay on passable seabed, which the detour's 3-D grid does not know: it is searched on
 //! the seabed map instead ([`shoal_common::coverage::reroute`]: the coverage planner's safety
 //! clearance and turning radius, the obstacle's keep-out sphere at the crawler's height). Its

@@ -3,8 +3,8 @@
 //! with the other vehicles as moving obstacles (their trajectories as the coordinator predicts
 //! them) and any new obstacle in the scenario.
 //!
-//! It is the follower problem of distributed AMP-PSO ([`VehicleProblem`], seed 004 eq. (9)–(12)
-//! restricted to one vehicle) solved by A-PSO (seed 004 eq. (7) parameters) under a wall-time
+//! It is the follower problem of distributed AMP-PSO ([`VehicleProblem`], Zhi & Zuo 2024, eq. (9)–(12)
+//! restricted to one vehicle) solved by A-PSO (Zhi & Zuo 2024, eq. (7) parameters) under a wall-time
 //! budget, warm-started: the first particle is the current plan's remainder resampled onto the
 //! M waypoints (pushed out of new obstacles), the second a coarse way round the hard obstacles
 //! (`detour`) when there is one, a few more are jittered copies of these, the rest are
@@ -321,7 +321,7 @@ pub fn replan(r: &Request) -> Replanned {
     let d_min = r.scenario.fleet.d_min_m;
     let mut scenario = r.scenario.clone();
     scenario.vehicles[r.vehicle].start = [r.p0.x, r.p0.y, r.p0.z];
-    // The swarm's separation penalty (seed 004 eq. (11)) starts at d_min plus the buffer.
+    // The swarm's separation penalty (Zhi & Zuo 2024, eq. (11)) starts at d_min plus the buffer.
     scenario.fleet.d_min_m = d_min + r.separation_buffer_m.max(0.0);
     let model = FleetModel::new(&scenario);
     let context: Vec<Trajectory> = r.others.iter().map(|t| rebase(t, r.t0)).collect();

@@ -16,7 +16,7 @@
 //! is never undone, so rounding it at once left that ground uncovered for nothing.
 //!
 //! Only coverage missions: a tour's repair waits rather than skip inspection points (it would
-//! be held long before it needs to), and seed 004's replan is not a way round.
+//! be held long before it needs to), and Zhi & Zuo's replan is not a way round.
 
 use shoal_common::geometry::{segment_point_distance, Vec3};
 use shoal_common::trajectory::Trajectory;

@@ -1,4 +1,4 @@
-//! `run` on a `[coverage]` mission (seed 002): the coverage plan, then its execution by the
+//! `run` on a `[coverage]` mission (CPP-DSMV): the coverage plan, then its execution by the
 //! agents' vehicles like any other plan ([`crate::execute`]).
 //!
 //! - **Planning** is `plan`'s ([`super::plan::plan_coverage_mission`]) without its closed-loop

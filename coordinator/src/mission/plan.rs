@@ -27,7 +27,7 @@ pub fn plan_mission(options: &MissionOptions, shutdown: Arc<AtomicBool>) -> anyh
     let algorithm = scenario.optimizer.algorithm;
     if algorithm.is_energy_planner() && !options.in_process {
         bail!(
-            "{}: {} plans one AUV inside this process (seed 001 has no fleet to distribute): add --in-process",
+            "{}: {} plans one AUV inside this process (Zhang et al. 2022 has no fleet to distribute): add --in-process",
             options.scenario.display(),
             algorithm.as_str()
         );
@@ -91,7 +91,7 @@ pub fn plan_coverage_mission(
     }
     if let Some(a) = options.overrides.algorithm {
         eprintln!(
-            "note: --algorithm {} is not used: a [coverage] mission plans with seed 002's Boustrophedon",
+            "note: --algorithm {} is not used: a [coverage] mission plans with CPP-DSMV's Boustrophedon",
             a.as_str()
         );
     }

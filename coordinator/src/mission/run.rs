@@ -24,7 +24,7 @@ use crate::report::progress::Progress;
 use crate::report::summary;
 
 /// Cross-track tolerance for a lone vehicle (d_min = 0, nothing to keep apart), metres: the
-/// simulated AUV tracks to within 2–9 m in seed 001's current, so 10 m means it is really off.
+/// simulated AUV tracks to within 2–9 m in Zhang et al.'s current, so 10 m means it is really off.
 pub const LONE_DEVIATION_M: f64 = 10.0;
 
 /// The deviation's default: half of d_min, so that two vehicles each off by less cannot close
@@ -311,7 +311,7 @@ mod tests {
     fn the_deviation_defaults_to_half_of_d_min_or_ten_metres_alone() {
         assert!((default_deviation(50.0) - 25.0).abs() < 1e-12);
         assert!((default_deviation(20.0) - 10.0).abs() < 1e-12);
-        // seed 001's lone AUV (d_min 0) gets a tolerance, not an error about a flag.
+        // Zhang et al.'s lone AUV (d_min 0) gets a tolerance, not an error about a flag.
         assert!((default_deviation(0.0) - LONE_DEVIATION_M).abs() < 1e-12);
         assert!(positive("--deviation", default_deviation(0.0)).is_ok());
     }

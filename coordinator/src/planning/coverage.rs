@@ -1,4 +1,4 @@
-//! Coverage missions (seed 002) from the command line: `plan` on a scenario with a `[coverage]`
+//! Coverage missions (CPP-DSMV) from the command line: `plan` on a scenario with a `[coverage]`
 //! table, and `bench-coverage`, the paper's Table 2 comparison (arc method vs the Hybrid A*
 //! baseline) over seeded maps.
 

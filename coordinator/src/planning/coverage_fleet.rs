@@ -1,4 +1,4 @@
-//! Fleet coverage missions (seed 002 with several crawlers) behind `plan`: the area is cut into
+//! Fleet coverage missions (CPP-DSMV with several crawlers) behind `plan`: the area is cut into
 //! strips of whole rows, one per crawler ([`FleetCoverage`]); each strip is planned by its
 //! crawler's agent (distributed, the default) or on its own thread (`--in-process`); then the
 //! coordinator measures the fleet from the paths and the map, and times the crawlers so every

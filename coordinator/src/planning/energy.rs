@@ -1,6 +1,6 @@
-//! Seed 001's single-AUV planners — EPA-PSO and its two baselines — behind the same `plan`
+//! Zhang et al.'s single-AUV planners — EPA-PSO and its two baselines — behind the same `plan`
 //! contract as the fleet planners: one optimizer run, then a timed trajectory assessed like any
-//! other, plus the seed 001 figures.
+//! other, plus the Zhang et al. 2022 figures.
 
 use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
@@ -14,7 +14,7 @@ use shoal_common::trajectory::Trajectory;
 
 use crate::planning::solver::{run_algorithm, RunResult};
 
-/// The objective an algorithm plans with: the path length alone for seed 001's length
+/// The objective an algorithm plans with: the path length alone for Zhang et al.'s length
 /// baseline, the full cost of eq. (6) otherwise.
 pub fn objective_of(algorithm: Algorithm) -> Objective {
     match family(algorithm) {
@@ -68,7 +68,7 @@ pub fn to_plan(scenario: &Scenario, problem: &EnergyProblem, run: RunResult) -> 
     let terms = eval.terms;
     if terms.min_turn_radius_m < m.min_turn_radius_m {
         assessment.violations.push(format!(
-            "{id} turns on a {:.2} m radius, tighter than its {:.1} m turning radius (seed 001 eq. (5))",
+            "{id} turns on a {:.2} m radius, tighter than its {:.1} m turning radius (Zhang et al. 2022, eq. (5))",
             terms.min_turn_radius_m, m.min_turn_radius_m
         ));
     }
@@ -93,7 +93,7 @@ pub fn to_plan(scenario: &Scenario, problem: &EnergyProblem, run: RunResult) -> 
     let mut notices = Vec::new();
     if scenario.currents.is_some() {
         notices.push(format!(
-            "{id} flies at a constant {speed:.2} m/s over ground (seed 001 §2.2); through the water that takes up to {:.2} m/s against the current",
+            "{id} flies at a constant {speed:.2} m/s over ground (Zhang et al. 2022, §2.2); through the water that takes up to {:.2} m/s against the current",
             terms.max_water_speed_mps
         ));
     }

@@ -7,7 +7,7 @@ use shoal_common::cost::FleetModel;
 use shoal_common::plan::{assess, notices, Plan};
 use shoal_common::scenario::Scenario;
 use shoal_common::swarm::catalog::{family, Family};
-use shoal_common::swarm::multi::SEED004_VELOCITY_CAP;
+use shoal_common::swarm::multi::AMP_PSO_VELOCITY_CAP;
 use shoal_common::swarm::{Executor, IterationReport, Termination};
 use shoal_common::touch_up::{touch_up, TouchUp, TouchUpSettings};
 
@@ -30,11 +30,11 @@ pub fn plan_in_process(
     };
     let run = match family(o.algorithm) {
         Family::Fleet { .. } => run_algorithm(&model, o, &executor, observe),
-        // Seed 001's planners plan one AUV on the energy cost, not the fleet fitness.
+        // Zhang et al.'s planners plan one AUV on the energy cost, not the fleet fitness.
         Family::Energy { .. } => {
             return crate::planning::energy::plan(scenario, executor.stop.clone(), observe)
         }
-        // Seed 003's planners plan inspection tours, leg by leg.
+        // Hu et al.'s planners plan inspection tours, leg by leg.
         Family::Tour(_) => {
             return crate::planning::tour::plan(scenario, executor.stop.clone(), observe)
         }
@@ -58,7 +58,7 @@ pub fn to_plan(
     let stopped = stop.is_some_and(|s| s.load(std::sync::atomic::Ordering::Relaxed));
     let touched = (o.touch_up && !stopped)
         .then(|| {
-            let settings = TouchUpSettings::new(o.seed, o.velocity_cap(SEED004_VELOCITY_CAP));
+            let settings = TouchUpSettings::new(o.seed, o.velocity_cap(AMP_PSO_VELOCITY_CAP));
             touch_up(model, &run.best_x, settings, stop)
         })
         .flatten();
@@ -177,7 +177,7 @@ mod tests {
     }
 
     #[test]
-    fn a_seed000_solver_runs_with_the_scenarios_velocity_cap_when_it_sets_one() {
+    fn a_ipso_runs_with_the_scenarios_velocity_cap_when_it_sets_one() {
         for algorithm in [Algorithm::Ipso, Algorithm::Spso, Algorithm::Cbpso] {
             let with = |cap| {
                 let mut s = dsmv(cap);
@@ -193,7 +193,7 @@ mod tests {
     }
 
     #[test]
-    fn seed001s_planners_run_with_the_scenarios_velocity_cap_when_it_sets_one() {
+    fn energy_planners_run_with_the_scenarios_velocity_cap_when_it_sets_one() {
         for algorithm in [Algorithm::EpaPso, Algorithm::MPso] {
             let with = |cap| {
                 let mut s = small("epa-pso", cap);

@@ -1,4 +1,4 @@
-//! Seed 003's cage-inspection tours behind the `plan` contract: the inspection points are shared
+//! Hu et al.'s cage-inspection tours behind the `plan` contract: the inspection points are shared
 //! among the scenario's AUVs (balanced tour lengths), each AUV's tour is ordered by the
 //! swap-operator PSO and its legs planned by the scenario's leg swarm (DE-PSO, LDIW-PSO or
 //! LCPSO), and the tours are timed so every AUV is back at its base at the same instant.

@@ -1,4 +1,4 @@
-//! The crawler figures of one `compare` cell (seed 000 Table 9): smoothed length, undulation,
+//! The crawler figures of one `compare` cell (Lu et al. 2023, Table 9): smoothed length, undulation,
 //! energy, slip, hazard intrusions, over every crawler of every run.
 
 use shoal_common::plan::Plan;

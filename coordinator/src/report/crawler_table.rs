@@ -1,4 +1,4 @@
-//! The crawler part of `compare` (seed 000 Table 9 and Fig. 10): smoothed path length per
+//! The crawler part of `compare` (Lu et al. 2023, Table 9 and Fig. 10): smoothed path length per
 //! algorithm over the seeds, hazard intrusions, the other §5.2 figures, and the gap to a
 //! reference shortest admissible path found by grid search on the same terrain.
 

@@ -1,6 +1,6 @@
 //! Is a difference in `compare`'s table real? The first algorithm named is the reference; on
 //! each scenario (and mode) its fitness over the seeds is tested against every other algorithm's
-//! with the two-sided Wilcoxon rank-sum test of [`shoal_common::stats::rank_sum`] — seed 000
+//! with the two-sided Wilcoxon rank-sum test of [`shoal_common::stats::rank_sum`] — Lu et al. 2023
 //! Table 6's test. A median that is lower but not significantly so is reported as such, so a
 //! ten-seed table is not read as more than it shows.
 

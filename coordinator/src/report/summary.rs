@@ -90,9 +90,9 @@ pub fn summary(plan: &Plan) -> String {
     s
 }
 
-/// The figures of a vehicle's own planner, one line: a crawler's seed 000 terms, an energy
-/// plan's seed 001 terms, an inspection tour's seed 003 figures, an AUV's height above a seabed;
-/// `None` for a plain seed 004 swimmer.
+/// The figures of a vehicle's own planner, one line: a crawler's Lu et al. 2023 terms, an energy
+/// plan's Zhang et al. 2022 terms, an inspection tour's Hu et al. 2023 figures, an AUV's height above a seabed;
+/// `None` for a plain Zhi & Zuo 2024 swimmer.
 fn capability_line(v: &VehiclePlan) -> Option<String> {
     let mut parts = Vec::new();
     if let Some(c) = &v.crawler {

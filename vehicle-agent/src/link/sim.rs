@@ -42,7 +42,7 @@ impl SimLink {
                     .map(|c| c.field(scenario.bounds.min[2], scenario.bounds.max[2])),
                 surface_z: scenario.bounds.max[2],
             },
-            // A seed 002 coverage crawler drives on the mission's 2.5-D seabed map, the one its
+            // A CPP-DSMV coverage crawler drives on the mission's 2.5-D seabed map, the one its
             // path was planned on (a heightmap file is looked up from the working directory,
             // as the agent's planning does).
             VehicleKind::Crawler if scenario.coverage.is_some() => {
@@ -88,7 +88,7 @@ impl SimLink {
 
 /// Battery drain of a simulated vehicle, fraction of a charge per hour underway: an AUV's own
 /// battery ([`SimSettings`]'s default, ten hours), none for a crawler. A deep-sea collector is
-/// powered from its support vessel through the umbilical of its riser (seed 000's P1–P3 are
+/// powered from its support vessel through the umbilical of its riser (Lu et al.'s P1–P3 are
 /// tens of kW for hours on end), so a coverage mission of a day or more does not end flat; a
 /// battery limit made every crawler of `cpp-fleet` fault ten hours into its 22–26 h strip.
 fn battery_per_hour(kind: VehicleKind) -> f64 {

@@ -42,7 +42,7 @@ pub struct HybridAStarParams {
 impl Default for HybridAStarParams {
     fn default() -> Self {
         Self {
-            // A heavy tracked crawler; rows are 2·R_min = 10 m apart in seed 002's pattern.
+            // A heavy tracked crawler; rows are 2·R_min = 10 m apart in CPP-DSMV's pattern.
             min_turn_radius_m: 5.0,
             // ≥ √2·xy_resolution_m; a full-lock step turns 0.6 rad (34°), half lock 17°.
             step_m: 3.0,

@@ -1,4 +1,4 @@
-//! Exact zero-order-hold discretisation of the V-MPC error model (seed 002 §2.3.2), see
+//! Exact zero-order-hold discretisation of the V-MPC error model (CPP-DSMV, §2.3.2), see
 //! [`super::mpc`] for the continuous model.
 
 use super::params::TrackingParams;

@@ -1,4 +1,4 @@
-//! Terrain-Adaptive Adaptive Extended Kalman Filter, TA-AEKF (seed 002 §2.3.1, rebuilt).
+//! Terrain-Adaptive Adaptive Extended Kalman Filter, TA-AEKF (CPP-DSMV, §2.3.1, rebuilt).
 //!
 //! State `x = [x, y, ψ, δs, d]`: position (m), heading (rad), a residual of the longitudinal slip
 //! ratio beyond the terrain law (-), and a residual lateral drift beyond the roll law (m/s). Both
@@ -19,7 +19,7 @@ pub type State = SVector<f64, NX>;
 /// State covariance / Jacobian.
 pub type Mat = SMatrix<f64, NX, NX>;
 
-/// seed 002 §2.3.1, prediction model (one sub-step dt, gradient g taken at the prior position):
+/// CPP-DSMV, §2.3.1, prediction model (one sub-step dt, gradient g taken at the prior position):
 ///   θ, φ from g and ψ (see [`attitude`]); s = clamp(s0 + k_s·max(θ,0) + δs, 0, s_max);
 ///   v_x = u·cosθ·(1 − s);  v_y = −k_d·v_x·sinφ + d       (predicted sideslip from the roll);
 ///   ψ_m = ψ + ω_g·dt/2;
@@ -120,7 +120,7 @@ impl Ekf {
         self.x[4]
     }
 
-    /// seed 002 §2.3.1, terrain-adaptive prediction: x ← f(x), P ← F P Fᵀ + Q with
+    /// CPP-DSMV, §2.3.1, terrain-adaptive prediction: x ← f(x), P ← F P Fᵀ + Q with
     ///   Q = dt·(1 + k_q·|∇z|)·diag(q_pos, q_pos, q_ψ, q_s, q_d) + diag(0, 0, (σ_g·dt)², 0, 0):
     /// steeper ground ⇒ less trust in the slip/drift law.
     pub fn predict(
@@ -165,7 +165,7 @@ impl Ekf {
         self.symmetrize();
     }
 
-    /// seed 002 §2.3.1, position-fix update with adaptive R:
+    /// CPP-DSMV, §2.3.1, position-fix update with adaptive R:
     ///   ν = z − H x,  H = [I₂ 0];
     ///   Sage–Husa (diagonal), k ≥ 1 the fix count including this one: d_k = (1 − b)/(1 − b^(k+1)),
     ///     R̂_k = (1 − d_k)·R̂_(k−1) + d_k·diag(ν νᵀ − H P⁻ Hᵀ), clamped to [f_lo, f_hi]·σ_fix²;

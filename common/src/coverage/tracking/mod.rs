@@ -1,9 +1,9 @@
-//! Closed-loop trajectory tracking under terrain disturbances (seed 002 §2.3 and §2.4): a
+//! Closed-loop trajectory tracking under terrain disturbances (CPP-DSMV, §2.3 and §2.4): a
 //! terrain-aware crawler plant, a terrain-adaptive adaptive EKF (TA-AEKF) and a variable-weight
 //! MPC (V-MPC) solved as a QP with Clarabel, run together along a coverage reference.
 //!
 //! The seed's equations were lost in extraction; the ones used here are rebuilt from its text and
-//! standard formulations and written next to the code (`// seed 002 §…`). In short:
+//! standard formulations and written next to the code (`// CPP-DSMV, §…`). In short:
 //!
 //! - **Plant** ([`plant`]): pose `(x, y, ψ)`; pitch `θ = atan(∇z·(cosψ, sinψ))`, roll
 //!   `φ = atan(∇z·(−sinψ, cosψ))`; track speed `u` and yaw rate `ω` behind a first-order lag with

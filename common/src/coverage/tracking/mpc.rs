@@ -1,7 +1,7 @@
-//! Variable-weight Model Predictive Control, V-MPC (seed 002 §2.3.2, rebuilt), solved as a dense
+//! Variable-weight Model Predictive Control, V-MPC (CPP-DSMV, §2.3.2, rebuilt), solved as a dense
 //! condensed QP with Clarabel.
 //!
-//! seed 002 §2.3.2, error model in the path (Frenet) frame about the reference point, with the
+//! CPP-DSMV, §2.3.2, error model in the path (Frenet) frame about the reference point, with the
 //! actuator lags of the plant as extra states, z = [e_y, e_ψ, ω_a, v_a], u = [ω_c, v_c]:
 //!   ė_y = a·e_ψ + w_y                       (a = η·v_r, w_y = predicted lateral drift)
 //!   ė_ψ = ω_a − κ·η·v_a − κ²·a·e_y          (linearised ω − κ·ṡ, ṡ = η·v·cos e_ψ/(1 − κ e_y))
@@ -46,7 +46,7 @@ pub struct StageWeights {
     pub rd_yaw_rate: f64,
 }
 
-/// seed 002 §2.3.2, the variable-weight law: with the normalised curvature ρ = min(|κ|·R_min, 1),
+/// CPP-DSMV, §2.3.2, the variable-weight law: with the normalised curvature ρ = min(|κ|·R_min, 1),
 ///   q_y(κ) = q_y,str + ρ·(q_y,arc − q_y,str),  q_ψ(κ) = q_ψ,str + ρ·(q_ψ,arc − q_ψ,str),
 ///   r_Δω(κ) = r_Δω,str + ρ·(r_Δω,arc − r_Δω,str).
 /// On straights the lateral error dominates and yaw-rate changes are expensive (smooth, low

@@ -1,4 +1,4 @@
-//! The truth model of the crawler on the 2.5D seabed (seed 002 §2.2 "Kinematic model of the
+//! The truth model of the crawler on the 2.5D seabed (CPP-DSMV, §2.2 "Kinematic model of the
 //! mining vehicle", rebuilt) and the terrain–traction law shared with the EKF and the MPC.
 
 use super::params::TrackingParams;
@@ -14,7 +14,7 @@ pub struct Attitude {
     pub roll: f64,
 }
 
-/// seed 002 §2.2: the body sits on the local tangent plane of `z(x, y)`, so with `g = ∇z`
+/// CPP-DSMV, §2.2: the body sits on the local tangent plane of `z(x, y)`, so with `g = ∇z`
 ///   θ = atan(g · (cosψ, sinψ)),   φ = atan(g · (−sinψ, cosψ)).
 pub fn attitude(g: [f64; 2], heading: f64) -> Attitude {
     let (s, c) = heading.sin_cos();
@@ -24,7 +24,7 @@ pub fn attitude(g: [f64; 2], heading: f64) -> Attitude {
     }
 }
 
-/// seed 002 §2.2 (longitudinal slip): `s = clamp(s0 + k_s·max(θ, 0) + δ, 0, s_max)`, where δ is a
+/// CPP-DSMV, §2.2 (longitudinal slip): `s = clamp(s0 + k_s·max(θ, 0) + δ, 0, s_max)`, where δ is a
 /// random (plant) or estimated (EKF) residual. Returns the slip and `∂s/∂θ`, `∂s/∂δ`.
 pub fn slip_ratio(pitch: f64, residual: f64, p: &TrackingParams) -> (f64, f64, f64) {
     let raw = p.base_slip + p.slip_pitch_gain * pitch.max(0.0) + residual;
@@ -49,7 +49,7 @@ pub struct BodyVelocity {
     pub efficiency: f64,
 }
 
-/// seed 002 §2.2, effective speeds of a tracked vehicle of track speed `u` on the slope:
+/// CPP-DSMV, §2.2, effective speeds of a tracked vehicle of track speed `u` on the slope:
 ///   v_x = u·cosθ·(1 − s)          (pitch attenuation: planar projection and slip),
 ///   v_y = −k_d·v_x·sinφ           (gravity-induced sideslip, down-slope, i.e. sideslip angle
 ///                                   β = atan(v_y/v_x) = −atan(k_d·sinφ)).

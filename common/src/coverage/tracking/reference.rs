@@ -1,5 +1,5 @@
 //! The sampled reference path: windowed monotone projection (progress and signed cross-track
-//! error, seed 002 §3 Figure 7(c)) and look-ups by arc length for the MPC horizon.
+//! error, CPP-DSMV, §3 Figure 7(c)) and look-ups by arc length for the MPC horizon.
 
 use super::types::{wrap_angle, PathSample, TrackingError};
 

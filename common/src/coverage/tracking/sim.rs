@@ -1,4 +1,4 @@
-//! The closed loop (seed 002 §2.3, Figure 1 execution layer): plant → sensors → TA-AEKF →
+//! The closed loop (CPP-DSMV, §2.3, Figure 1 execution layer): plant → sensors → TA-AEKF →
 //! V-MPC → plant, with the cross-track statistics of §3 Figure 7(c).
 
 use super::ekf::Ekf;
@@ -111,7 +111,7 @@ pub fn track_from_pose(
     let mut t = 0.0;
 
     loop {
-        // Cross-track error of the TRUE position (seed 002 §3, Figure 7(c)).
+        // Cross-track error of the TRUE position (CPP-DSMV, §3, Figure 7(c)).
         let tp = r.project(
             &mut truth_cursor,
             plant.pose.x,

@@ -166,7 +166,7 @@ pub struct Coefficients {
 pub enum Schedule {
     /// Constant (classic PSO, MP-PSO: ω = 0.15, c1 = c2 = c3 = 1.5 in Table 5).
     Fixed(Coefficients),
-    /// Seed 004 eq. (7)–(8): ω = 2 − 2a/b, c1 = 2 − a/b, c2 = 1 + a/b, c3 = 2 − a/b.
+    /// Zhi & Zuo 2024, eq. (7)–(8): ω = 2 − 2a/b, c1 = 2 − a/b, c2 = 1 + a/b, c3 = 2 − a/b.
     Adaptive,
 }
 

@@ -44,13 +44,13 @@ pub trait Problem: Sync {
         c
     }
     /// True when `x` meets every hard constraint of the problem. Solvers that keep a set of
-    /// feasible solutions (EPA-PSO, seed 001 §3.2.2) ask it; the default calls everything
+    /// feasible solutions (EPA-PSO, Zhang et al. 2022, §3.2.2) ask it; the default calls everything
     /// feasible, which is right for unconstrained problems.
     fn feasible(&self, x: &[f64]) -> bool {
         let _ = x;
         true
     }
-    /// An initial position. Default: uniform in the box (seed 004 §3.1, `g ~ U`).
+    /// An initial position. Default: uniform in the box (Zhi & Zuo 2024, §3.1, `g ~ U`).
     fn sample(&self, rng: &mut StdRng) -> Vec<f64> {
         self.lower()
             .iter()

@@ -40,7 +40,7 @@ pub trait SolverState {
 ///
 /// # Example
 ///
-/// A 2-D bowl with its minimum at (1, −2), solved by seed 000's standard PSO:
+/// A 2-D bowl with its minimum at (1, −2), solved by Lu et al.'s standard PSO:
 ///
 /// ```
 /// use shoal_common::swarm::pso::Pso;

@@ -1,4 +1,4 @@
-//! ACO-PSO, seed 000's ant colony + PSO hybrid baseline (ref. \[7\], Shi, Bu & Li 2008) with the
+//! ACO-PSO, Lu et al.'s ant colony + PSO hybrid baseline (ref. \[7\], Shi, Bu & Li 2008) with the
 //! settings of Table 4 (functions: M = 30, t_max = 300) and Table 8 (crawler path: M = 50,
 //! t_max = 100): c1 = c2 = 2, ω = 0.5, α = 1, β = 5, ρ = 0.5. Ref. \[7\] plans on a 2-D grid,
 //! where ants walk from cell to cell; the seed gives no more detail and its problems are

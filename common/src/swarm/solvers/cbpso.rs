@@ -1,4 +1,4 @@
-//! CBPSO, seed 000's chaos-based PSO baseline (Table 4 / Table 8: c1 = c2 = 2, ω from 0.9 down
+//! CBPSO, Lu et al.'s chaos-based PSO baseline (Table 4 / Table 8: c1 = c2 = 2, ω from 0.9 down
 //! to 0.4, μ = 4): the initial swarm comes from the logistic map `z ← μ z (1 − z)` instead of
 //! uniform draws — one chaotic sequence per dimension, seeded from the run's RNG — and the
 //! inertia weight falls linearly over the run. Moves are eq. (5) of the shared update.

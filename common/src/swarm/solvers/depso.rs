@@ -1,4 +1,4 @@
-//! DE-PSO, seed 003 §IV-A: PSO with a differential-evolution pass after every move.
+//! DE-PSO, Hu et al. 2023, §IV-A: PSO with a differential-evolution pass after every move.
 //!
 //! One iteration:
 //! 1. every particle moves by eq. (18)–(19) with the LDIW inertia of eq. (3) (Table 5: ω 0.9 →
@@ -38,9 +38,9 @@ use crate::swarm::core::{Problem, Progress, Solver};
 /// Base vector of the DE mutation.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum MutationBase {
-    /// The swarm's global best, DE/best/1 (seed 003 eq. (15)).
+    /// The swarm's global best, DE/best/1 (Hu et al. 2023, eq. (15)).
     Best,
-    /// The target particle itself (seed 003 eq. (20) as printed).
+    /// The target particle itself (Hu et al. 2023, eq. (20) as printed).
     Target,
 }
 
@@ -69,7 +69,7 @@ pub struct DePso {
 }
 
 impl DePso {
-    /// Table 5's settings (seed 003): c1 = 2.0, c2 = 1.5, ω 0.9 → 0.4, F = 0.8, CR = 0.6,
+    /// Table 5's settings (Hu et al. 2023): c1 = 2.0, c2 = 1.5, ω 0.9 → 0.4, F = 0.8, CR = 0.6,
     /// DE/best/1/bin. The table's M = 60 and 400 iterations are the caller's `particles` and the
     /// executor's budget.
     pub fn table5(particles: usize, seed: u64) -> DePso {
@@ -113,11 +113,11 @@ impl DePso {
                 let b = pick_other(&mut pop.rng, n, &[i, a]);
                 let (xa, xb) = (&pop.particles[a].x, &pop.particles[b].x);
                 for d in range.clone() {
-                    // seed 003 eq. (15) / (20)
+                    // Hu et al. 2023, eq. (15) / (20)
                     trial[d] = base[d] + self.f * (xa[d] - xb[d]);
                 }
             }
-            // seed 003 eq. (30), feasible-area case: absorb onto the box.
+            // Hu et al. 2023, eq. (30), feasible-area case: absorb onto the box.
             let mut absorbed = Vec::new();
             for (d, x) in trial.iter_mut().enumerate() {
                 if *x < limits.lower[d] {
@@ -132,7 +132,7 @@ impl DePso {
             candidate.x = trial;
             candidate.evaluate(problem);
             evaluations += 1;
-            // seed 003 eq. (17): keep the trial unless it is worse.
+            // Hu et al. 2023, eq. (17): keep the trial unless it is worse.
             if candidate.cost <= pop.particles[i].cost {
                 for d in absorbed {
                     candidate.v[d] = 0.0;
@@ -172,7 +172,7 @@ impl<P: Problem> Solver<P> for DePso {
     }
 
     fn init(&mut self, problem: &P) -> PsoState {
-        // Step 1, seed 003 eq. (14): random initial positions (the problem's sampler).
+        // Step 1, Hu et al. 2023, eq. (14): random initial positions (the problem's sampler).
         PsoState::sampled(
             problem,
             self.particles,
@@ -182,7 +182,7 @@ impl<P: Problem> Solver<P> for DePso {
     }
 
     fn step(&mut self, problem: &P, mut state: PsoState, progress: Progress) -> PsoState {
-        // Step 3, seed 003 eq. (18)–(19) with the eq. (3) inertia.
+        // Step 3, Hu et al. 2023, eq. (18)–(19) with the eq. (3) inertia.
         ldiw_move(problem, &mut state, self.w, (self.c1, self.c2), progress);
         // Steps 4–6.
         state.evaluations += self.de_pass(problem, &mut state);
@@ -228,7 +228,7 @@ mod tests {
 
     #[test]
     fn de_pso_finds_the_global_minimum_of_rastrigin() {
-        // Seed 003 Table 2: DE-PSO converged on f4 in 50/50 runs.
+        // Hu et al. 2023, Table 2: DE-PSO converged on f4 in 50/50 runs.
         let r = Rastrigin::new(2);
         for seed in 0..5 {
             let out = Executor::new(200).run(&r, &mut DePso::table5(30, seed), |_| {});

@@ -1,4 +1,4 @@
-//! EPA-PSO, seed 001 §3.2: PSO with a velocity jump that grows while the swarm stagnates
+//! EPA-PSO, Zhang et al. 2022, §3.2: PSO with a velocity jump that grows while the swarm stagnates
 //! (eq. (14)), velocity limits (eq. (15)), a non-linear coefficient schedule with a constriction
 //! factor (eq. (16)), re-initialisation around the stagnated swarm (eq. (17)), and a feasible
 //! solution set from which the answer is finally chosen.
@@ -214,7 +214,7 @@ impl<P: Problem> Solver<P> for EpaPso {
     fn step(&mut self, problem: &P, mut s: EpaPsoState, progress: Progress) -> EpaPsoState {
         let (lo, hi) = (problem.lower(), problem.upper());
         let range: Vec<f64> = lo.iter().zip(hi).map(|(l, h)| h - l).collect();
-        // seed 001 eq. (16): c1, c2 rise towards their maxima, c3 falls towards its minimum,
+        // Zhang et al. 2022, eq. (16): c1, c2 rise towards their maxima, c3 falls towards its minimum,
         // each by the share t / (α T) of the remaining gap.
         let f = progress.iteration as f64 / progress.max_iterations.max(1) as f64;
         let [w, c1, c2, c3] = &mut s.coefficients;
@@ -231,12 +231,12 @@ impl<P: Problem> Solver<P> for EpaPso {
                 let vmax = self.max_velocity_fraction * range[d];
                 let (r1, r2): (f64, f64) = (s.rng.random(), s.rng.random());
                 let r3: f64 = s.rng.random_range(-1.0..=1.0);
-                // seed 001 eq. (14), the jump in units of a 100 m map.
+                // Zhang et al. 2022, eq. (14), the jump in units of a 100 m map.
                 let v = inertia * s.v[i][d]
                     + c1 * r1 * (s.pbest[i].0[d] - s.x[i][d])
                     + c2 * r2 * (s.gbest.x[d] - s.x[i][d])
                     + jump * r3 * range[d] / 100.0;
-                // seed 001 eq. (15).
+                // Zhang et al. 2022, eq. (15).
                 s.v[i][d] = v.clamp(-vmax, vmax);
                 let moved = s.x[i][d] + s.v[i][d];
                 if moved < lo[d] || moved > hi[d] {
@@ -266,7 +266,7 @@ impl<P: Problem> Solver<P> for EpaPso {
             s.stagnation += 1;
         }
         if s.stagnation > self.n_smax {
-            // seed 001 eq. (17): keep the stagnated best, move every particle by its
+            // Zhang et al. 2022, eq. (17): keep the stagnated best, move every particle by its
             // standardised position and start the memories afresh.
             s.archive.push(s.gbest.clone());
             let n = s.x.len() as f64;

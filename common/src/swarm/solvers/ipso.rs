@@ -1,4 +1,4 @@
-//! IPSO, the improved PSO of seed 000 §3.2 (eq. (19)–(26)), for the mining crawler's path and the
+//! IPSO, the improved PSO of Lu et al. 2023, §3.2 (eq. (19)–(26)), for the mining crawler's path and the
 //! benchmark functions:
 //! - a third attractor, the mean of the personal bests `s` (eq. (21)), with `c3 = 1 + t/t_max`
 //!   (eq. (20)), in the velocity update of eq. (19)/(26);

@@ -1,4 +1,4 @@
-//! LCPSO, seed 003 §III-A-3 (after Nkwanyana and Wang): the inertia weight blends a linearly
+//! LCPSO, Hu et al. 2023, §III-A-3 (after Nkwanyana and Wang): the inertia weight blends a linearly
 //! decreasing weight `w^l` (eq. (5)) and a chaotic one `w^c` (eq. (6)–(8)) driven by the logistic
 //! map `u ← ρ u (1 − u)` (eq. (4)), as `w^ζ = ζ (w^l + w^c)` (eq. (9)), and particles move by
 //! eq. (10) (the shared update of [`update`](crate::swarm::core::population::update) with ω = w^ζ).
@@ -59,14 +59,14 @@ impl Lcpso {
     /// `ζ · [(w_max − Δw·t/t_max) + (Δw·(t_max − t)/t_max + w_min·u)]`.
     pub fn weight(&self, progress: Progress, u: f64) -> f64 {
         let (w_max, w_min) = self.w;
-        let dw = w_max - w_min; // seed 003 eq. (8)
+        let dw = w_max - w_min; // Hu et al. 2023, eq. (8)
         let r = progress.fraction(); // t / t_max
-        let wl = w_max - dw * r; // seed 003 eq. (5)
-        let wc = dw * (1.0 - r) + w_min * u; // seed 003 eq. (6)–(7)
-        self.zeta * (wl + wc) // seed 003 eq. (9)
+        let wl = w_max - dw * r; // Hu et al. 2023, eq. (5)
+        let wc = dw * (1.0 - r) + w_min * u; // Hu et al. 2023, eq. (6)–(7)
+        self.zeta * (wl + wc) // Hu et al. 2023, eq. (9)
     }
 
-    /// One logistic-map step (seed 003 eq. (4)). A value that falls onto 0, 1 or the fixed point
+    /// One logistic-map step (Hu et al. 2023, eq. (4)). A value that falls onto 0, 1 or the fixed point
     /// `1 − 1/ρ` (where the map would stay forever) is replaced by a fresh random start.
     pub fn logistic(&self, u: f64, rng: &mut StdRng) -> f64 {
         let next = self.rho * u * (1.0 - u);
@@ -131,7 +131,7 @@ impl<P: Problem> Solver<P> for Lcpso {
             c3: 0.0,
         };
         let pso = &mut state.pso;
-        // seed 003 eq. (10): the usual update with ω = w^ζ.
+        // Hu et al. 2023, eq. (10): the usual update with ω = w^ζ.
         pso.evaluations += pso.population.step(problem, c, None, &pso.limits);
         state
     }

@@ -1,4 +1,4 @@
-//! LDIW-PSO, seed 003 §III-A-2: PSO whose inertia weight falls linearly from `w_ini` to `w_end`
+//! LDIW-PSO, Hu et al. 2023, §III-A-2: PSO whose inertia weight falls linearly from `w_ini` to `w_end`
 //! over the run (eq. (3), after Shi and Eberhart), moving by the shared update of
 //! [`update`](crate::swarm::core::population::update). It is the seed's baseline for leg planning (Table 6) and the
 //! inertia schedule DE-PSO reuses.
@@ -11,11 +11,11 @@ use super::pso::PsoState;
 use crate::swarm::core::population::Coefficients;
 use crate::swarm::core::{Problem, Progress, Solver};
 
-/// Inertia weight of seed 003 eq. (3): `w(k) = (T_max − T)/T_max · (w_ini − w_end) + w_end`,
+/// Inertia weight of Hu et al. 2023, eq. (3): `w(k) = (T_max − T)/T_max · (w_ini − w_end) + w_end`,
 /// with `T / T_max` taken from `progress` (so `w_ini` at the first iteration, approaching `w_end`
 /// at the last).
 pub fn ldiw_weight(w_ini: f64, w_end: f64, progress: Progress) -> f64 {
-    // seed 003 eq. (3)
+    // Hu et al. 2023, eq. (3)
     (1.0 - progress.fraction()) * (w_ini - w_end) + w_end
 }
 
@@ -38,7 +38,7 @@ pub struct LdiwPso {
 }
 
 impl LdiwPso {
-    /// Table 5's PSO settings (seed 003): c1 = 2.0, c2 = 1.5, ω 0.9 → 0.4.
+    /// Table 5's PSO settings (Hu et al. 2023): c1 = 2.0, c2 = 1.5, ω 0.9 → 0.4.
     pub fn table5(particles: usize, seed: u64) -> LdiwPso {
         LdiwPso {
             particles,
@@ -77,7 +77,7 @@ impl<P: Problem> Solver<P> for LdiwPso {
     }
 
     fn init(&mut self, problem: &P) -> PsoState {
-        // seed 003 eq. (14): uniform initial positions (or the problem's own sampler).
+        // Hu et al. 2023, eq. (14): uniform initial positions (or the problem's own sampler).
         PsoState::sampled(
             problem,
             self.particles,

@@ -1,4 +1,4 @@
-//! Multi-population PSO with a leader population (seed 004 §3.2–3.3): AMP-PSO with the adaptive
+//! Multi-population PSO with a leader population (Zhi & Zuo 2024, §3.2–3.3): AMP-PSO with the adaptive
 //! coefficients of eq. (7)–(8), and MP-PSO with Table 5's fixed ones (c3 = 1.5).
 //!
 //! Every iteration each follower population moves by eq. (5) on its own. Every `exchange_every`
@@ -13,9 +13,9 @@ use crate::swarm::core::population::{
 };
 use crate::swarm::core::{parallel, Problem, Progress, Solver, SolverState};
 
-/// Velocity cap of seed 004's solvers, as a fraction of each dimension's range: eq. (7) starts
+/// Velocity cap of Zhi & Zuo's solvers, as a fraction of each dimension's range: eq. (7) starts
 /// ω at 2, which diverges without a limit; 0.1 is the common PSO choice (docs/AMP-PSO.md).
-pub const SEED004_VELOCITY_CAP: f64 = 0.1;
+pub const AMP_PSO_VELOCITY_CAP: f64 = 0.1;
 
 /// Multi-population PSO with a leader.
 #[derive(Debug, Clone)]
@@ -47,7 +47,7 @@ impl MultiPso {
             leader_particles: 20,
             exchange_every: 1,
             schedule: Schedule::Adaptive,
-            max_velocity_fraction: SEED004_VELOCITY_CAP,
+            max_velocity_fraction: AMP_PSO_VELOCITY_CAP,
             threads: 2,
             seed,
         }
@@ -195,7 +195,7 @@ pub struct LeaderMove {
     pub evaluations: u64,
 }
 
-/// Fig. 5b, the leader update of seed 004 §3.2.2 that the in-process solver and the
+/// Fig. 5b, the leader update of Zhi & Zuo 2024, §3.2.2 that the in-process solver and the
 /// coordinator's distributed leader both run: the leader's own particles and the `immigrants`
 /// move by eq. (6) towards the leader's o_gbest (assembled from them, trusted only if it beats
 /// `elite`, the best truly evaluated position they know) and the followers' `f_gbest`. The moves

@@ -1,4 +1,4 @@
-//! NSPSO, seed 000's non-dominated sorting PSO baseline (ref. \[46\], Li 2003) with the settings of
+//! NSPSO, Lu et al.'s non-dominated sorting PSO baseline (ref. \[46\], Li 2003) with the settings of
 //! Table 4 (functions: M = 30, t_max = 300) and Table 8 (crawler path: M = 50, t_max = 100):
 //! c1 = c2 = 2 and an inertia weight falling linearly from ω_max = 0.9 to ω_min = 0.4. The seed
 //! gives nothing more, so Shoal reads Li's algorithm as follows.
@@ -49,7 +49,7 @@ pub struct Nspso {
     /// ω at the first and at the last iteration (ω_max = 0.9 → ω_min = 0.4).
     pub w: (f64, f64),
     /// Share of the first front, least crowded first, that leaders are drawn from (not in
-    /// seed 000; Li draws from "a top part" of the sorted front).
+    /// Lu et al. 2023; Li draws from "a top part" of the sorted front).
     pub leader_share: f64,
     /// Sort on per-block costs instead of the total when the problem has several blocks.
     pub block_objectives: bool,

@@ -1,4 +1,4 @@
-//! Single-population PSO: classic PSO (fixed ω = 0.15, c1 = c2 = 1.5, seed 004 Table 5) and
+//! Single-population PSO: classic PSO (fixed ω = 0.15, c1 = c2 = 1.5, Zhi & Zuo 2024, Table 5) and
 //! A-PSO (the adaptive coefficients of eq. (7)), both updating by eq. (5).
 
 use crate::swarm::core::population::{Limits, Population, Schedule};
@@ -23,12 +23,12 @@ impl Pso {
         Pso {
             particles,
             schedule: Schedule::TABLE5_FIXED,
-            max_velocity_fraction: super::multi::SEED004_VELOCITY_CAP,
+            max_velocity_fraction: super::multi::AMP_PSO_VELOCITY_CAP,
             seed,
         }
     }
 
-    /// SPSO, seed 000's standard PSO baseline (Table 4 / Table 8): ω = 0.5, c1 = c2 = 2.
+    /// SPSO, Lu et al.'s standard PSO baseline (Table 4 / Table 8): ω = 0.5, c1 = c2 = 2.
     pub fn spso(particles: usize, seed: u64) -> Pso {
         Pso {
             schedule: Schedule::Fixed(crate::swarm::core::population::Coefficients {

@@ -1,4 +1,4 @@
-//! `bench-cages`: seed 003's comparison (§V-B, Table 6) — LDIW-PSO, LCPSO and DE-PSO planning the
+//! `bench-cages`: Hu et al.'s comparison (§V-B, Table 6) — LDIW-PSO, LCPSO and DE-PSO planning the
 //! cage-inspection tour of groups A and B, several seeds each — as a markdown table with the
 //! paper's numbers beside ours.
 
@@ -28,10 +28,10 @@ pub struct BenchCagesArgs {
     pub out: Option<PathBuf>,
 }
 
-/// Seed 003's three leg swarms, in Table 6's order.
+/// Hu et al.'s three leg swarms, in Table 6's order.
 pub const METHODS: [Algorithm; 3] = [Algorithm::LdiwPso, Algorithm::Lcpso, Algorithm::DePso];
 
-/// Seed 003 Table 6: (group, method, mean growth m, variance m², std m, mean growth rate %);
+/// Hu et al. 2023, Table 6: (group, method, mean growth m, variance m², std m, mean growth rate %);
 /// `None` where the paper's LCPSO found no complete route.
 const PAPER: [(&str, &str, Option<[f64; 4]>); 6] = [
     ("A", "ldiw-pso", Some([500.654, 3259.42, 57.0913, 23.72])),

@@ -1,4 +1,4 @@
-//! `shoal-coordinator bench-coverage`: seed 002's Table 2 comparison (arc method vs the Hybrid
+//! `shoal-coordinator bench-coverage`: CPP-DSMV's Table 2 comparison (arc method vs the Hybrid
 //! A* baseline) over seeded maps.
 
 use std::path::{Path, PathBuf};
@@ -30,7 +30,7 @@ pub struct BenchCoverageArgs {
     pub out: Option<PathBuf>,
 }
 
-/// Runs both methods on every seed and prints seed 002 Table 2 style rows. A raised `stop`
+/// Runs both methods on every seed and prints CPP-DSMV, Table 2 style rows. A raised `stop`
 /// (Ctrl-C) ends the bench: the run it cut short is left out, the tables hold the finished ones.
 pub fn bench_coverage(args: &BenchCoverageArgs, stop: &AtomicBool) -> anyhow::Result<i32> {
     let scenario = Scenario::load(&args.scenario)?;

@@ -1,4 +1,4 @@
-//! `bench-energy`: seed 001's comparison (§4, Tables 3–4) — PSO on length only, M-PSO and
+//! `bench-energy`: Zhang et al.'s comparison (§4, Tables 3–4) — PSO on length only, M-PSO and
 //! EPA-PSO at several iteration budgets over several seeds — as a markdown table with the
 //! paper's numbers beside ours.
 
@@ -32,10 +32,10 @@ pub struct BenchEnergyArgs {
     pub out: Option<PathBuf>,
 }
 
-/// The three methods of seed 001 §4, in the paper's order.
+/// The three methods of Zhang et al. 2022, §4, in the paper's order.
 pub const METHODS: [Algorithm; 3] = [Algorithm::PsoLength, Algorithm::MPso, Algorithm::EpaPso];
 
-/// Seed 001 Table 3 (fitness, q_e, q_r, q_a, q_path) and Table 4 (f_f), by budget then method.
+/// Zhang et al. 2022, Table 3 (fitness, q_e, q_r, q_a, q_path) and Table 4 (f_f), by budget then method.
 const PAPER: [(usize, [[f64; 6]; 3]); 3] = [
     (
         100,
@@ -74,7 +74,7 @@ pub struct Run {
     pub seed: u64,
     /// The method's own final fitness.
     pub fitness: f64,
-    /// Seed 001 figures of the final path.
+    /// Zhang et al. 2022 figures of the final path.
     pub terms: EnergyTerms,
     /// No violation at all.
     pub feasible: bool,
@@ -191,7 +191,7 @@ pub fn markdown(runs: &[Run]) -> String {
             ));
         }
     }
-    s.push_str("\nSeed 001's own numbers (Table 3, Table 4; its energy unit is not stated, its fitness is normalised differently):\n\n");
+    s.push_str("\nZhang et al.'s own numbers (Table 3, Table 4; its energy unit is not stated, its fitness is normalised differently):\n\n");
     s.push_str(
         "| iterations | method | fitness | q_e | q_r | q_a | q_path | f_f | q_e / PSO's |\n",
     );

@@ -1,5 +1,5 @@
 //! `shoal-coordinator bench-functions`: every optimizer Shoal has on the benchmark functions of
-//! seed 000 §4 (Table 3, f1–f12) and seed 003's Schaffer F6, with seed 000 Table 4's budget
+//! Lu et al. 2023, §4 (Table 3, f1–f12) and Hu et al.'s Schaffer F6, with Lu et al. 2023, Table 4's budget
 //! (M = 30 particles, t_max = 300 iterations, D = 30 for f1–f8). Prints best / mean / std over the
 //! runs like Table 5 and the Wilcoxon rank-sum p-values of IPSO against each other algorithm like
 //! Table 6.
@@ -26,7 +26,7 @@ pub use report::{Cell, FunctionInfo, Report, LATE_SHARE, MULTI_POPULATIONS};
 /// `shoal-coordinator bench-functions`.
 #[derive(Debug, Clone, clap::Args)]
 pub struct BenchFunctionsArgs {
-    /// Independent runs per function and algorithm (seed 000 §4: 50).
+    /// Independent runs per function and algorithm (Lu et al. 2023, §4: 50).
     #[arg(long, env = "SHOAL_RUNS", default_value_t = 50)]
     pub runs: usize,
     /// Algorithms, comma-separated (default: all): ipso, spso, cbpso, nspso, aco-pso, pso,
@@ -52,7 +52,7 @@ pub struct BenchFunctionsArgs {
     #[arg(long, env = "SHOAL_PARTICLES", default_value_t = 30)]
     pub particles: usize,
     /// Velocity cap of every solver, as a fraction of each dimension's range (no seed gives
-    /// one). Default: each solver's own — 0.1 for seed 004's, 0.2 for the others.
+    /// one). Default: each solver's own — 0.1 for Zhi & Zuo's, 0.2 for the others.
     #[arg(long, env = "SHOAL_MAX_VELOCITY_FRACTION")]
     pub max_velocity_fraction: Option<f64>,
     /// Worker threads (default: all cores); the results do not depend on it.
@@ -132,8 +132,8 @@ impl Algorithm {
     }
 }
 
-/// Every optimizer Shoal has, in table order (seed 000's five, seed 004's four, seed 001's
-/// EPA-PSO, seed 003's three). A new solver is one line here, once it is in the catalog.
+/// Every optimizer Shoal has, in table order (Lu et al.'s five, Zhi & Zuo's four, Zhang et al.'s
+/// EPA-PSO, Hu et al.'s three). A new solver is one line here, once it is in the catalog.
 pub fn solvers() -> Vec<Algorithm> {
     let a = |algorithm: scenario::Algorithm, about| Algorithm {
         name: algorithm.as_str(),
@@ -143,55 +143,55 @@ pub fn solvers() -> Vec<Algorithm> {
     vec![
         a(
             scenario::Algorithm::Ipso,
-            "seed 000 IPSO, Table 4: c1, c2 2 → 0.5, ω ∈ [0.4, 0.9] by fitness, p = 5 %",
+            "Lu et al. 2023 IPSO, Table 4: c1, c2 2 → 0.5, ω ∈ [0.4, 0.9] by fitness, p = 5 %",
         ),
         a(
             scenario::Algorithm::Spso,
-            "seed 000 SPSO, Table 4: ω = 0.5, c1 = c2 = 2",
+            "Lu et al. 2023 SPSO, Table 4: ω = 0.5, c1 = c2 = 2",
         ),
         a(
             scenario::Algorithm::Cbpso,
-            "seed 000 CBPSO, Table 4: chaotic start (μ = 4), ω 0.9 → 0.4, c1 = c2 = 2",
+            "Lu et al. 2023 CBPSO, Table 4: chaotic start (μ = 4), ω 0.9 → 0.4, c1 = c2 = 2",
         ),
         a(
             scenario::Algorithm::Nspso,
-            "seed 000 NSPSO, Table 4: ω 0.9 → 0.4, c1 = c2 = 2, one objective",
+            "Lu et al. 2023 NSPSO, Table 4: ω 0.9 → 0.4, c1 = c2 = 2, one objective",
         ),
         a(
             scenario::Algorithm::AcoPso,
-            "seed 000 ACO-PSO, Table 4: SPSO + continuous ant colony (α = 1, β = 5, ρ = 0.5)",
+            "Lu et al. 2023 ACO-PSO, Table 4: SPSO + continuous ant colony (α = 1, β = 5, ρ = 0.5)",
         ),
         a(
             scenario::Algorithm::Pso,
-            "seed 004 PSO, Table 5 coefficients: ω = 0.15, c1 = c2 = 1.5",
+            "Zhi & Zuo 2024 PSO, Table 5 coefficients: ω = 0.15, c1 = c2 = 1.5",
         ),
         a(
             scenario::Algorithm::APso,
-            "seed 004 A-PSO: eq. (7) adaptive coefficients, one population",
+            "Zhi & Zuo 2024 A-PSO: eq. (7) adaptive coefficients, one population",
         ),
         a(
             scenario::Algorithm::MpPso,
-            "seed 004 MP-PSO: Table 5 coefficients, M split as below",
+            "Zhi & Zuo 2024 MP-PSO: Table 5 coefficients, M split as below",
         ),
         a(
             scenario::Algorithm::AmpPso,
-            "seed 004 AMP-PSO: eq. (7)–(8), M split as below",
+            "Zhi & Zuo 2024 AMP-PSO: eq. (7)–(8), M split as below",
         ),
         a(
             scenario::Algorithm::EpaPso,
-            "seed 001 EPA-PSO, Table 2: velocity jump, eq. (16) schedule, eq. (17) restarts",
+            "Zhang et al. 2022 EPA-PSO, Table 2: velocity jump, eq. (16) schedule, eq. (17) restarts",
         ),
         a(
             scenario::Algorithm::LdiwPso,
-            "seed 003 LDIW-PSO, Table 5: ω 0.9 → 0.4, c1 = 2, c2 = 1.5",
+            "Hu et al. 2023 LDIW-PSO, Table 5: ω 0.9 → 0.4, c1 = 2, c2 = 1.5",
         ),
         a(
             scenario::Algorithm::Lcpso,
-            "seed 003 LCPSO, Table 5: logistic-chaos inertia (eq. 4–10)",
+            "Hu et al. 2023 LCPSO, Table 5: logistic-chaos inertia (eq. 4–10)",
         ),
         a(
             scenario::Algorithm::DePso,
-            "seed 003 DE-PSO, Table 5: PSO move + DE/best/1/bin (F = 0.8, CR = 0.6); 2 evaluations per particle per iteration",
+            "Hu et al. 2023 DE-PSO, Table 5: PSO move + DE/best/1/bin (F = 0.8, CR = 0.6); 2 evaluations per particle per iteration",
         ),
     ]
 }

@@ -1,4 +1,4 @@
-//! The coordinator's mission loop: agents join, then exchange rounds (seed 004 Fig. 5) until
+//! The coordinator's mission loop: agents join, then exchange rounds (Zhi & Zuo 2024, Fig. 5) until
 //! the budget is spent. Each round every agent's elites come up, the leader exchanges, and the
 //! new context (when due) and the migrants go back down. A vehicle whose agent vanishes or
 //! stops answering is planned here from its last elites (degraded mode) and the plan says so.
@@ -186,7 +186,7 @@ pub fn run(
     Ok((result, figures))
 }
 
-/// Runs a one-shot mission (tours of seed 003, coverage strips of seed 002): every agent plans
+/// Runs a one-shot mission (tours of Hu et al. 2023, coverage strips of CPP-DSMV): every agent plans
 /// its own share; see `shares`. Returns every vehicle's share and the figures.
 #[allow(clippy::too_many_arguments)] // `run`'s inputs plus the job
 pub fn run_share_mission(

@@ -11,9 +11,9 @@ use shoal_common::wire::agent_to_coordinator::{tour_from_wire, AgentToCoordinato
 
 /// What the agents of a one-shot mission plan.
 pub enum ShareJob {
-    /// Inspection tours (seed 003).
+    /// Inspection tours (Hu et al. 2023).
     Tours(Box<FleetTours>),
-    /// Coverage strips (seed 002) on the seabed map.
+    /// Coverage strips (CPP-DSMV) on the seabed map.
     Strips(Box<FleetCoverage>, Box<TerrainMap25>),
 }
 

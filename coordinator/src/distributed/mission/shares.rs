@@ -1,6 +1,6 @@
 //! One-shot missions: the agents join as for any mission, then each plans its own share once
-//! and sends it up — the inspection tour of its share of the points (seed 003, [`FleetTours`])
-//! or the coverage of its strip of the area (seed 002, [`FleetCoverage`]). Every process derives
+//! and sends it up — the inspection tour of its share of the points (Hu et al. 2023, [`FleetTours`])
+//! or the coverage of its strip of the area (CPP-DSMV, [`FleetCoverage`]). Every process derives
 //! the shares from the scenario alone. A vehicle whose agent leaves, ends without a result, or
 //! stays silent past the deadline has its share planned here instead (degraded mode), so a plan
 //! is always produced.

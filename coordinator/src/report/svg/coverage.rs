@@ -1,4 +1,4 @@
-//! `plan.svg` of a coverage mission (seed 002 Figures 5–7): the shaded 2.5D map with its
+//! `plan.svg` of a coverage mission (CPP-DSMV, Figures 5–7): the shaded 2.5D map with its
 //! impassable cells, the merged no-go boxes (red), the planned path (blue) and the tracked path
 //! (orange) on the left; the three distributions of Figure 7 — clearance to impassable terrain,
 //! slope under the path, |cross-track error| — on the right.

@@ -1,4 +1,4 @@
-//! The current field in `plan.svg` (seed 001 eq. (2)): arrows on a grid over the top and side
+//! The current field in `plan.svg` (Zhang et al. 2022, eq. (2)): arrows on a grid over the top and side
 //! views, pointing where the water flows and as long as it is fast. The top view samples the
 //! field at the mean depth of the vehicles' starts and goals, the side view on the box's middle
 //! y (the analytic model varies with depth only; a gridded field anywhere).

@@ -1,4 +1,4 @@
-//! The seabed under the top view of `plan.svg` (crawler scenarios, seed 000): a shaded map of
+//! The seabed under the top view of `plan.svg` (crawler scenarios, Lu et al. 2023): a shaded map of
 //! the terrain's elevation (light = low, dark = high), contour ticks on cell edges where the
 //! elevation crosses a multiple of the contour interval (1 m on a gentle seabed, see
 //! [`contour_step`]), and the hazard cylinders (eq. (4)) as hatched

@@ -1,4 +1,4 @@
-//! Inspection points in `plan.svg` (seed 003 tours): a cross in the vehicle's colour on a white
+//! Inspection points in `plan.svg` (Hu et al. 2023 tours): a cross in the vehicle's colour on a white
 //! cross at every point a vehicle's tour visits, so which AUV inspects which side of which cage
 //! can be read off the views.
 

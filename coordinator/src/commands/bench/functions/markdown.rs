@@ -1,4 +1,4 @@
-//! The suite's report as markdown: seed 000 Table 5 (best / mean / std, plus the worst run), the
+//! The suite's report as markdown: Lu et al. 2023, Table 5 (best / mean / std, plus the worst run), the
 //! runs that found f*, the runs the budget cut short, Table 6 (Wilcoxon rank-sum p-values of IPSO
 //! against each other algorithm), evaluations per run and a legend.
 
@@ -56,7 +56,7 @@ fn write_markdown(s: &mut String, r: &Report) -> std::fmt::Result {
     let scalable_dim = r.functions.iter().find(|f| f.scalable).map(|f| f.dim);
     writeln!(
         s,
-        "## Best / mean / std of the best cost over {} runs (seed 000 Table 5)\n",
+        "## Best / mean / std of the best cost over {} runs (Lu et al. 2023, Table 5)\n",
         r.runs
     )?;
     writeln!(
@@ -68,7 +68,7 @@ fn write_markdown(s: &mut String, r: &Report) -> std::fmt::Result {
         scalable_dim.map_or(String::new(), |d| format!(", D = {d} for f1–f8")),
         r.seed,
         r.velocity_cap.map_or_else(
-            || "each solver's own (seed 004's 0.1, the others' 0.2 of each range)".to_string(),
+            || "each solver's own (Zhi & Zuo's 0.1, the others' 0.2 of each range)".to_string(),
             |c| format!("{c} of each range for every solver")
         ),
     )?;
@@ -122,7 +122,7 @@ fn write_markdown(s: &mut String, r: &Report) -> std::fmt::Result {
 
     writeln!(
         s,
-        "\n## Runs whose best is within {HIT_TOLERANCE:e} of f* (seed 003 Table 2's \
+        "\n## Runs whose best is within {HIT_TOLERANCE:e} of f* (Hu et al. 2023, Table 2's \
          convergence rate)\n"
     )?;
     counts(s, r, |c, f| {
@@ -213,7 +213,7 @@ fn write_wilcoxon(s: &mut String, r: &Report) -> std::fmt::Result {
     let names: Vec<&str> = names.iter().map(String::as_str).collect();
     writeln!(
         s,
-        "\n## Wilcoxon rank-sum p-values, IPSO against each other algorithm (seed 000 Table 6)\n"
+        "\n## Wilcoxon rank-sum p-values, IPSO against each other algorithm (Lu et al. 2023, Table 6)\n"
     )?;
     writeln!(
         s,
@@ -251,7 +251,7 @@ fn write_wilcoxon(s: &mut String, r: &Report) -> std::fmt::Result {
             .collect();
         writeln!(s, "| {} {} | {} |", f.label, f.name, ps.join(" | "))?;
     }
-    // Seed 000's own test: the best value of each of f1–f8, eight against eight.
+    // Lu et al.'s own test: the best value of each of f1–f8, eight against eight.
     let scalable: Vec<usize> = (0..r.functions.len())
         .filter(|fi| r.functions[*fi].scalable)
         .collect();
@@ -287,7 +287,7 @@ fn write_wilcoxon(s: &mut String, r: &Report) -> std::fmt::Result {
     )?;
     writeln!(
         s,
-        "\nThe \"best values of f1–f8\" row is seed 000's Table 6 test: for each pair, the best \
+        "\nThe \"best values of f1–f8\" row is Lu et al.'s Table 6 test: for each pair, the best \
          cost over the runs on each of f1–f8, IPSO's {n} against the other's {n}, ranked \
          together. It pools functions whose values differ by many orders of magnitude, so it \
          says little on its own; the per-function rows compare like with like.",
