@@ -232,12 +232,10 @@ pub fn detour(
     let grid = Grid::new(scenario, max_pitch, seabed);
     let cells = grid.search(grid.nearest(from), grid.nearest(to), stop)?;
     let mut raw = vec![from];
-    // The end nodes stand for `from` and `to` themselves.
-    raw.extend(
-        cells[1..cells.len().saturating_sub(1)]
-            .iter()
-            .map(|&k| grid.centre(k)),
-    );
+    // The end nodes stand for `from` and `to` themselves; when both are in one cell (a climb
+    // steeper than the pitch limit, in place) there is nothing between them.
+    let inner = cells.get(1..cells.len().saturating_sub(1)).unwrap_or(&[]);
+    raw.extend(inner.iter().map(|&k| grid.centre(k)));
     raw.push(to);
     // Line of sight: from each corner, jump to the farthest point still in view.
     let mut out = vec![from];
@@ -308,6 +306,22 @@ mod tests {
             Vec3::new(1900.0, 500.0, 200.0),
         );
         assert_eq!(detour(&s, a, b, 20.0, None, None), Some(vec![a, b]));
+        Ok(())
+    }
+
+    #[test]
+    fn a_climb_in_place_steeper_than_the_pitch_limit_does_not_panic(
+    ) -> Result<(), Box<dyn std::error::Error>> {
+        // From and to in one grid cell, 5 m apart vertically: not flyable at 20°, and the grid
+        // search is one cell long.
+        let s = scenario(&[])?;
+        let (a, b) = (
+            Vec3::new(500.0, 500.0, 200.0),
+            Vec3::new(500.0, 500.0, 205.0),
+        );
+        if let Some(path) = detour(&s, a, b, 20.0, None, None) {
+            assert_eq!((path.first(), path.last()), (Some(&a), Some(&b)));
+        }
         Ok(())
     }
 
