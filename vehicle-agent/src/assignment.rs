@@ -1,5 +1,5 @@
 //! What an agent is handed and what it hands back: a checked mission assignment, and how the
-//! mission ended. Both the planning loop ([`crate::mission`]) and the one-go planners
+//! mission ended. Both the planning loop (`mission`) and the one-go planners
 //! (`one_shot`) use them, so they sit below both.
 
 use std::path::Path;
