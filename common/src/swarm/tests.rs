@@ -103,3 +103,28 @@ fn executor_owns_budgets() {
     let out = ex.run(&problem, &mut Pso::classic(30, 1), |_| {});
     assert_eq!(out.termination, Termination::Interrupted);
 }
+
+#[test]
+fn a_longer_amp_pso_run_repeats_the_default_run_and_ends_no_worse() {
+    // Rastrigin's many local minima stall the greedy end of a sweep; more sweeps may leave one.
+    use super::core::population::ADAPTIVE_SPAN;
+    let problem = Rastrigin::new(6);
+    for seed in 1..=3 {
+        let solver = || {
+            let mut m = MultiPso::amp(seed);
+            (m.populations, m.particles, m.leader_particles, m.threads) = (3, 8, 3, 1);
+            m
+        };
+        let short = Executor::new(ADAPTIVE_SPAN).run(&problem, &mut solver(), |_| {});
+        let long = Executor::new(3 * ADAPTIVE_SPAN + 17).run(&problem, &mut solver(), |_| {});
+        assert_eq!(
+            long.convergence[..ADAPTIVE_SPAN],
+            short.convergence[..],
+            "seed {seed}: the first sweep differs"
+        );
+        assert!(
+            long.state.best_cost() <= short.state.best_cost(),
+            "seed {seed}"
+        );
+    }
+}
