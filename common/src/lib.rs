@@ -21,6 +21,7 @@ pub mod health;
 pub mod limits;
 pub mod plan;
 pub mod queue;
+pub mod refine;
 pub mod scenario;
 pub mod separation;
 pub mod stats;

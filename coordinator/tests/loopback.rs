@@ -33,8 +33,10 @@ fn scenario() -> Result<Scenario, Box<dyn std::error::Error>> {
     // Rounds of 3, 3, 3, 3, 3 and 1 iterations.
     s.optimizer.distributed.exchange_every = 3;
     // The plans are compared with the lockstep reference's best, which is the swarm's own: no
-    // touch-up after it (this small budget leaves violations the touch-up would work on).
+    // touch-up or refinement after it (this small budget leaves violations the touch-up would
+    // work on, and paths the refinement would pull tight).
     s.optimizer.touch_up = false;
+    s.optimizer.refine = false;
     Ok(s)
 }
 

@@ -72,12 +72,14 @@ fn amp_pso_plan_meets_the_contract() -> TestResult {
         panic!("`convergence` is not an array");
     };
     let c: Vec<f64> = convergence.iter().filter_map(Value::as_f64).collect();
-    assert_eq!(
-        c.len(),
-        30,
-        "one convergence entry per iteration: {convergence:?}"
+    // One entry per iteration, and one more for the local steps after the swarm when they
+    // changed the plan: the curve ends at the plan's fitness.
+    assert!(
+        c.len() == 30 || c.len() == 31,
+        "one convergence entry per iteration (and the local steps'): {convergence:?}"
     );
-    for (k, w) in c.windows(2).enumerate() {
+    assert_eq!(c.last().copied(), key(&json, "fitness").as_f64());
+    for (k, w) in c[..30].windows(2).enumerate() {
         assert!(
             w[1] <= w[0],
             "convergence rises from iteration {k} to {}: {} → {}",

@@ -48,6 +48,11 @@ pub struct OptimizerSettings {
     /// (`crate::touch_up`, not part of any seed's algorithm). `plan` does it by default
     /// (`--no-touch-up` or `touch_up = false` to see the swarm's own result); `compare` never.
     pub touch_up: bool,
+    /// After the swarm (and the touch-up), pull every swimmer's path tight inside its limits
+    /// and the fleet's separation by a local constrained search (`crate::refine`, not part of
+    /// any seed's algorithm). `plan` does it by default (`--no-refine` or `refine = false` for
+    /// the swarm's own result); `compare` reports the algorithm both with and without it.
+    pub refine: bool,
 }
 
 /// Distributed AMP-PSO (`plan` without `--in-process`): each vehicle's agent runs follower
@@ -102,6 +107,7 @@ impl Default for OptimizerSettings {
             threads: 2,
             distributed: DistributedSettings::default(),
             touch_up: true,
+            refine: true,
         }
     }
 }

@@ -128,3 +128,34 @@ fn a_longer_amp_pso_run_repeats_the_default_run_and_ends_no_worse() {
         );
     }
 }
+
+#[test]
+fn checkpoints_hold_the_best_after_each_sweep_before_the_last_iteration() {
+    let problem = Rastrigin::new(4);
+    let solver = || Pso::classic(10, 3);
+    let every = |max: usize| Executor {
+        checkpoint_every: Some(20),
+        ..Executor::new(max)
+    };
+    let out = every(65).run(&problem, &mut solver(), |_| {});
+    // After iterations 20, 40 and 60; 65 is the run's own end.
+    assert_eq!(out.checkpoints.len(), 3);
+    for (k, x) in out.checkpoints.iter().enumerate() {
+        let shorter = Executor::new(20 * (k + 1)).run(&problem, &mut solver(), |_| {});
+        assert_eq!(
+            x.as_slice(),
+            shorter.state.best_position(),
+            "checkpoint {k}"
+        );
+    }
+    // A run that ends on a sweep keeps no checkpoint there; none without the setting.
+    assert_eq!(
+        every(40)
+            .run(&problem, &mut solver(), |_| {})
+            .checkpoints
+            .len(),
+        1
+    );
+    let plain = Executor::new(65).run(&problem, &mut solver(), |_| {});
+    assert!(plain.checkpoints.is_empty());
+}

@@ -60,6 +60,11 @@ pub struct PlanArgs {
     /// scenario's `optimizer.touch_up`).
     #[arg(long, env = "SHOAL_NO_TOUCH_UP")]
     pub no_touch_up: bool,
+    /// Fleet plans: keep the swarm's plan as it ends, without pulling each path tight inside
+    /// its limits and the fleet's separation by a local constrained search afterwards (the
+    /// scenario's `optimizer.refine`).
+    #[arg(long, env = "SHOAL_NO_REFINE")]
+    pub no_refine: bool,
     /// Distributed mode: start one agent per vehicle here (embedded) or wait for agents started
     /// elsewhere to connect (external).
     #[arg(long, env = "SHOAL_AGENTS", value_enum, default_value_t = AgentsMode::Embedded)]
@@ -110,6 +115,7 @@ impl PlanArgs {
                 particles: self.particles,
                 threads: self.threads,
                 no_touch_up: self.no_touch_up,
+                no_refine: self.no_refine,
             },
             quiet: self.quiet,
             in_process: self.in_process,

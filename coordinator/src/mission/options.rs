@@ -31,6 +31,9 @@ pub struct Overrides {
     /// Keep the swarm's own best instead of re-planning each vehicle in a violation (the
     /// scenario's `optimizer.touch_up` off).
     pub no_touch_up: bool,
+    /// Keep the swarm's (touched-up) plan without the local refinement (the scenario's
+    /// `optimizer.refine` off).
+    pub no_refine: bool,
 }
 
 /// Loads a scenario and applies `overrides`, checking the result with the file's own rules; an
@@ -66,6 +69,9 @@ pub fn load_scenario(path: &Path, overrides: &Overrides) -> anyhow::Result<Scena
     }
     if overrides.no_touch_up {
         o.touch_up = false;
+    }
+    if overrides.no_refine {
+        o.refine = false;
     }
     match s.validate(path) {
         Ok(()) => Ok(s),

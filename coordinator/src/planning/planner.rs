@@ -7,10 +7,9 @@ use shoal_common::cost::FleetModel;
 use shoal_common::plan::{assess, notices, Plan};
 use shoal_common::scenario::Scenario;
 use shoal_common::swarm::catalog::{family, Family};
-use shoal_common::swarm::multi::AMP_PSO_VELOCITY_CAP;
 use shoal_common::swarm::{Executor, IterationReport, Termination};
-use shoal_common::touch_up::{touch_up, TouchUp, TouchUpSettings};
 
+use super::finish::finish;
 use super::solver::run_algorithm;
 pub use super::solver::RunResult;
 
@@ -26,6 +25,7 @@ pub fn plan_in_process(
     let executor = Executor {
         max_iterations: o.iterations,
         stop,
+        checkpoint_every: Some(super::finish::CHECKPOINT_EVERY),
         ..Executor::default()
     };
     let run = match family(o.algorithm) {
@@ -42,10 +42,33 @@ pub fn plan_in_process(
     to_plan(scenario, &model, run, "in-process", executor.stop.as_ref())
 }
 
-/// The validated plan of a run: the fleet figures are recomputed from the trajectories. When
-/// the swarm's best breaks a limit and the settings allow it, the plan is first touched up
-/// ([`shoal_common::touch_up`]) and says so. A raised `stop` skips the touch-up, or ends it
-/// with what it kept so far.
+/// The scenario's algorithm as its paper gives it (no touch-up, no refinement) and, for the
+/// fleet algorithms, the same swarm run refined: what `compare` reports side by side.
+pub fn plan_alone_and_refined(scenario: &Scenario) -> (Plan, Option<Plan>) {
+    let mut alone = scenario.clone();
+    alone.optimizer.touch_up = false;
+    alone.optimizer.refine = false;
+    let o = &alone.optimizer;
+    if !matches!(family(o.algorithm), Family::Fleet { .. }) {
+        return (plan_in_process(&alone, None, &mut |_| {}), None);
+    }
+    let model = FleetModel::new(&alone);
+    let executor = Executor {
+        max_iterations: o.iterations,
+        checkpoint_every: Some(super::finish::CHECKPOINT_EVERY),
+        ..Executor::default()
+    };
+    let run = run_algorithm(&model, o, &executor, &mut |_| {});
+    let mut refined = alone.clone();
+    refined.optimizer.refine = true;
+    let with = to_plan(&refined, &model, run.clone(), "in-process+refine", None);
+    (to_plan(&alone, &model, run, "in-process", None), Some(with))
+}
+
+/// The validated plan of a run: the fleet figures are recomputed from the trajectories. The
+/// swarm's best is first finished as the settings ask ([`finish`]: touched up, refined) and
+/// the plan says what that changed. A raised `stop` skips those steps, or ends them with what
+/// they kept so far.
 pub fn to_plan(
     scenario: &Scenario,
     model: &FleetModel,
@@ -55,24 +78,12 @@ pub fn to_plan(
 ) -> Plan {
     let o = &scenario.optimizer;
     let started = std::time::Instant::now();
-    let stopped = stop.is_some_and(|s| s.load(std::sync::atomic::Ordering::Relaxed));
-    let touched = (o.touch_up && !stopped)
-        .then(|| {
-            let settings = TouchUpSettings::new(o.seed, o.velocity_cap(AMP_PSO_VELOCITY_CAP));
-            touch_up(model, &run.best_x, settings, stop)
-        })
-        .flatten();
-    let touch_up_s = started.elapsed().as_secs_f64();
-    let eval = model.evaluate(touched.as_ref().map_or(&run.best_x, |t| &t.x));
+    let finished = finish(model, &run, o, stop);
+    let local_s = started.elapsed().as_secs_f64();
+    let eval = &finished.eval;
     let assessment = assess(scenario, &eval.trajectories);
     let mut notices = notices(scenario, &eval.trajectories, eval.common_arrival);
-    if let Some(t) = &touched {
-        notices.push(touch_up_notice(
-            scenario,
-            t,
-            assessment.violations.is_empty(),
-        ));
-    }
+    notices.extend(finished.notices(scenario, assessment.violations.is_empty()));
     if run.termination == Termination::Interrupted {
         notices.push(format!(
             "planning was interrupted after {} of {} iterations: this is the best plan found so far",
@@ -80,12 +91,18 @@ pub fn to_plan(
             o.iterations
         ));
     }
+    let iterations = run.convergence.len();
+    let mut convergence = run.convergence;
+    // The curve ends at the plan returned: the local steps after the swarm add one point.
+    if convergence.last() != Some(&eval.total) {
+        convergence.push(eval.total);
+    }
     Plan {
         scenario: scenario.name.clone(),
         algorithm: o.algorithm.as_str().to_string(),
         mode: mode.to_string(),
         seed: o.seed,
-        runtime_s: run.runtime_s + if touched.is_some() { touch_up_s } else { 0.0 },
+        runtime_s: run.runtime_s + local_s,
         fitness: eval.total,
         objective: eval.objective,
         penalty: eval.penalty,
@@ -95,68 +112,23 @@ pub fn to_plan(
         mission_time_s: scenario.fleet.mission_time_s,
         common_arrival_s: eval.common_arrival,
         d_min_m: scenario.fleet.d_min_m,
-        iterations: run.convergence.len(),
-        evaluations: run.evaluations + touched.as_ref().map_or(0, |t| t.evaluations),
+        iterations,
+        evaluations: run.evaluations + finished.evaluations,
         termination: format!("{:?}", run.termination),
         vehicles: assessment.vehicles,
         fleet: assessment.fleet,
-        convergence: run.convergence,
+        convergence,
         distributed: None,
         origin: scenario.origin,
     }
 }
 
-/// What the touch-up did, in words, for the plan's notices.
-fn touch_up_notice(scenario: &Scenario, t: &TouchUp, cleared: bool) -> String {
-    // Vehicle ids of scenario indices, each once, in first-seen order.
-    let names = |vs: &[usize]| {
-        let mut ids: Vec<&str> = Vec::new();
-        for vehicle in vs.iter().filter_map(|v| scenario.vehicles.get(*v)) {
-            if !ids.contains(&vehicle.id.as_str()) {
-                ids.push(vehicle.id.as_str());
-            }
-        }
-        ids
-    };
-    let (ids, fresh) = (names(&t.changed), names(&t.fresh));
-    let what = if ids.is_empty() {
-        "no vehicle's path could be improved".to_string()
-    } else {
-        format!(
-            "{} re-planned against the others' paths{} (penalty {:.3} -> {:.3}, fitness {:.4} -> {:.4})",
-            ids.join(", "),
-            if fresh.is_empty() {
-                String::new()
-            } else {
-                format!(", {} from a fresh search", fresh.join(", "))
-            },
-            t.penalty.0,
-            t.penalty.1,
-            t.total.0,
-            t.total.1
-        )
-    };
-    format!(
-        "touch-up: the swarm's best plan broke a limit; {what} in {} evaluations{}{} \
-         (--no-touch-up gives the swarm's own plan)",
-        t.evaluations,
-        if t.interrupted {
-            ", cut short by the stop request"
-        } else {
-            ""
-        },
-        if cleared {
-            ", which cleared every violation"
-        } else {
-            "; the violations listed remain"
-        }
-    )
-}
-
 #[cfg(test)]
 mod tests {
+    use super::super::finish::touch_up_notice;
     use super::*;
     use shoal_common::scenario::Algorithm;
+    use shoal_common::touch_up::TouchUp;
     use std::path::Path;
 
     fn dsmv(cap: Option<f64>) -> Scenario {
@@ -213,6 +185,7 @@ mod tests {
         s.optimizer.particles = 50;
         s.optimizer.seed = seed;
         s.optimizer.touch_up = false;
+        s.optimizer.refine = false;
         s
     }
 
@@ -231,9 +204,11 @@ mod tests {
         assert!(touched.fitness < own.fitness);
         assert!(touched.evaluations > own.evaluations);
         assert_eq!(
-            touched.convergence, own.convergence,
+            touched.convergence[..own.convergence.len()],
+            own.convergence,
             "the swarm ran the same"
         );
+        assert_eq!(touched.convergence.last(), Some(&touched.fitness));
         let note = touched
             .notices
             .iter()
@@ -245,6 +220,86 @@ mod tests {
                 && note.contains("cleared every violation"),
             "{note}"
         );
+    }
+
+    /// Scenario 3, seed 2, in process: the swarm's plan is feasible but arrives at 2926 s; the
+    /// refinement pulls the paths tight and the fleet arrives at the mission time, 2700 s,
+    /// with a lower fitness (measured: 1.7776 -> 1.6528).
+    #[test]
+    fn the_refinement_brings_a_late_fleet_in_on_time_with_a_lower_fitness() {
+        let s = scenario3_untouched(2);
+        let own = plan_in_process(&s, None, &mut |_| {});
+        assert!(own.feasible, "{:?}", own.violations);
+        assert!(own.common_arrival_s > 2800.0, "{}", own.common_arrival_s);
+        assert!(!own.notices.iter().any(|n| n.starts_with("refinement")));
+        let mut with = s.clone();
+        with.optimizer.refine = true;
+        let refined = plan_in_process(&with, None, &mut |_| {});
+        assert!(refined.feasible, "{:?}", refined.violations);
+        assert!((refined.common_arrival_s - 2700.0).abs() < 1e-6);
+        assert!(
+            refined.fitness < own.fitness - 0.05,
+            "{} vs {}",
+            refined.fitness,
+            own.fitness
+        );
+        assert_eq!(
+            refined.convergence[..own.convergence.len()],
+            own.convergence
+        );
+        assert_eq!(refined.convergence.last(), Some(&refined.fitness));
+        assert_eq!(refined.iterations, own.iterations);
+        let note = refined
+            .notices
+            .iter()
+            .find(|n| n.starts_with("refinement"))
+            .unwrap_or_else(|| panic!("no refinement notice: {:?}", refined.notices));
+        assert!(
+            note.contains("-> 2700 s") && note.contains("--no-refine"),
+            "{note}"
+        );
+        assert!(!refined
+            .notices
+            .iter()
+            .any(|n| n.contains("instead of the mission time")));
+    }
+
+    /// Whatever the local steps after the swarm do, the convergence curve ends at the fitness
+    /// of the plan returned.
+    #[test]
+    fn the_curve_ends_at_the_returned_plans_fitness() {
+        for (name, seed) in [("amp-pso-1", 1), ("amp-pso-1", 2), ("amp-pso-2", 3)] {
+            let mut s = small(name, None);
+            s.optimizer.seed = seed;
+            for (touch_up, refine) in [(true, true), (false, true), (true, false), (false, false)] {
+                s.optimizer.touch_up = touch_up;
+                s.optimizer.refine = refine;
+                let p = plan_in_process(&s, None, &mut |_| {});
+                assert_eq!(p.convergence.last(), Some(&p.fitness), "{name} {seed}");
+            }
+        }
+    }
+
+    /// A budget of three sweeps finishes the best after each: its plan is never worse than the
+    /// one-sweep plan, which is among the candidates (the first sweep is the same run).
+    #[test]
+    fn a_longer_budget_never_finishes_worse_than_the_default() {
+        for seed in 1..=2 {
+            let mut s = small("amp-pso-1", None);
+            (s.optimizer.populations, s.optimizer.particles) = (3, 10);
+            s.optimizer.seed = seed;
+            s.optimizer.iterations = super::super::finish::CHECKPOINT_EVERY;
+            let short = plan_in_process(&s, None, &mut |_| {});
+            s.optimizer.iterations = 3 * super::super::finish::CHECKPOINT_EVERY;
+            let long = plan_in_process(&s, None, &mut |_| {});
+            assert!(
+                long.fitness <= short.fitness + 1e-12,
+                "seed {seed}: {} vs {}",
+                long.fitness,
+                short.fitness
+            );
+            assert_eq!(long.convergence.last(), Some(&long.fitness));
+        }
     }
 
     /// Scenario 3, seed 15, in process: the swarm leaves auv3 on a detour with a 46.0° corner

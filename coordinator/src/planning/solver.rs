@@ -6,6 +6,7 @@ use shoal_common::swarm::catalog::{with_solver, MultiSizes, SolverSettings, Solv
 use shoal_common::swarm::{Executor, IterationReport, Problem, Solver, SolverState, Termination};
 
 /// What an optimizer run leaves behind, whatever the algorithm and the mode.
+#[derive(Debug, Clone)]
 pub struct RunResult {
     /// Best fleet position (a true evaluation).
     pub best_x: Vec<f64>,
@@ -17,6 +18,9 @@ pub struct RunResult {
     pub termination: Termination,
     /// Wall time, seconds.
     pub runtime_s: f64,
+    /// The best position after each sweep the executor was asked to keep
+    /// ([`Executor::checkpoint_every`]), oldest first.
+    pub checkpoints: Vec<Vec<f64>>,
 }
 
 /// Runs `solver` on `model` under `executor`.
@@ -33,6 +37,7 @@ pub fn run_solver<P: Problem, S: Solver<P>>(
         convergence: out.convergence,
         termination: out.termination,
         runtime_s: out.elapsed.as_secs_f64(),
+        checkpoints: out.checkpoints,
     }
 }
 

@@ -12,7 +12,7 @@ use shoal_common::stats;
 use std::time::Instant;
 
 use crate::distributed::{default_mission_id, plan_distributed, DistributedOptions};
-use crate::planning::planner::plan_in_process;
+use crate::planning::planner::plan_alone_and_refined;
 
 /// Aggregates of one (scenario, algorithm) cell over all seeds.
 #[derive(Debug, Clone, PartialEq)]
@@ -21,7 +21,7 @@ pub struct Cell {
     pub scenario: String,
     /// Algorithm.
     pub algorithm: Algorithm,
-    /// `in-process` or `distributed`.
+    /// `in-process`, `in-process+refine` or `distributed`.
     pub mode: String,
     /// Seeds run.
     pub runs: usize,
@@ -121,6 +121,7 @@ pub fn compare(
                 }
                 let mut plans = Vec::new();
                 let mut walls = Vec::new();
+                let mut refined = Vec::new();
                 for seed in seeds.clone() {
                     if stop.load(Ordering::Relaxed) {
                         return Ok(cells);
@@ -128,8 +129,10 @@ pub fn compare(
                     let mut s = s.clone();
                     s.optimizer.algorithm = a;
                     s.optimizer.seed = seed;
-                    // The algorithms as their papers give them: no touch-up afterwards.
+                    // The algorithms as their papers give them: no touch-up or refinement
+                    // afterwards; in process also the same run refined, beside it.
                     s.optimizer.touch_up = false;
+                    s.optimizer.refine = false;
                     let started = Instant::now();
                     let p = match distributed {
                         Some(o) if remote => {
@@ -137,13 +140,22 @@ pub fn compare(
                             o.mission = default_mission_id(&s);
                             plan_distributed(&s, &o, stop, &mut |_| {})?
                         }
-                        _ => plan_in_process(&s, None, &mut |_| {}),
+                        _ => {
+                            let (alone, with) = plan_alone_and_refined(&s);
+                            refined.extend(with);
+                            alone
+                        }
                     };
                     walls.push(started.elapsed().as_secs_f64());
                     progress(&p);
                     plans.push(p);
                 }
                 cells.push(cell(&s.name, a, &plans, &walls, s.fleet.d_min_m));
+                if !refined.is_empty() {
+                    // Wall times are the pair's: the refined plan's own time is its runtime.
+                    let runtimes: Vec<f64> = refined.iter().map(|p| p.runtime_s).collect();
+                    cells.push(cell(&s.name, a, &refined, &runtimes, s.fleet.d_min_m));
+                }
             }
         }
     }

@@ -45,6 +45,9 @@ pub struct Outcome<S> {
     pub convergence: Vec<f64>,
     /// Wall time, including init.
     pub elapsed: Duration,
+    /// The best position after every [`Executor::checkpoint_every`] iterations, oldest first,
+    /// when the run went on past it.
+    pub checkpoints: Vec<Vec<f64>>,
 }
 
 /// Owns the optimisation loop and its budgets.
@@ -58,6 +61,9 @@ pub struct Executor {
     pub time_limit: Option<Duration>,
     /// Stop when this flag is raised.
     pub stop: Option<Arc<AtomicBool>>,
+    /// Keep the best position after every this many iterations (before the last), so a caller
+    /// can finish each as it would have finished a run of that budget.
+    pub checkpoint_every: Option<usize>,
 }
 
 impl Executor {
@@ -84,6 +90,7 @@ impl Executor {
         let mut state = solver.init(problem);
         let mut convergence = Vec::with_capacity(self.max_iterations);
         let mut termination = Termination::MaxIterations;
+        let mut checkpoints = Vec::new();
         for iteration in 0..self.max_iterations {
             if let Some(t) = self.target_cost {
                 if state.best_cost() <= t {
@@ -109,6 +116,13 @@ impl Executor {
             };
             state = solver.step(problem, state, progress);
             convergence.push(state.best_cost());
+            let done = iteration + 1;
+            if self
+                .checkpoint_every
+                .is_some_and(|k| k > 0 && done % k == 0 && done < self.max_iterations)
+            {
+                checkpoints.push(state.best_position().to_vec());
+            }
             observe(&IterationReport {
                 iteration: iteration + 1,
                 max_iterations: self.max_iterations,
@@ -121,6 +135,7 @@ impl Executor {
             termination,
             convergence,
             elapsed: started.elapsed(),
+            checkpoints,
         }
     }
 }

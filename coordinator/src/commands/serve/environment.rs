@@ -46,6 +46,7 @@ pub fn overlay(options: &mut RunOptions) -> anyhow::Result<()> {
     o.particles = parsed("SHOAL_PARTICLES")?;
     o.threads = parsed("SHOAL_THREADS")?;
     o.no_touch_up = parsed("SHOAL_NO_TOUCH_UP")?.unwrap_or(false);
+    o.no_refine = parsed("SHOAL_NO_REFINE")?.unwrap_or(false);
     m.in_process = parsed("SHOAL_IN_PROCESS")?.unwrap_or(false);
     if let Some(n) = m.network.as_mut() {
         if let Some(s) = parsed("SHOAL_JOIN_TIMEOUT")? {

@@ -182,6 +182,8 @@ pub fn run(
             Termination::MaxIterations
         },
         runtime_s: started.elapsed().as_secs_f64(),
+        // The leader's rounds keep no sweep checkpoints: the run's best alone is finished.
+        checkpoints: Vec::new(),
     };
     Ok((result, figures))
 }

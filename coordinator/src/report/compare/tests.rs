@@ -37,9 +37,26 @@ fn cells_hold_every_seeds_fitness_in_seed_order_and_their_median_and_range() {
         &mut |p| seen.push((p.algorithm.clone(), p.seed, p.fitness)),
     )
     .unwrap_or_else(|e| panic!("compare failed: {e}"));
-    assert_eq!(cells.len(), 2);
+    // Each algorithm alone, then refined.
+    assert_eq!(cells.len(), 4);
     assert_eq!(seen.len(), 6);
-    for (c, name) in cells.iter().zip(["pso", "a-pso"]) {
+    let modes: Vec<&str> = cells.iter().map(|c| c.mode.as_str()).collect();
+    assert_eq!(
+        modes,
+        [
+            "in-process",
+            "in-process+refine",
+            "in-process",
+            "in-process+refine"
+        ]
+    );
+    for pair in cells.chunks(2) {
+        for (alone, refined) in pair[0].fitness.iter().zip(&pair[1].fitness) {
+            assert!(refined <= alone, "{refined} > {alone}");
+        }
+    }
+    let alone: Vec<&Cell> = cells.iter().step_by(2).collect();
+    for (c, name) in alone.into_iter().zip(["pso", "a-pso"]) {
         let own: Vec<&(String, u64, f64)> = seen.iter().filter(|s| s.0 == name).collect();
         assert_eq!(own.iter().map(|s| s.1).collect::<Vec<_>>(), [1, 2, 3]);
         let fitness: Vec<f64> = own.iter().map(|s| s.2).collect();
@@ -50,17 +67,20 @@ fn cells_hold_every_seeds_fitness_in_seed_order_and_their_median_and_range() {
         assert_eq!(c.median_fitness(), sorted[1]);
         assert_eq!(c.fitness_range(), (sorted[0], sorted[2]));
     }
-    // The first algorithm named is the reference of the significance rows.
+    // The first algorithm named is the reference of the significance rows, alone and refined.
     let rows = crate::report::significance::significance(&cells);
-    assert_eq!(rows.len(), 1);
-    assert_eq!(
-        (rows[0].reference, rows[0].other),
-        (Algorithm::Pso, Algorithm::APso)
-    );
+    assert_eq!(rows.len(), 2);
+    for (row, mode) in rows.iter().zip(["in-process", "in-process+refine"]) {
+        assert_eq!(
+            (row.reference, row.other, row.mode.as_str()),
+            (Algorithm::Pso, Algorithm::APso, mode)
+        );
+    }
 }
 
 /// `compare` measures the algorithms themselves: a plan the swarm leaves over a limit is
-/// not touched up there, whatever the scenario says.
+/// not touched up there, whatever the scenario says (the refined rows beside them refine the
+/// same swarm plans without touching them up).
 #[test]
 fn compare_measures_the_swarms_own_plans_without_the_touch_up() {
     // Scenario 3 on a budget of 3 iterations of 10 particles: plans that break limits.
@@ -83,6 +103,7 @@ fn compare_measures_the_swarms_own_plans_without_the_touch_up() {
         let mut s = scenario.clone();
         s.optimizer.algorithm = Algorithm::Pso;
         s.optimizer.seed = seed;
+        s.optimizer.refine = false;
         let touched = crate::planning::planner::plan_in_process(&s, None, &mut |_| {});
         s.optimizer.touch_up = false;
         let own = crate::planning::planner::plan_in_process(&s, None, &mut |_| {});
