@@ -33,6 +33,7 @@ pub mod reroute;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 
+use crate::bspline::polyline_length;
 use crate::cost::{depth_term, soft_threat_term, time_term, FleetEvaluation, FleetModel};
 use crate::geometry::Vec3;
 use crate::scenario::Scenario;
@@ -141,11 +142,7 @@ pub fn refine(
         // The latest vehicles first: they hold the fleet's arrival.
         let mut order = swimmers.clone();
         let lateness = |i: usize| {
-            search.eval.trajectories[i]
-                .points
-                .windows(2)
-                .map(|w| (w[1] - w[0]).norm())
-                .sum::<f64>()
+            polyline_length(&search.eval.trajectories[i].points)
                 / model.scenario.vehicles[i].speed_max_mps
         };
         order.sort_by(|a, b| lateness(*b).total_cmp(&lateness(*a)));
@@ -180,7 +177,7 @@ pub fn refine(
 fn fleet_length(eval: &FleetEvaluation) -> f64 {
     eval.trajectories
         .iter()
-        .flat_map(|t| t.points.windows(2).map(|w| (w[1] - w[0]).norm()))
+        .map(|t| polyline_length(&t.points))
         .sum()
 }
 
@@ -281,11 +278,7 @@ impl Search<'_> {
     /// ([`reroute::fresh_route`]) refined like the others, kept if it lowers the merit.
     fn reroute_if_late(&mut self, i: usize) {
         let v = &self.model.scenario.vehicles[i];
-        let length: f64 = self.eval.trajectories[i]
-            .points
-            .windows(2)
-            .map(|w| (w[1] - w[0]).norm())
-            .sum();
+        let length = polyline_length(&self.eval.trajectories[i].points);
         if self.interrupted || length / v.speed_max_mps <= self.target * (1.0 + 1e-9) {
             return;
         }
@@ -374,7 +367,7 @@ fn smooth_objective(model: &FleetModel, i: usize, points: &[Vec3]) -> f64 {
     let s = &model.scenario;
     let w = &s.optimizer.weights;
     let straight = model.straight[i].max(1e-9);
-    let length: f64 = points.windows(2).map(|p| (p[1] - p[0]).norm()).sum();
+    let length = polyline_length(points);
     let column = s.bounds.max[2] - s.bounds.min[2];
     w[0] * length / straight
         + w[1] * depth_term(points, s.bounds.max[2], column)
@@ -412,7 +405,7 @@ fn model_hessian(model: &FleetModel, i: usize, points: &[Vec3]) -> Vec<f64> {
     let w = &s.optimizer.weights;
     let inner = points.len().saturating_sub(2);
     let n = 3 * inner;
-    let length: f64 = points.windows(2).map(|p| (p[1] - p[0]).norm()).sum();
+    let length = polyline_length(points);
     let mission = s.fleet.mission_time_s;
     let mut scale = w[0] / model.straight[i].max(1e-9);
     if length / v.speed_max_mps > mission {
