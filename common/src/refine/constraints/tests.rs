@@ -151,3 +151,30 @@ fn a_17_m_path_is_seven_tenths_over_a_10_m_limit() -> Result<(), &'static str> {
     gradient_matches_differences(&points, |p| length_row(p, 10.0, 1.0).into_iter().collect());
     Ok(())
 }
+
+#[test]
+fn a_leg_shorter_than_its_floor_is_over_by_the_shortfall_over_the_floor() {
+    // Horizontal extents 5, 0.8 and 7 m against floors of 1 m: only the middle leg is near
+    // (0.2 over); the others are far below the cut.
+    let points = [
+        Vec3::zeros(),
+        Vec3::new(3.0, 4.0, 0.0),
+        Vec3::new(3.0, 4.8, 1.0),
+        Vec3::new(10.0, 4.8, 1.0),
+    ];
+    let floors = [1.0, 1.0, 1.0];
+    let mut rows = Vec::new();
+    spacing_rows(&points, &floors, &mut rows);
+    assert_eq!(rows.len(), 1);
+    assert_abs_diff_eq!(rows[0].value, 0.2, epsilon = 1e-12);
+    gradient_matches_differences(&points, |p| {
+        let mut rows = Vec::new();
+        spacing_rows(p, &floors, &mut rows);
+        rows
+    });
+    // Floors: a third of the mean extent (12.8 / 3 / 3 = 1.422 m), or half a shorter leg.
+    let f = spacing_floors(&points);
+    assert_abs_diff_eq!(f[0], 12.8 / 9.0, epsilon = 1e-12);
+    assert_abs_diff_eq!(f[1], 0.4, epsilon = 1e-12);
+    assert_abs_diff_eq!(f[2], 12.8 / 9.0, epsilon = 1e-12);
+}
