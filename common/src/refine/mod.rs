@@ -111,6 +111,17 @@ pub fn target_arrival(scenario: &Scenario) -> f64 {
         .fold(scenario.fleet.mission_time_s, f64::max)
 }
 
+/// What a refinement step must lower, and what picks the best finished plan: the fleet
+/// fitness, plus the penalty weight times the arrival's delay past `target` over `target`.
+/// Eq. (10)'s F(T) weighs a late arrival lightly (λ4 = 0.1 over the mission time: 0.004 for
+/// 100 s at 2700 s), less than the depth a shorter path may give up; arriving when the fleet was
+/// told to is a constraint of the mission (Zhi & Zuo 2024, §2.2.2's temporal coupling), so
+/// lateness the limits do not force is paid like a breach.
+pub fn merit(scenario: &Scenario, e: &FleetEvaluation, target: f64) -> f64 {
+    let late = (e.common_arrival - target).max(0.0) / target;
+    e.total + scenario.optimizer.penalty_weight * late
+}
+
 /// Refines fleet position `x`. A raised `stop` ends it at its next program with what it kept.
 pub fn refine(
     model: &FleetModel,
@@ -301,15 +312,9 @@ impl Search<'_> {
         }
     }
 
-    /// What a step must lower: the fleet fitness, plus the penalty weight times the arrival's
-    /// delay past the target over the target. Eq. (10)'s F(T) weighs a late arrival lightly
-    /// (λ4 = 0.1 over the mission time: 0.004 for 100 s at 2700 s), less than the depth a
-    /// shorter path may give up; arriving when the fleet was told to is a constraint of the
-    /// mission (Zhi & Zuo 2024, §2.2.2's temporal coupling), so lateness the limits do not
-    /// force is paid like a breach.
+    /// [`merit`] against this search's target.
     fn merit(&self, e: &FleetEvaluation) -> f64 {
-        let late = (e.common_arrival - self.target).max(0.0) / self.target;
-        e.total + self.model.scenario.optimizer.penalty_weight * late
+        merit(&self.model.scenario, e, self.target)
     }
 
     /// Moves the genes `coords` by `d`, or by a half or a quarter of it when the whole step

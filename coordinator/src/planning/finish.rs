@@ -12,7 +12,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 
 use shoal_common::cost::{FleetEvaluation, FleetModel};
-use shoal_common::refine::{refine, target_arrival, RefineSettings, Refinement};
+use shoal_common::refine::{merit, refine, target_arrival, RefineSettings, Refinement};
 use shoal_common::scenario::{OptimizerSettings, Scenario};
 use shoal_common::swarm::multi::AMP_PSO_VELOCITY_CAP;
 use shoal_common::swarm::population::ADAPTIVE_SPAN;
@@ -58,8 +58,8 @@ impl Finished {
     }
 }
 
-/// Finishes the run's best and every checkpoint; returns the best by fitness plus the
-/// penalty weight times the lateness past what the limits force (the refinement's measure).
+/// Finishes the run's best and every checkpoint; returns the best by the refinement's own
+/// measure ([`merit`]).
 pub fn finish(
     model: &FleetModel,
     run: &RunResult,
@@ -67,9 +67,7 @@ pub fn finish(
     stop: Option<&Arc<AtomicBool>>,
 ) -> Finished {
     let target = target_arrival(&model.scenario);
-    let merit = |e: &FleetEvaluation| {
-        e.total + o.penalty_weight * (e.common_arrival - target).max(0.0) / target
-    };
+    let merit = |e: &FleetEvaluation| merit(&model.scenario, e, target);
     let mut best = finish_one(model, &run.best_x, o, stop);
     let mut spent = best.evaluations;
     for (k, x) in run.checkpoints.iter().enumerate() {
