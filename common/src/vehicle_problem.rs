@@ -98,6 +98,36 @@ impl<'a> VehicleProblem<'a> {
         self
     }
 
+    /// The fleet model it scores with.
+    pub fn model(&self) -> &'a FleetModel {
+        self.model
+    }
+
+    /// Which vehicle, in scenario order.
+    pub fn vehicle(&self) -> usize {
+        self.vehicle
+    }
+
+    /// The other vehicles' trajectories, in scenario order without this one.
+    pub fn others(&self) -> &[Trajectory] {
+        &self.others
+    }
+
+    /// The arrival the context was timed for, seconds.
+    pub fn arrival(&self) -> f64 {
+        self.arrival
+    }
+
+    /// The course the vehicle starts on, when it starts under way.
+    pub fn heading_in(&self) -> Option<Vec3> {
+        self.heading_in
+    }
+
+    /// Whether an early arrival is penalised.
+    pub fn synchronised(&self) -> bool {
+        self.synchronised
+    }
+
     /// Decodes and scores one chromosome.
     pub fn evaluate(&self, genes: &[f64]) -> VehicleEvaluation {
         let s = &self.model.scenario;

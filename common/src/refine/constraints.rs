@@ -115,6 +115,33 @@ pub fn turn_rows(points: &[Vec3], limits: &Limits, rows: &mut Vec<Row>) {
     }
 }
 
+/// The turn off a vehicle's present course `heading` onto the path, for a path that starts
+/// under way: `cos θ_max − cos θ ≤ 0` between the heading's horizontal part and the first leg
+/// with a horizontal extent (as the fitness's entry turn test), `None` when either has none or
+/// the leg ends at the fixed goal.
+pub fn entry_turn_row(heading: Vec3, points: &[Vec3], limits: &Limits) -> Option<Row> {
+    let inner = points.len().saturating_sub(2);
+    let a = Vec3::new(heading.x, heading.y, 0.0);
+    let first = points.first()?;
+    let na = a.norm();
+    if na <= MIN_HEADING_EXTENT {
+        return None;
+    }
+    let (k, b) = points.iter().enumerate().skip(1).find_map(|(k, p)| {
+        let b = Vec3::new(p.x - first.x, p.y - first.y, 0.0);
+        (b.norm() > MIN_HEADING_EXTENT).then_some((k, b))
+    })?;
+    if k > inner {
+        return None;
+    }
+    let nb = b.norm();
+    let cos = a.dot(&b) / (na * nb);
+    let mut row = Row::new(limits.max_turn.cos() - cos);
+    let gb = -(a / (na * nb) - b * (cos / (nb * nb)));
+    row.add(k, inner, gb);
+    Some(row)
+}
+
 /// Spacing rows: `(h_min − h) / h_min ≤ 0` for every leg whose horizontal extent `h` could fall
 /// under its floor `floors[k]`. A length objective alone lets neighbouring waypoints run
 /// together, and a leg of a few centimetres can swing its heading round in one step: the turns

@@ -1,4 +1,5 @@
 use super::*;
+use crate::geometry::Vec3;
 use crate::scenario::ScenarioError;
 use std::f64::consts::PI;
 
@@ -161,5 +162,104 @@ fn the_target_arrival_is_the_mission_time_unless_a_pitch_limit_forbids_it(
     deep.vehicles[0].goal[2] = 200.0;
     let need = 1200.0 / 20f64.to_radians().sin() / 1.5;
     assert!((target_arrival(&deep) - need).abs() < 1e-6);
+    Ok(())
+}
+
+/// One vehicle refined against fixed others (a replan's answer): the sphere detour above is
+/// pulled onto the same bound, and a second vehicle parked on the tangent line (its fixed
+/// trajectory holds still at (500, 740, 250)) keeps the path d_min away from it.
+#[test]
+fn one_vehicle_against_fixed_others_is_pulled_tight_around_them() -> Result<(), ScenarioError> {
+    let s = scenario(
+        "[[obstacles]]\nid = \"rock\"\nkind = \"hard\"\ncentre = [500.0, 500.0, 250.0]\n\
+         radius_m = 150.0\ninflation_m = 50.0\n",
+        &[
+            vehicle("a", [100.0, 500.0, 250.0], [900.0, 500.0, 250.0]),
+            vehicle("b", [900.0, 900.0, 450.0], [950.0, 950.0, 450.0]),
+        ],
+    )?;
+    let model = FleetModel::new(&s);
+    let genes = chromosome(12, |u| {
+        [100.0 + 800.0 * u, 500.0 + 330.0 * (PI * u).sin(), 250.0]
+    });
+    let parked = crate::trajectory::Trajectory {
+        times: vec![0.0, 1000.0],
+        points: vec![Vec3::new(500.0, 740.0, 250.0); 2],
+    };
+    let context = [parked.clone(), parked.clone()];
+    let problem = crate::vehicle_problem::VehicleProblem::new(&model, 0, &context, 1000.0)
+        .early_arrival_allowed();
+    let before = problem.evaluate(&genes);
+    assert_eq!(
+        before.terms.hard + before.terms.motion + before.terms.separation,
+        0.0
+    );
+    let r = refine_vehicle(&problem, &genes, 1000.0, &RefineSettings::default(), None);
+    let after = problem.evaluate(&r.genes);
+    assert_eq!(
+        after.terms.hard + after.terms.motion + after.terms.separation,
+        0.0
+    );
+    assert!(after.min_separation >= 50.0, "{}", after.min_separation);
+    // The tangent-and-arc bound is 902.26 m; the parked vehicle's 50 m ring sits on the arc
+    // (740 − 50 = 690 m against the arc's 700 m top), so the path may not reach it.
+    let bound = 2.0 * (400f64.powi(2) - 200f64.powi(2)).sqrt() + 200.0 * (PI - 2.0 * 0.5f64.acos());
+    assert!(r.length_m.1 < r.length_m.0 - 50.0, "{r:?}");
+    assert!(r.length_m.1 > bound, "{r:?}");
+    assert!(r.total.1 < r.total.0 && r.steps > 0);
+    assert_eq!(r.total.1, after.total);
+    Ok(())
+}
+
+/// A replan under way northwards keeps the turn off that course within the limit while its
+/// path is pulled tight towards a goal due east.
+#[test]
+fn a_path_entered_under_way_keeps_its_first_turn_within_the_limit() -> Result<(), ScenarioError> {
+    let s = scenario(
+        "",
+        &[vehicle("a", [100.0, 300.0, 250.0], [900.0, 300.0, 250.0])],
+    )?;
+    let model = FleetModel::new(&s);
+    let north = Vec3::new(0.0, 1.0, 0.0);
+    // Leaves northwards, swings round to the east: a wide, flyable arc.
+    let genes = chromosome(12, |u| {
+        [100.0 + 800.0 * u * u, 300.0 + 500.0 * (PI * u).sin(), 250.0]
+    });
+    let context = [Trajectory {
+        times: vec![0.0, 1000.0],
+        points: vec![Vec3::new(0.0, 0.0, 0.0); 2],
+    }];
+    let problem = crate::vehicle_problem::VehicleProblem::new(&model, 0, &context, 1000.0)
+        .early_arrival_allowed()
+        .entering_along(north);
+    let max_turn = s.vehicles[0].max_turn_deg.to_radians();
+    let entry =
+        |g: &[f64]| crate::cost::entry_turn_penalty(north, &model.decode(0, g).points, max_turn);
+    assert_eq!(entry(&genes), 0.0);
+    assert_eq!(problem.evaluate(&genes).terms.motion, 0.0);
+    let r = refine_vehicle(&problem, &genes, 1000.0, &RefineSettings::default(), None);
+    assert!(r.length_m.1 < 0.95 * r.length_m.0, "{r:?}");
+    assert_eq!(entry(&r.genes), 0.0);
+    assert_eq!(problem.evaluate(&r.genes).terms.motion, 0.0);
+    Ok(())
+}
+
+/// A deadline already past ends the refinement before its first program.
+#[test]
+fn a_passed_deadline_returns_the_path_unchanged() -> Result<(), ScenarioError> {
+    let s = scenario(
+        "",
+        &[vehicle("a", [100.0, 500.0, 250.0], [900.0, 500.0, 250.0])],
+    )?;
+    let model = FleetModel::new(&s);
+    let x = chromosome(12, |u| {
+        [100.0 + 800.0 * u, 500.0 + 300.0 * (PI * u).sin(), 250.0]
+    });
+    let settings = RefineSettings {
+        deadline: Some(Instant::now()),
+        ..RefineSettings::default()
+    };
+    let r = refine(&model, &x, &settings, None);
+    assert!(r.interrupted && r.steps == 0 && r.x == x);
     Ok(())
 }

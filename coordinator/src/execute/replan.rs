@@ -24,6 +24,7 @@ use rand::Rng;
 use shoal_common::cost::FleetModel;
 use shoal_common::coverage::reroute::CrawlerGround;
 use shoal_common::geometry::Vec3;
+use shoal_common::refine::{refine_vehicle, RefineSettings};
 use shoal_common::scenario::Scenario;
 use shoal_common::swarm::pso::Pso;
 use shoal_common::swarm::{Executor, Problem, SolverState};
@@ -292,27 +293,71 @@ const MOTION_SLACK: f64 = 2.0;
 /// "Safe" is tried at each separation of `separations` in turn (d_min plus the tracking
 /// buffer, then d_min itself): a candidate that keeps the buffer beats one that only keeps
 /// d_min, and one that keeps d_min still beats an unsafe one.
-fn choose(
-    swarm: VehicleEvaluation,
-    warm: impl Iterator<Item = VehicleEvaluation>,
-    separations: &[f64],
-) -> VehicleEvaluation {
-    let all: Vec<VehicleEvaluation> = std::iter::once(swarm.clone()).chain(warm).collect();
+fn choose(all: &[VehicleEvaluation], separations: &[f64]) -> usize {
     for &d in separations {
-        let safe: Vec<&VehicleEvaluation> = all.iter().filter(|e| is_safe(e, d)).collect();
+        let safe: Vec<usize> = (0..all.len()).filter(|k| is_safe(&all[*k], d)).collect();
         let cleanest = safe
             .iter()
-            .map(|e| e.terms.motion)
+            .map(|k| all[*k].terms.motion)
             .fold(f64::INFINITY, f64::min);
         if let Some(best) = safe
             .into_iter()
-            .filter(|e| e.terms.motion <= cleanest + MOTION_SLACK)
-            .min_by(|a, b| a.total.total_cmp(&b.total))
+            .filter(|k| all[*k].terms.motion <= cleanest + MOTION_SLACK)
+            .min_by(|a, b| all[*a].total.total_cmp(&all[*b].total))
         {
-            return best.clone();
+            return best;
         }
     }
-    swarm
+    0
+}
+
+/// The chosen answer `genes` (scored `chosen`) pulled tight by the refinement
+/// ([`refine_vehicle`]) until the request's budget ends, when the scenario asks for it; kept
+/// only when it is at least as safe at every separation of `separations`.
+fn tighten(
+    problem: &VehicleProblem,
+    genes: &[f64],
+    chosen: VehicleEvaluation,
+    r: &Request,
+    started: Instant,
+    separations: &[f64],
+) -> VehicleEvaluation {
+    if !r.scenario.optimizer.refine {
+        return chosen;
+    }
+    let settings = RefineSettings {
+        deadline: Some(started + r.budget),
+        ..RefineSettings::default()
+    };
+    let arrival = problem.arrival();
+    let refined = refine_vehicle(problem, genes, arrival, &settings, r.stop.as_ref());
+    if refined.steps == 0 {
+        return chosen;
+    }
+    let e = problem.evaluate(&refined.genes);
+    let as_safe = separations
+        .iter()
+        .all(|d| is_safe(&e, *d) || !is_safe(&chosen, *d));
+    if as_safe {
+        e
+    } else {
+        chosen
+    }
+}
+
+/// The share of a replan's budget the refinement keeps for itself when the scenario asks for
+/// it: one refinement program of a 30-waypoint path takes a few milliseconds, so a fifth of the
+/// 300 ms default is a few dozen of them, while the swarm keeps most of the time to find the
+/// way round.
+const REFINE_SHARE: f64 = 0.2;
+
+/// What of the request's budget the swarm may spend.
+fn swarm_budget(r: &Request) -> Duration {
+    if r.scenario.optimizer.refine {
+        r.budget.mul_f64(1.0 - REFINE_SHARE)
+    } else {
+        r.budget
+    }
 }
 
 /// Replans (see the module doc).
@@ -380,18 +425,21 @@ pub fn replan(r: &Request) -> Replanned {
     };
     let executor = Executor {
         max_iterations: 10_000,
-        // The warm starts (the A* way round) came out of the same budget.
-        time_limit: Some(r.budget.saturating_sub(started.elapsed())),
+        // The warm starts (the A* way round) came out of the same budget, and the refinement
+        // has the last part of it.
+        time_limit: Some(swarm_budget(r).saturating_sub(started.elapsed())),
         stop: r.stop.clone(),
         ..Executor::default()
     };
     let mut solver = Pso::adaptive(PARTICLES, r.seed);
     let out = executor.run(&warm_problem, &mut solver, |_| {});
-    let best = choose(
-        problem.evaluate(out.state.best_position()),
-        warm_problem.warm.iter().map(|w| problem.evaluate(w)),
-        &[scenario.fleet.d_min_m, d_min],
-    );
+    let genes: Vec<&[f64]> = std::iter::once(out.state.best_position())
+        .chain(warm_problem.warm.iter().map(|w| w.as_slice()))
+        .collect();
+    let all: Vec<VehicleEvaluation> = genes.iter().map(|g| problem.evaluate(g)).collect();
+    let separations = [scenario.fleet.d_min_m, d_min];
+    let k = choose(&all, &separations);
+    let best = tighten(&problem, genes[k], all[k].clone(), r, started, &separations);
     let safe = is_safe(&best, d_min);
     let trajectory = Trajectory {
         times: best.trajectory.times.iter().map(|t| t + r.t0).collect(),
@@ -409,170 +457,4 @@ pub fn replan(r: &Request) -> Replanned {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn line(t0: f64, t1: f64) -> Trajectory {
-        Trajectory {
-            times: vec![t0, t1],
-            points: vec![Vec3::new(0.0, 0.0, 100.0), Vec3::new(1000.0, 0.0, 100.0)],
-        }
-    }
-
-    #[test]
-    fn the_warm_start_is_the_rest_of_the_plan_evenly_spaced() {
-        // 1000 m in 1000 s; from t0 = 200 the rest is 800 m in 800 s from x = 200.
-        let g = warm_chromosome(
-            &line(0.0, 1000.0),
-            200.0,
-            Vec3::new(200.0, 0.0, 100.0),
-            3,
-            (0.5, 2.0),
-        );
-        assert_eq!(g.len(), 12);
-        for (k, x) in [400.0, 600.0, 800.0].iter().enumerate() {
-            assert!((g[3 * k] - x).abs() < 1e-9, "{g:?}");
-            assert!(g[3 * k + 1].abs() < 1e-9);
-        }
-        // 1 m/s, inside the range.
-        assert!(g[9..].iter().all(|v| (v - 1.0).abs() < 1e-9), "{g:?}");
-    }
-
-    #[test]
-    fn a_raised_stop_flag_ends_the_swarm_long_before_its_budget(
-    ) -> Result<(), Box<dyn std::error::Error>> {
-        let file = concat!(env!("CARGO_MANIFEST_DIR"), "/../scenarios/amp-pso-1.toml");
-        let s = Scenario::load(std::path::Path::new(file))?;
-        let plans: Vec<Trajectory> = s
-            .vehicles
-            .iter()
-            .map(|v| Trajectory {
-                times: vec![0.0, 2100.0],
-                points: vec![v.start(), v.goal()],
-            })
-            .collect();
-        let stop = Arc::new(AtomicBool::new(true));
-        let r = Request {
-            scenario: &s,
-            vehicle: 0,
-            t0: 100.0,
-            p0: plans[0].position_at(100.0),
-            heading: None,
-            current: &plans[0],
-            resume_s: None,
-            others: &plans,
-            arrival_s: 2100.0,
-            budget: Duration::from_secs(5),
-            separation_buffer_m: 10.0,
-            seed: 1,
-            ground: None,
-            stop: Some(Arc::clone(&stop)),
-        };
-        let out = replan(&r);
-        // It still answers: the warm start, the rest of the straight plan.
-        assert_eq!(out.trajectory.points.len(), s.optimizer.waypoints + 2);
-        // Not raised, the swarm runs to its budget or its iteration cap: 818 ms against 3.9 ms
-        // stopped (266 ms when the flag stopped only the swarm: the coarse way round's search,
-        // 263 ms of that, stops for it too).
-        stop.store(false, Ordering::Relaxed);
-        let full = replan(&r);
-        assert!(
-            out.elapsed * 20 < full.elapsed,
-            "stopped {:?}, not stopped {:?}",
-            out.elapsed,
-            full.elapsed
-        );
-        Ok(())
-    }
-
-    #[test]
-    fn a_waypoint_inside_an_obstacle_is_pushed_sideways() -> Result<(), Box<dyn std::error::Error>>
-    {
-        let file = concat!(env!("CARGO_MANIFEST_DIR"), "/../scenarios/amp-pso-1.toml");
-        let mut s = Scenario::load(std::path::Path::new(file))?;
-        s.obstacles = vec![shoal_common::scenario::Obstacle {
-            id: "new".into(),
-            kind: shoal_common::scenario::ObstacleKind::Hard,
-            centre: [500.0, 0.0, 100.0],
-            radius_m: 40.0,
-            inflation_m: 50.0,
-        }];
-        let mut g = vec![
-            250.0, 0.0, 100.0, 500.0, 0.0, 100.0, 750.0, 0.0, 100.0, 1.0, 1.0, 1.0,
-        ];
-        push_out_of_obstacles(&mut g, &s, 3);
-        // The middle one is on the path through the centre: pushed horizontally across it, to
-        // 1.4 × 90 m from the centre; the others are outside 1.4 r and stay.
-        let p = Vec3::new(g[3], g[4], g[5]);
-        assert!(
-            ((p - Vec3::new(500.0, 0.0, 100.0)).norm() - 126.0).abs() < 1e-9,
-            "{p}"
-        );
-        assert!(
-            (p.x - 500.0).abs() < 1e-9 && (p.z - 100.0).abs() < 1e-9,
-            "{p}"
-        );
-        assert_eq!(&g[0..3], &[250.0, 0.0, 100.0]);
-        assert_eq!(&g[6..9], &[750.0, 0.0, 100.0]);
-        Ok(())
-    }
-
-    fn candidate(hits: usize, separation: f64, motion: f64, total: f64) -> VehicleEvaluation {
-        VehicleEvaluation {
-            trajectory: line(0.0, 1.0),
-            terms: shoal_common::cost::VehicleTerms {
-                hard_hits: hits,
-                motion,
-                ..Default::default()
-            },
-            min_separation: separation,
-            total,
-        }
-    }
-
-    #[test]
-    fn the_answer_is_safe_then_flyable_then_cheapest() {
-        // (swarm's best, the one warm start, which wins), each as (hits, separation, motion
-        // penalty, cost); d_min 50 m.
-        let cases = [
-            // The swarm's best is safe and clean: it is the answer.
-            ((0, 80.0, 0.0, 1.0), (0, 80.0, 0.0, 3.0), 1.0),
-            // It grazes an obstacle, or comes within d_min: the safe warm start wins.
-            ((1, 80.0, 0.0, 1.0), (0, 80.0, 0.0, 3.0), 3.0),
-            ((0, 49.0, 0.0, 1.0), (0, 80.0, 0.0, 3.0), 3.0),
-            // Safe with one slight turn violation (1.1): within the slack of the clean one.
-            ((0, 80.0, 1.1, 1.0), (0, 80.0, 0.0, 3.0), 1.0),
-            // Safe but a string of reversals (9.0): the clean warm start wins.
-            ((0, 80.0, 9.0, 1.0), (0, 80.0, 0.0, 3.0), 3.0),
-            // Nothing safe: the swarm's best, reported unsafe by the caller.
-            ((2, 80.0, 0.0, 1.0), (1, 80.0, 0.0, 3.0), 1.0),
-        ];
-        for (swarm, warm, expected) in cases {
-            let c = |(h, s, m, t)| candidate(h, s, m, t);
-            let got = choose(c(swarm), std::iter::once(c(warm)), &[50.0]).total;
-            assert_eq!(got, expected, "swarm {swarm:?}, warm {warm:?}");
-        }
-    }
-
-    #[test]
-    fn a_candidate_that_keeps_the_buffer_beats_one_that_only_keeps_d_min() {
-        // d_min 50 m, buffer 10 m: (swarm's best, warm start) as (separation, cost).
-        let c = |s: f64, t: f64| candidate(0, s, 0.0, t);
-        let pick = |swarm: (f64, f64), warm: (f64, f64)| {
-            choose(
-                c(swarm.0, swarm.1),
-                std::iter::once(c(warm.0, warm.1)),
-                &[60.0, 50.0],
-            )
-            .total
-        };
-        // The cheaper answer grazes d_min (52 m); the dearer one keeps 61 m: it wins.
-        assert_eq!(pick((52.0, 1.0), (61.0, 3.0)), 3.0);
-        // Both keep the buffer: the cheaper wins.
-        assert_eq!(pick((65.0, 1.0), (61.0, 3.0)), 1.0);
-        // Neither keeps it; both keep d_min: the cheaper wins rather than nothing.
-        assert_eq!(pick((52.0, 1.0), (55.0, 3.0)), 1.0);
-        // Only one keeps d_min: it wins.
-        assert_eq!(pick((49.0, 1.0), (55.0, 3.0)), 3.0);
-    }
-}
+mod tests;

@@ -178,3 +178,33 @@ fn a_leg_shorter_than_its_floor_is_over_by_the_shortfall_over_the_floor() {
     assert_abs_diff_eq!(f[1], 0.4, epsilon = 1e-12);
     assert_abs_diff_eq!(f[2], 12.8 / 9.0, epsilon = 1e-12);
 }
+
+#[test]
+fn entering_a_leg_45_degrees_off_the_course_is_cos_35_minus_cos_45_over() -> Result<(), &'static str>
+{
+    // Under way northwards; the first leg heads north-east (45°), the turn limit is 35°:
+    // cos 35° − cos 45° = 0.819152 − 0.707107 = 0.112045.
+    let north = Vec3::new(0.0, 1.0, 0.3);
+    let points = [
+        Vec3::zeros(),
+        Vec3::new(10.0, 10.0, -2.0),
+        Vec3::new(20.0, 30.0, -4.0),
+        Vec3::new(30.0, 50.0, -4.0),
+    ];
+    let row = entry_turn_row(north, &points, &limits(20.0, 35.0)).ok_or("no row")?;
+    assert_abs_diff_eq!(row.value, 0.112045, epsilon = 1e-6);
+    // Only the first leg's end moves the turn; its height does not.
+    assert!(row
+        .gradient
+        .iter()
+        .all(|(v, g)| *v < 3 && (*v != 2 || *g == 0.0)));
+    gradient_matches_differences(&points, |p| {
+        entry_turn_row(north, p, &limits(20.0, 35.0))
+            .into_iter()
+            .collect()
+    });
+    // A vertical course, or a first leg that ends at the fixed goal, gives no row.
+    assert!(entry_turn_row(Vec3::z(), &points, &limits(20.0, 35.0)).is_none());
+    assert!(entry_turn_row(north, &points[..2], &limits(20.0, 35.0)).is_none());
+    Ok(())
+}

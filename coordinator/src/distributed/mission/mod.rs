@@ -36,6 +36,7 @@ pub use state::{Status, Timing};
 
 use super::agents::LocalAgents;
 use super::network::{Event, Network};
+use crate::planning::finish::CHECKPOINT_EVERY;
 use crate::planning::solver::RunResult;
 
 /// Runs the mission and returns the best plan's run result and the network figures.
@@ -61,6 +62,7 @@ pub fn run(
     let mut iteration = 0usize;
     let mut stale = false;
     let mut interrupted = false;
+    let mut checkpoints = Vec::new();
     for round in 0..total_rounds {
         if stop.load(Ordering::Relaxed) {
             interrupted = true;
@@ -107,6 +109,12 @@ pub fn run(
         };
         let (migrants, improved) = leader.exchange(&elites, progress);
         stale |= improved;
+        // The leader's best after every sweep of the adaptive schedule, finished like the
+        // run's end (`planning::finish`), as the in-process executor keeps them.
+        let sweeps = |i: usize| i / CHECKPOINT_EVERY;
+        if sweeps(iteration) > sweeps(iteration - n) && iteration < o.iterations {
+            checkpoints.push(leader.best_x().to_vec());
+        }
         if stale && context_due(round, o.distributed.context_every) {
             stale = false;
             context = leader.context(round as u32 + 1);
@@ -182,8 +190,7 @@ pub fn run(
             Termination::MaxIterations
         },
         runtime_s: started.elapsed().as_secs_f64(),
-        // The leader's rounds keep no sweep checkpoints: the run's best alone is finished.
-        checkpoints: Vec::new(),
+        checkpoints,
     };
     Ok((result, figures))
 }

@@ -1,0 +1,217 @@
+//! The Sℓ1QP search of one vehicle's path (Nocedal & Wright 2006, §18.5), against whatever
+//! judges it: the whole fleet's fitness when a plan is refined ([`super::refine`]), or one
+//! vehicle's cost against fixed others when a replan is ([`super::vehicle`]).
+
+use std::ops::Range;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+use std::time::Instant;
+
+use super::constraints::{self, Limits, Row};
+use super::objective::{model_hessian, objective_gradient};
+use super::qp::Program;
+use super::RefineSettings;
+use crate::cost::FleetModel;
+use crate::geometry::Vec3;
+use crate::trajectory::Trajectory;
+
+/// What a search steps in: how a position is scored and what the rows see of it.
+pub(super) trait Arena {
+    /// One scored position.
+    type Eval: Clone;
+    /// The fleet model (scenario, obstacles, decoding).
+    fn model(&self) -> &FleetModel;
+    /// Scores position `x`.
+    fn evaluate(&self, x: &[f64]) -> Self::Eval;
+    /// Where vehicle `i`'s chromosome sits in a position.
+    fn genes(&self, i: usize) -> Range<usize>;
+    /// What a step must lower.
+    fn merit(&self, e: &Self::Eval) -> f64;
+    /// Weighted penalties (zero: every limit kept).
+    fn penalty(&self, e: &Self::Eval) -> f64;
+    /// The arrival the others keep, seconds: with the slowest speed, the shortest a path may
+    /// be (`None`: an early arrival is allowed).
+    fn common_arrival(&self, e: &Self::Eval) -> Option<f64>;
+    /// Vehicle `i`'s timed trajectory.
+    fn mine<'e>(&'e self, e: &'e Self::Eval, i: usize) -> &'e Trajectory;
+    /// The other vehicles' timed trajectories.
+    fn others<'e>(&'e self, e: &'e Self::Eval, i: usize) -> Vec<&'e Trajectory>;
+    /// Rows only this arena has (a replan's turn off the vehicle's present course).
+    fn extra_rows(&self, _points: &[Vec3], _limits: &Limits, _rows: &mut Vec<Row>) {}
+}
+
+/// The state of one refinement.
+pub(super) struct Search<'a, A: Arena> {
+    pub arena: &'a A,
+    pub settings: &'a RefineSettings,
+    pub stop: Option<&'a Arc<AtomicBool>>,
+    /// The arrival a path's length must allow at top speed, seconds.
+    pub target: f64,
+    pub x: Vec<f64>,
+    pub eval: A::Eval,
+    pub evaluations: u64,
+    pub steps: usize,
+    pub interrupted: bool,
+}
+
+impl<'a, A: Arena> Search<'a, A> {
+    /// A search from `x`.
+    pub fn new(
+        arena: &'a A,
+        x: &[f64],
+        target: f64,
+        settings: &'a RefineSettings,
+        stop: Option<&'a Arc<AtomicBool>>,
+    ) -> Self {
+        Search {
+            arena,
+            settings,
+            stop,
+            target,
+            x: x.to_vec(),
+            eval: arena.evaluate(x),
+            evaluations: 1,
+            steps: 0,
+            interrupted: false,
+        }
+    }
+
+    /// The stop flag is raised or the deadline has passed.
+    fn should_stop(&self) -> bool {
+        self.stop.is_some_and(|f| f.load(Ordering::Relaxed))
+            || self.settings.deadline.is_some_and(|d| Instant::now() >= d)
+    }
+
+    /// Up to `steps` programs for vehicle `i`, the others held.
+    pub fn vehicle(&mut self, i: usize) {
+        let model = self.arena.model();
+        let s = &model.scenario;
+        let v = &s.vehicles[i];
+        let margin = self.settings.angle_margin_deg;
+        let limits = Limits {
+            max_pitch: (v.max_pitch_deg - margin).to_radians(),
+            max_turn: (v.max_turn_deg - margin).to_radians(),
+            clearance_margin: self.settings.distance_margin_m,
+            separation: s.fleet.d_min_m + self.settings.distance_margin_m,
+            d_min: s.fleet.d_min_m,
+        };
+        let range = self.arena.genes(i);
+        let n = 3 * model.layout.waypoints;
+        let coords = range.start..range.start + n;
+        let bounds = model.layout.chromosome(i).start;
+        let mut radius = self.settings.radius_m;
+        let floors = constraints::spacing_floors(&model.decode(i, &self.x[range.clone()]).points);
+        for _ in 0..self.settings.steps {
+            if self.should_stop() {
+                self.interrupted = true;
+                return;
+            }
+            let points = model.decode(i, &self.x[range.clone()]).points;
+            let mut rows = self.rows(i, &points, &limits, radius);
+            constraints::spacing_rows(&points, &floors, &mut rows);
+            if self.arena.penalty(&self.eval) <= 0.0 {
+                // A plan that keeps every limit may sit inside a margin: it holds its ground
+                // there instead of paying (in the model) for leaving it.
+                for row in rows.iter_mut() {
+                    row.value = row.value.min(0.0);
+                }
+            }
+            let gradient = objective_gradient(model, i, &points);
+            let hessian = model_hessian(model, i, &points);
+            let (lo, hi): (Vec<f64>, Vec<f64>) = coords
+                .clone()
+                .map(|g| {
+                    let b = bounds + g - range.start;
+                    (
+                        (model.lower[b] - self.x[g]).max(-radius),
+                        (model.upper[b] - self.x[g]).min(radius),
+                    )
+                })
+                .unzip();
+            let program = Program {
+                hessian: &hessian,
+                gradient: &gradient,
+                rows: &rows,
+                lo: &lo,
+                hi: &hi,
+                rho: s.optimizer.penalty_weight,
+            };
+            let Some(step) = program.solve() else {
+                return;
+            };
+            let merit = self.arena.merit(&self.eval);
+            if step.predicted > -1e-12 * merit.abs().max(1.0) {
+                return;
+            }
+            let longest = step.d.iter().fold(0.0_f64, |m, d| m.max(d.abs()));
+            match self.try_step(&coords, &step.d) {
+                Some((scale, actual)) => {
+                    self.steps += 1;
+                    let ratio = actual / step.predicted;
+                    if scale < 1.0 {
+                        radius = scale * longest;
+                    } else if ratio > 0.75 && longest > 0.9 * radius {
+                        radius = (2.0 * radius).min(8.0 * self.settings.radius_m);
+                    } else if ratio < 0.25 {
+                        radius = 0.5 * longest;
+                    }
+                }
+                None => radius = 0.125 * longest,
+            }
+            if radius < self.settings.min_radius_m {
+                return;
+            }
+        }
+    }
+
+    /// Moves the genes `coords` by `d`, or by a half or a quarter of it when the whole step
+    /// does not lower the merit (a step the linearised limits allowed may cross a curved
+    /// limit: halving it quarters that second-order error). Returns the fraction kept and the
+    /// change of merit, or `None` when no fraction lowered it.
+    fn try_step(&mut self, coords: &Range<usize>, d: &[f64]) -> Option<(f64, f64)> {
+        let mut scale = 1.0;
+        let now = self.arena.merit(&self.eval);
+        for _ in 0..3 {
+            let mut trial = self.x.clone();
+            for (g, d) in coords.clone().zip(d) {
+                trial[g] += scale * d;
+            }
+            let e = self.arena.evaluate(&trial);
+            self.evaluations += 1;
+            let actual = self.arena.merit(&e) - now;
+            if actual < 0.0 {
+                self.x = trial;
+                self.eval = e;
+                return Some((scale, actual / scale));
+            }
+            scale *= 0.5;
+        }
+        None
+    }
+
+    /// The limits of vehicle `i` near its path `points`, the others as the arena has them.
+    fn rows(&self, i: usize, points: &[Vec3], limits: &Limits, radius: f64) -> Vec<Row> {
+        let model = self.arena.model();
+        let s = &model.scenario;
+        let v = &s.vehicles[i];
+        // Limits a step of `radius` per coordinate could reach, with room to spare.
+        let reach = 4.0 * radius + s.fleet.d_min_m;
+        let mut rows = Vec::new();
+        constraints::pitch_rows(points, limits, &mut rows);
+        constraints::turn_rows(points, limits, &mut rows);
+        constraints::hard_rows(points, &model.hard, limits, reach, &mut rows);
+        self.arena.extra_rows(points, limits, &mut rows);
+        let mine = self.arena.mine(&self.eval, i);
+        let step = self.settings.sample_step_s;
+        for other in self.arena.others(&self.eval, i) {
+            constraints::separation_rows(mine, other, limits, step, reach, &mut rows);
+        }
+        let latest = v.speed_max_mps * self.target;
+        rows.extend(constraints::length_row(points, latest, 1.0));
+        if let Some(arrival) = self.arena.common_arrival(&self.eval) {
+            let earliest = v.speed_min_mps * arrival;
+            rows.extend(constraints::length_row(points, earliest, -1.0));
+        }
+        rows
+    }
+}
