@@ -148,6 +148,30 @@ fn a_lost_agent_is_planned_by_the_coordinator() -> TestResult {
     Ok(())
 }
 
+/// The leader keeps its best after every sweep of the adaptive schedule and the coordinator
+/// finishes each (touch-up and refinement, as a plan ends): two sweeps never end worse than
+/// one, whose run they repeat before going on.
+#[test]
+fn a_longer_distributed_budget_never_finishes_worse() -> TestResult {
+    let mut s = scenario()?;
+    (s.optimizer.touch_up, s.optimizer.refine) = (true, true);
+    s.optimizer.distributed.exchange_every = 25;
+    let sweep = shoal_coordinator::planning::finish::CHECKPOINT_EVERY;
+    let mut fitness = Vec::new();
+    for (k, iterations) in [sweep, 2 * sweep].into_iter().enumerate() {
+        s.optimizer.iterations = iterations;
+        let endpoint = free_endpoint()?;
+        let agents = fleet_agents(&endpoint);
+        let mission = format!("loopback-sweeps-{k}");
+        let plan = coordinate(&s, options(&mission, &endpoint, 30), |_| {})??;
+        finish(agents)?;
+        assert_eq!(plan.convergence.last(), Some(&plan.fitness));
+        fitness.push(plan.fitness);
+    }
+    assert!(fitness[1] <= fitness[0] + 1e-12, "{fitness:?}");
+    Ok(())
+}
+
 #[test]
 fn agents_that_never_join_are_named() -> TestResult {
     let s = scenario()?;
