@@ -207,6 +207,31 @@ pub fn hard_rows(
     }
 }
 
+/// Soft-obstacle rows: `(r − distance(leg, centre)) / r ≤ 0` for every leg that is outside a
+/// soft sphere and within `reach` metres of its surface. F(O) pays the chord a leg cuts through
+/// the sphere, which grows as the square root of the depth it dips in: its gradient at the
+/// surface is unbounded and a difference gradient taken outside does not see it, so a step
+/// that shortens a path past a soft sphere would dip in and be refused. A leg already inside
+/// one has no row: F(O) itself pulls it out.
+pub fn soft_rows(points: &[Vec3], soft: &[Sphere], reach: f64, rows: &mut Vec<Row>) {
+    let inner = points.len().saturating_sub(2);
+    for s in soft {
+        for (k, w) in points.windows(2).enumerate() {
+            let u = closest_param(&w[0], &w[1], &s.centre);
+            let away = w[0] + (w[1] - w[0]) * u - s.centre;
+            let distance = away.norm();
+            if distance <= s.radius || distance > s.radius + reach {
+                continue;
+            }
+            let mut row = Row::new((s.radius - distance) / s.radius);
+            let g = -away / (distance * s.radius);
+            row.add(k, inner, g * (1.0 - u));
+            row.add(k + 1, inner, g * u);
+            rows.push(row);
+        }
+    }
+}
+
 /// Separation rows against one other vehicle: `(separation − |p(t) − q(t)|) / d_min ≤ 0` at
 /// the sample times (every `step` seconds to the later arrival) where the distance has a local
 /// minimum within `reach` metres of the limit: the closest approaches, which a small change of

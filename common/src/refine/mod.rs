@@ -13,7 +13,9 @@
 //! - the objective is the vehicle's smooth part of eq. (12): F(L), F(D), F(O) and F(T) (its
 //!   gradient by central differences; its model Hessian the path length's, exact);
 //! - the limits are rows with analytic gradients ([`constraints`]): pitch and turn at every leg
-//!   and waypoint, clearance of every hard sphere, separation from every other vehicle sampled
+//!   and waypoint, clearance of every hard sphere (and of every soft sphere a leg is outside:
+//!   F(O)'s chord is not differentiable where a leg touches one), separation from every other
+//!   vehicle sampled
 //!   along the timed trajectories, and a length that arrives by the target arrival at top speed;
 //! - each step is one convex program for Clarabel ([`qp`]);
 //! - a step is kept only when the *true* fleet fitness (eq. (12) plus every penalty, as the swarm

@@ -200,6 +200,7 @@ impl<'a, A: Arena> Search<'a, A> {
         constraints::pitch_rows(points, limits, &mut rows);
         constraints::turn_rows(points, limits, &mut rows);
         constraints::hard_rows(points, &model.hard, limits, reach, &mut rows);
+        constraints::soft_rows(points, &model.soft, reach, &mut rows);
         self.arena.extra_rows(points, limits, &mut rows);
         let mine = self.arena.mine(&self.eval, i);
         let step = self.settings.sample_step_s;

@@ -263,3 +263,28 @@ fn a_passed_deadline_returns_the_path_unchanged() -> Result<(), ScenarioError> {
     assert!(r.interrupted && r.steps == 0 && r.x == x);
     Ok(())
 }
+
+/// Round a soft sphere that costs more to cross than to go round (F(O) weighted ten times
+/// F(L)), the detour is pulled onto the same tangents and arc as round a hard one, 902.26 m,
+/// and never dips in.
+#[test]
+fn a_detour_round_a_costly_soft_sphere_is_pulled_tight_without_entering_it(
+) -> Result<(), ScenarioError> {
+    let mut s = scenario(
+        "[[obstacles]]\nid = \"zone\"\nkind = \"soft\"\ncentre = [500.0, 500.0, 250.0]\n\
+         radius_m = 150.0\ninflation_m = 50.0\n",
+        &[vehicle("a", [100.0, 500.0, 250.0], [900.0, 500.0, 250.0])],
+    )?;
+    s.optimizer.weights = [1.0, 0.0, 10.0, 0.0, 0.0];
+    let model = FleetModel::new(&s);
+    let x = chromosome(12, |u| {
+        [100.0 + 800.0 * u, 500.0 + 300.0 * (PI * u).sin(), 250.0]
+    });
+    let r = refine(&model, &x, &RefineSettings::default(), None);
+    let bound = 2.0 * (400f64.powi(2) - 200f64.powi(2)).sqrt() + 200.0 * (PI - 2.0 * 0.5f64.acos());
+    let l = length(&model, &r.x, 0);
+    assert!(l > bound - 0.01 && l < 1.01 * bound, "{l} against {bound}");
+    let soft = crate::cost::soft_threat_term(&model.decode(0, &r.x[..]).points, &model.soft, 800.0);
+    assert_eq!(soft, 0.0);
+    Ok(())
+}

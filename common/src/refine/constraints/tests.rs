@@ -208,3 +208,34 @@ fn entering_a_leg_45_degrees_off_the_course_is_cos_35_minus_cos_45_over() -> Res
     assert!(entry_turn_row(north, &points[..2], &limits(20.0, 35.0)).is_none());
     Ok(())
 }
+
+#[test]
+fn a_leg_3_m_from_a_2_m_soft_sphere_is_half_a_radius_clear_and_one_inside_has_no_row() {
+    let sphere = Sphere {
+        centre: Vec3::new(5.0, 3.0, 0.0),
+        radius: 2.0,
+    };
+    let points = [
+        Vec3::zeros(),
+        Vec3::new(4.0, 0.0, 0.0),
+        Vec3::new(10.0, 0.0, 0.0),
+    ];
+    let mut rows = Vec::new();
+    soft_rows(&points, &[sphere], 5.0, &mut rows);
+    // First leg: closest at (4, 0, 0), √10 away; second: 3 m away. No margin, no guard.
+    assert_eq!(rows.len(), 2);
+    assert_abs_diff_eq!(rows[0].value, (2.0 - 10f64.sqrt()) / 2.0, epsilon = 1e-12);
+    assert_abs_diff_eq!(rows[1].value, (2.0 - 3.0) / 2.0, epsilon = 1e-12);
+    gradient_matches_differences(&points, |p| {
+        let mut rows = Vec::new();
+        soft_rows(p, &[sphere], 5.0, &mut rows);
+        rows
+    });
+    // The second leg turned towards (10, 4, 0) passes 1.94 m from the centre, inside: F(O)
+    // pays for that one, and only the first leg keeps its row.
+    let inside = [points[0], points[1], Vec3::new(10.0, 4.0, 0.0)];
+    let mut rows = Vec::new();
+    soft_rows(&inside, &[sphere], 5.0, &mut rows);
+    assert_eq!(rows.len(), 1);
+    assert_abs_diff_eq!(rows[0].value, (2.0 - 10f64.sqrt()) / 2.0, epsilon = 1e-12);
+}
