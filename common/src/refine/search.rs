@@ -10,7 +10,7 @@ use std::time::Instant;
 use super::constraints::{self, Limits, Row};
 use super::objective::{model_hessian, objective_gradient};
 use super::qp::Program;
-use super::RefineSettings;
+use super::settings::RefineSettings;
 use crate::cost::FleetModel;
 use crate::geometry::Vec3;
 use crate::trajectory::Trajectory;

@@ -2,6 +2,7 @@ use super::*;
 use crate::geometry::Vec3;
 use crate::scenario::ScenarioError;
 use std::f64::consts::PI;
+use std::time::Instant;
 
 /// One or two AUVs in a 1000 × 1000 × 500 m box, 12 waypoints, length the only objective term.
 fn scenario(extra: &str, vehicles: &[String]) -> Result<Scenario, ScenarioError> {
