@@ -128,9 +128,11 @@ fn a_path_is_pulled_tight_only_as_far_as_the_separation_allows() -> Result<(), S
     Ok(())
 }
 
-/// A raised stop flag returns the plan as it came, marked as interrupted.
+/// A raised stop flag, or a deadline already past, returns the plan as it came, marked as
+/// interrupted.
 #[test]
-fn a_raised_stop_flag_returns_the_plan_unchanged() -> Result<(), ScenarioError> {
+fn a_raised_stop_flag_or_a_passed_deadline_returns_the_plan_unchanged() -> Result<(), ScenarioError>
+{
     let s = scenario(
         "",
         &[vehicle("a", [100.0, 500.0, 250.0], [900.0, 500.0, 250.0])],
@@ -144,6 +146,12 @@ fn a_raised_stop_flag_returns_the_plan_unchanged() -> Result<(), ScenarioError> 
     assert!(r.interrupted);
     assert_eq!(r.x, x);
     assert_eq!(r.steps, 0);
+    let settings = RefineSettings {
+        deadline: Some(Instant::now()),
+        ..RefineSettings::default()
+    };
+    let r = refine(&model, &x, &settings, None);
+    assert!(r.interrupted && r.steps == 0 && r.x == x);
     Ok(())
 }
 
@@ -242,26 +250,6 @@ fn a_path_entered_under_way_keeps_its_first_turn_within_the_limit() -> Result<()
     assert!(r.length_m.1 < 0.95 * r.length_m.0, "{r:?}");
     assert_eq!(entry(&r.genes), 0.0);
     assert_eq!(problem.evaluate(&r.genes).terms.motion, 0.0);
-    Ok(())
-}
-
-/// A deadline already past ends the refinement before its first program.
-#[test]
-fn a_passed_deadline_returns_the_path_unchanged() -> Result<(), ScenarioError> {
-    let s = scenario(
-        "",
-        &[vehicle("a", [100.0, 500.0, 250.0], [900.0, 500.0, 250.0])],
-    )?;
-    let model = FleetModel::new(&s);
-    let x = chromosome(12, |u| {
-        [100.0 + 800.0 * u, 500.0 + 300.0 * (PI * u).sin(), 250.0]
-    });
-    let settings = RefineSettings {
-        deadline: Some(Instant::now()),
-        ..RefineSettings::default()
-    };
-    let r = refine(&model, &x, &settings, None);
-    assert!(r.interrupted && r.steps == 0 && r.x == x);
     Ok(())
 }
 

@@ -78,8 +78,9 @@ fn a_right_angle_turn_is_cos_35_over_a_35_degree_limit() {
     });
 }
 
-#[test]
-fn a_leg_passing_3_m_from_a_2_m_sphere_keeps_a_quarter_radius_to_spare() {
+/// A sphere of radius 2 m centred at (5, 3, 0), beside legs (0,0,0)→(4,0,0)→(10,0,0): √10 m
+/// from the first, 3 m from the second.
+fn sphere_beside_two_legs() -> (Sphere, [Vec3; 3]) {
     let sphere = Sphere {
         centre: Vec3::new(5.0, 3.0, 0.0),
         radius: 2.0,
@@ -89,6 +90,12 @@ fn a_leg_passing_3_m_from_a_2_m_sphere_keeps_a_quarter_radius_to_spare() {
         Vec3::new(4.0, 0.0, 0.0),
         Vec3::new(10.0, 0.0, 0.0),
     ];
+    (sphere, points)
+}
+
+#[test]
+fn a_leg_passing_3_m_from_a_2_m_sphere_keeps_a_quarter_radius_to_spare() {
+    let (sphere, points) = sphere_beside_two_legs();
     let mut rows = Vec::new();
     hard_rows(&points, &[sphere], &limits(20.0, 35.0), 5.0, &mut rows);
     // First leg: closest at (4, 0, 0), √(1 + 9) away; second: 3 m away. Keep 2.5 m (+ guard).
@@ -211,15 +218,7 @@ fn entering_a_leg_45_degrees_off_the_course_is_cos_35_minus_cos_45_over() -> Res
 
 #[test]
 fn a_leg_3_m_from_a_2_m_soft_sphere_is_half_a_radius_clear_and_one_inside_has_no_row() {
-    let sphere = Sphere {
-        centre: Vec3::new(5.0, 3.0, 0.0),
-        radius: 2.0,
-    };
-    let points = [
-        Vec3::zeros(),
-        Vec3::new(4.0, 0.0, 0.0),
-        Vec3::new(10.0, 0.0, 0.0),
-    ];
+    let (sphere, points) = sphere_beside_two_legs();
     let mut rows = Vec::new();
     soft_rows(&points, &[sphere], 5.0, &mut rows);
     // First leg: closest at (4, 0, 0), √10 away; second: 3 m away. No margin, no guard.

@@ -26,19 +26,28 @@ fn the_warm_start_is_the_rest_of_the_plan_evenly_spaced() {
     assert!(g[9..].iter().all(|v| (v - 1.0).abs() < 1e-9), "{g:?}");
 }
 
-#[test]
-fn a_raised_stop_flag_ends_the_swarm_long_before_its_budget(
-) -> Result<(), Box<dyn std::error::Error>> {
+/// The shipped scenario 1.
+fn scenario_1() -> Result<Scenario, Box<dyn std::error::Error>> {
     let file = concat!(env!("CARGO_MANIFEST_DIR"), "/../scenarios/amp-pso-1.toml");
-    let s = Scenario::load(std::path::Path::new(file))?;
-    let plans: Vec<Trajectory> = s
-        .vehicles
+    Ok(Scenario::load(std::path::Path::new(file))?)
+}
+
+/// Every vehicle of `s` straight from its start to its goal in 2100 s.
+fn straight_plans(s: &Scenario) -> Vec<Trajectory> {
+    s.vehicles
         .iter()
         .map(|v| Trajectory {
             times: vec![0.0, 2100.0],
             points: vec![v.start(), v.goal()],
         })
-        .collect();
+        .collect()
+}
+
+#[test]
+fn a_raised_stop_flag_ends_the_swarm_long_before_its_budget(
+) -> Result<(), Box<dyn std::error::Error>> {
+    let s = scenario_1()?;
+    let plans = straight_plans(&s);
     let stop = Arc::new(AtomicBool::new(true));
     let r = Request {
         scenario: &s,
@@ -75,8 +84,7 @@ fn a_raised_stop_flag_ends_the_swarm_long_before_its_budget(
 
 #[test]
 fn a_waypoint_inside_an_obstacle_is_pushed_sideways() -> Result<(), Box<dyn std::error::Error>> {
-    let file = concat!(env!("CARGO_MANIFEST_DIR"), "/../scenarios/amp-pso-1.toml");
-    let mut s = Scenario::load(std::path::Path::new(file))?;
+    let mut s = scenario_1()?;
     s.obstacles = vec![shoal_common::scenario::Obstacle {
         id: "new".into(),
         kind: shoal_common::scenario::ObstacleKind::Hard,
@@ -166,21 +174,13 @@ fn a_candidate_that_keeps_the_buffer_beats_one_that_only_keeps_d_min() {
 #[test]
 fn the_chosen_answer_is_refined_within_the_budget_unless_turned_off(
 ) -> Result<(), Box<dyn std::error::Error>> {
-    let file = concat!(env!("CARGO_MANIFEST_DIR"), "/../scenarios/amp-pso-1.toml");
-    let mut s = Scenario::load(std::path::Path::new(file))?;
+    let mut s = scenario_1()?;
     s.obstacles.clear();
     // Level, so the straight line keeps the pitch limit and the bowed path breaks nothing.
     s.vehicles[0].goal[2] = s.vehicles[0].start[2];
     // Length the only term: the depth term alone would trade length for a shallower path.
     s.optimizer.weights = [1.0, 0.0, 0.0, 0.0, 0.0];
-    let plans: Vec<Trajectory> = s
-        .vehicles
-        .iter()
-        .map(|v| Trajectory {
-            times: vec![0.0, 2100.0],
-            points: vec![v.start(), v.goal()],
-        })
-        .collect();
+    let plans = straight_plans(&s);
     let model = FleetModel::new(&s);
     let problem = VehicleProblem::new(&model, 0, &plans, 2100.0).early_arrival_allowed();
     let v = &s.vehicles[0];
