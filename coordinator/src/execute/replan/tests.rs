@@ -219,15 +219,10 @@ fn the_chosen_answer_is_refined_within_the_budget_unless_turned_off(
         ground: None,
         stop: None,
     };
-    let separations = [50.0];
-    let refined = tighten(
-        &problem,
-        &genes,
-        chosen.clone(),
-        &r,
-        Instant::now(),
-        &separations,
-    );
+    let tightened = |r: &Request, started: Instant| {
+        tighten(&problem, &genes, chosen.clone(), r, started, &[50.0])
+    };
+    let refined = tightened(&r, Instant::now());
     let length =
         |e: &VehicleEvaluation| shoal_common::bspline::polyline_length(&e.trajectory.points);
     assert!(
@@ -248,25 +243,10 @@ fn the_chosen_answer_is_refined_within_the_budget_unless_turned_off(
     let mut off = s.clone();
     off.optimizer.refine = false;
     r.scenario = &off;
-    let kept = tighten(
-        &problem,
-        &genes,
-        chosen.clone(),
-        &r,
-        Instant::now(),
-        &separations,
-    );
-    assert_eq!(kept.total, chosen.total);
+    assert_eq!(tightened(&r, Instant::now()).total, chosen.total);
     // A budget already spent leaves the answer as it was, too.
     r.scenario = &s;
-    let late = tighten(
-        &problem,
-        &genes,
-        chosen.clone(),
-        &r,
-        Instant::now() - r.budget,
-        &separations,
-    );
+    let late = tightened(&r, Instant::now() - r.budget);
     assert_eq!(late.total, chosen.total);
     Ok(())
 }
