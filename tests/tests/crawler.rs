@@ -50,6 +50,14 @@ fn every_ipso_plans_the_dsmv_on_the_seabed() -> TestResult {
         // Longer than the 281.43 m straight line (which crosses hazard pa), not absurdly so.
         let length = c["length_m"].as_f64().unwrap_or(f64::NAN);
         assert!(length > 281.43 && length < 300.0, "{algorithm}: {length}");
+        // The plan says how far that is from the grid-search reference (282.314 m on 1 m cells).
+        let gap = 100.0 * (length / 282.3137 - 1.0);
+        let told = format!("dsmv: path {length:.1} m, {gap:+.2} % against the shortest");
+        let notices = key(&json, "notices").to_string();
+        assert!(
+            notices.contains(&told),
+            "{algorithm}: {told} not in {notices}"
+        );
         assert!(c["max_slope_deg"].as_f64() <= c["slope_limit_deg"].as_f64());
         // Energy by hand from the length: 1 m/s, 60 % mining: L/3600 · (1.5·90 + 50 + 2.5·5).
         let energy = length / 3600.0 * (1.5 * 90.0 + 50.0 + 2.5 * 5.0);

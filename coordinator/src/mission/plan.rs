@@ -12,7 +12,7 @@ use crate::distributed::{self, DistributedOptions};
 use crate::planning::{coverage, coverage_fleet, planner};
 use crate::report::out::{say, write_outputs, write_svg};
 use crate::report::progress::Progress;
-use crate::report::summary;
+use crate::report::{crawler_gap, summary};
 
 /// Plans the mission and writes its outputs into `options.out`; whether the plan is feasible.
 /// `shutdown` ends the search early (the best plan so far is still written).
@@ -47,13 +47,18 @@ pub fn plan_mission(options: &MissionOptions, shutdown: Arc<AtomicBool>) -> anyh
         "planning"
     );
     let mut progress = Progress::new(scenario.optimizer.iterations, options.quiet);
-    let plan = match &distributed {
-        None => planner::plan_in_process(&scenario, Some(shutdown), &mut |r| progress.update(r)),
+    let mut plan = match &distributed {
+        None => planner::plan_in_process(&scenario, Some(Arc::clone(&shutdown)), &mut |r| {
+            progress.update(r)
+        }),
         Some(o) => distributed::plan_distributed(&scenario, o, &shutdown, &mut |s| {
             progress.update_distributed(s)
         })?,
     };
     progress.finish();
+    if !shutdown.load(std::sync::atomic::Ordering::Relaxed) {
+        plan.notices.extend(crawler_gap::notices(&scenario, &plan));
+    }
     write_outputs(&options.out, &plan)?;
     write_svg(&options.out, &scenario, &plan)?;
     say(&summary::summary(&plan));

@@ -102,7 +102,7 @@ fn finish_one(
     let swarm_x = touched.as_ref().map_or(x, |t| &t.x);
     let refined = (o.refine && !stopped())
         .then(|| refine(model, swarm_x, &RefineSettings::default(), stop))
-        .filter(|r| r.steps > 0);
+        .filter(shows);
     let evaluations = touched.as_ref().map_or(0, |t| t.evaluations)
         + refined.as_ref().map_or(0, |r| r.evaluations);
     Finished {
@@ -112,6 +112,16 @@ fn finish_one(
         evaluations,
         from_checkpoint: None,
     }
+}
+
+/// Whether a refinement changed what its notice prints (fitness to 4 decimals, length and
+/// arrival to the metre and the second): one that did not is dropped, and the swarm's plan
+/// stands as it was, with no notice of nothing.
+fn shows(r: &Refinement) -> bool {
+    r.steps > 0
+        && (r.total.0 - r.total.1 >= 5e-5
+            || (r.length_m.0 - r.length_m.1).abs() >= 0.5
+            || (r.arrival_s.0 - r.arrival_s.1).abs() >= 0.5)
 }
 
 /// What the refinement changed, in words, for the plan's notices.
@@ -185,4 +195,49 @@ pub fn touch_up_notice(scenario: &Scenario, t: &TouchUp, cleared: bool) -> Strin
             "; the violations listed remain"
         }
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn refinement(total: (f64, f64), length_m: (f64, f64), arrival_s: (f64, f64)) -> Refinement {
+        Refinement {
+            x: Vec::new(),
+            total,
+            length_m,
+            arrival_s,
+            target_arrival_s: 420.0,
+            steps: 1,
+            evaluations: 2,
+            interrupted: false,
+        }
+    }
+
+    /// A refinement whose notice would read "964 m -> 964 m, 0.9322 -> 0.9322, 420 s -> 420 s"
+    /// is dropped; a change any of the three figures shows is kept.
+    #[test]
+    fn a_refinement_that_changes_nothing_the_notice_prints_is_dropped() {
+        let same = refinement((0.93221, 0.93220), (964.2, 964.0), (420.1, 420.0));
+        assert!(!shows(&same));
+        assert!(shows(&refinement(
+            (0.9322, 0.9321),
+            (964.0, 964.0),
+            (420.0, 420.0)
+        )));
+        assert!(shows(&refinement(
+            (0.9322, 0.9322),
+            (964.0, 963.4),
+            (420.0, 420.0)
+        )));
+        assert!(shows(&refinement(
+            (0.9322, 0.9322),
+            (964.0, 964.0),
+            (421.0, 420.0)
+        )));
+        assert!(!shows(&Refinement {
+            steps: 0,
+            ..refinement((0.9322, 0.9), (964.0, 900.0), (421.0, 400.0))
+        }));
+    }
 }

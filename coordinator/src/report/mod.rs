@@ -1,8 +1,9 @@
 //! What the commands write and print: `plan.json` and `plan.svg` ([`out`], [`svg`]), progress,
 //! plan and coverage summaries, the comparison tables ([`compare`], [`significance`],
-//! [`crawler_table`]) and the exports for maps and ground stations ([`geo_export`]).
+//! [`crawler_table`]), a crawler plan's gap to its reference path ([`crawler_gap`]) and the exports for maps and ground stations ([`geo_export`]).
 
 pub mod compare;
+pub mod crawler_gap;
 pub mod crawler_stats;
 pub mod crawler_table;
 pub mod geo_export;
