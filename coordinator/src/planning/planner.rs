@@ -43,7 +43,8 @@ pub fn plan_in_process(
 }
 
 /// The scenario's algorithm as its paper gives it (no touch-up, no refinement) and, for the
-/// fleet algorithms, the same swarm run refined: what `compare` reports side by side.
+/// fleet algorithms with an AUV to refine (crawlers are left alone), the same swarm run
+/// refined: what `compare` reports side by side.
 pub fn plan_alone_and_refined(scenario: &Scenario) -> (Plan, Option<Plan>) {
     let mut alone = scenario.clone();
     alone.optimizer.touch_up = false;
@@ -53,6 +54,9 @@ pub fn plan_alone_and_refined(scenario: &Scenario) -> (Plan, Option<Plan>) {
         return (plan_in_process(&alone, None, &mut |_| {}), None);
     }
     let model = FleetModel::new(&alone);
+    if model.crawlers.iter().all(Option::is_some) {
+        return (plan_in_process(&alone, None, &mut |_| {}), None);
+    }
     let executor = Executor {
         max_iterations: o.iterations,
         checkpoint_every: Some(super::finish::CHECKPOINT_EVERY),

@@ -135,3 +135,23 @@ fn a_raised_stop_returns_the_cells_completed_so_far() {
     .unwrap_or_else(|e| panic!("compare failed: {e}"));
     assert!(cells.is_empty());
 }
+
+/// A scenario of crawlers alone has nothing the refinement touches: one row per algorithm,
+/// not a refined copy of it.
+#[test]
+fn crawlers_alone_get_no_refined_rows() -> Result<(), Box<dyn std::error::Error>> {
+    let file = concat!(env!("CARGO_MANIFEST_DIR"), "/../scenarios/ipso-dsmv.toml");
+    let mut s = Scenario::load(Path::new(file))?;
+    s.optimizer.iterations = 5;
+    let cells = compare(
+        std::slice::from_ref(&s),
+        &[Algorithm::Ipso],
+        1..2,
+        None,
+        &Arc::new(AtomicBool::new(false)),
+        &mut |_| {},
+    )?;
+    let modes: Vec<&str> = cells.iter().map(|c| c.mode.as_str()).collect();
+    assert_eq!(modes, ["in-process"]);
+    Ok(())
+}
