@@ -346,10 +346,10 @@ fn tighten(
 }
 
 /// The share of a replan's budget the refinement keeps for itself when the scenario asks for
-/// it: one refinement program of a 30-waypoint path takes a few milliseconds, so a fifth of the
-/// 300 ms default is a few dozen of them, while the swarm keeps most of the time to find the
-/// way round.
-const REFINE_SHARE: f64 = 0.2;
+/// it: one refinement program of a 30-waypoint path takes about two milliseconds, so a tenth of
+/// the 300 ms default is a dozen or more of them (the search keeps what it has when the time is
+/// up), while the swarm keeps nearly all the time to find the way round.
+const REFINE_SHARE: f64 = 0.1;
 
 /// What of the request's budget the swarm may spend.
 fn swarm_budget(r: &Request) -> Duration {
