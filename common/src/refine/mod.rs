@@ -26,7 +26,9 @@
 //!
 //! The target arrival is the mission time when every vehicle's pitch limit lets it arrive by
 //! then ([`target_arrival`]), so a fleet the swarm left late is pulled back on time where the
-//! paths allow it. Crawlers (their path is a B-spline draped on the seabed) are left as they are.
+//! paths allow it: a vehicle still late gets a fresh route of its own ([`reroute`]), and then a
+//! last pass with margins a tenth as wide (it may be pressed against several limits at once).
+//! Crawlers (their path is a B-spline draped on the seabed) are left as they are.
 
 pub mod constraints;
 mod objective;
@@ -103,6 +105,13 @@ pub fn refine(
         model,
         target: target_arrival(&model.scenario),
     };
+    // The last pass of a vehicle still late: margins a tenth as wide (the acceptance test is
+    // the fitness's own sharp limits, so a narrower margin risks a refused step, not a breach).
+    let fine = RefineSettings {
+        angle_margin_deg: settings.angle_margin_deg / 10.0,
+        distance_margin_m: settings.distance_margin_m / 10.0,
+        ..*settings
+    };
     let mut search = Search::new(&arena, x, arena.target, settings, stop);
     let before = (
         search.eval.total,
@@ -131,11 +140,20 @@ pub fn refine(
             break;
         }
     }
-    for i in swimmers {
+    for &i in &swimmers {
         if search.interrupted {
             break;
         }
         reroute_if_late(&mut search, i);
+    }
+    search.settings = &fine;
+    for &i in &swimmers {
+        if search.interrupted {
+            break;
+        }
+        if late(&search, i) {
+            search.vehicle(i);
+        }
     }
     Refinement {
         total: (before.0, search.eval.total),
@@ -202,13 +220,18 @@ impl Arena for FleetArena<'_> {
     }
 }
 
+/// Vehicle `i`'s path is too long to arrive by the target at its top speed.
+fn late(search: &Search<FleetArena>, i: usize) -> bool {
+    let v = &search.arena.model.scenario.vehicles[i];
+    let length = polyline_length(&search.eval.trajectories[i].points);
+    length / v.speed_max_mps > search.target * (1.0 + 1e-9)
+}
+
 /// When vehicle `i` alone still makes the fleet late, a fresh route for it
 /// ([`reroute::fresh_route`]) refined like the others, kept if it lowers the merit.
 fn reroute_if_late(search: &mut Search<FleetArena>, i: usize) {
     let model = search.arena.model;
-    let v = &model.scenario.vehicles[i];
-    let length = polyline_length(&search.eval.trajectories[i].points);
-    if length / v.speed_max_mps <= search.target * (1.0 + 1e-9) {
+    if !late(search, i) {
         return;
     }
     let executor = crate::swarm::Executor {
