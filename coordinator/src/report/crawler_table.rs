@@ -91,7 +91,7 @@ pub fn markdown(cells: &[crate::report::compare::Cell], references: &[Reference]
         for r in references {
             let _ = writeln!(
                 s,
-                "| {} | {} | Dijkstra, 32 directions, hazard clearance 0, slope limit, then string pulling | {} | {:.3} | {:.3} | {:.2} |",
+                "| {} | {} | A* (Dijkstra's lengths), 32 directions, hazard clearance 0, slope limit, then string pulling | {} | {:.3} | {:.3} | {:.2} |",
                 r.scenario, r.vehicle, r.cell_m, r.grid_m, r.refined_m, r.time_s
             );
         }
