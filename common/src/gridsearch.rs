@@ -206,16 +206,14 @@ impl GridSearch<'_> {
         }
     }
 
-    /// The reference path of crawler `i` of a loaded scenario: its hazards with `clearance_m`
-    /// from their edges, its pitch limit as the slope limit, on a grid of `cell_m`, refined by
-    /// [`Self::shortcut`]. `None` when the vehicle is not a crawler or no path exists.
+    /// The reference path of a crawler (`crate::scenario::Scenario::crawler_model`): its
+    /// hazards with `clearance_m` from their edges, its pitch limit as the slope limit, on a
+    /// grid of `cell_m`, refined by [`Self::shortcut`]. `None` when no path exists.
     pub fn crawler_reference(
-        scenario: &crate::scenario::Scenario,
-        i: usize,
+        model: &crate::crawler::CrawlerModel,
         cell_m: f64,
         clearance_m: f64,
     ) -> Option<(GridPath, GridPath)> {
-        let model = scenario.crawler_model(i)?;
         let search = GridSearch {
             terrain: &model.terrain,
             hazards: &model.hazards,

@@ -5,7 +5,7 @@ use std::sync::Arc;
 
 use shoal_common::cost::FleetModel;
 use shoal_common::plan::{assess, notices, Plan};
-use shoal_common::scenario::Scenario;
+use shoal_common::scenario::{Scenario, VehicleKind};
 use shoal_common::swarm::catalog::{family, Family};
 use shoal_common::swarm::{Executor, IterationReport, Termination};
 
@@ -50,13 +50,14 @@ pub fn plan_alone_and_refined(scenario: &Scenario) -> (Plan, Option<Plan>) {
     alone.optimizer.touch_up = false;
     alone.optimizer.refine = false;
     let o = &alone.optimizer;
-    if !matches!(family(o.algorithm), Family::Fleet { .. }) {
+    let crawlers_only = alone
+        .vehicles
+        .iter()
+        .all(|v| v.kind == VehicleKind::Crawler);
+    if crawlers_only || !matches!(family(o.algorithm), Family::Fleet { .. }) {
         return (plan_in_process(&alone, None, &mut |_| {}), None);
     }
     let model = FleetModel::new(&alone);
-    if model.crawlers.iter().all(Option::is_some) {
-        return (plan_in_process(&alone, None, &mut |_| {}), None);
-    }
     let executor = Executor {
         max_iterations: o.iterations,
         checkpoint_every: Some(super::finish::CHECKPOINT_EVERY),

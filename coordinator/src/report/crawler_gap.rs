@@ -28,26 +28,27 @@ pub fn notices(scenario: &Scenario, plan: &Plan) -> Vec<String> {
         };
         let [x0, y0, x1, y1] = model.area;
         let cell = ((x1 - x0).max(y1 - y0) / CELLS_ALONG).max(MIN_CELL_M);
-        out.push(
-            match GridSearch::crawler_reference(scenario, i, cell, 0.0) {
-                Some((_, reference)) => {
-                    gap_notice(&v.id, planned.length_m, reference.length_m, cell)
-                }
-                None => format!(
-                    "{}: no admissible path on a {cell:.1} m grid of the seabed (every way from \
+        out.push(match GridSearch::crawler_reference(&model, cell, 0.0) {
+            Some((_, reference)) => gap_notice(&v.id, planned.length_m, reference.length_m, cell),
+            None => format!(
+                "{}: no admissible path on a {cell:.1} m grid of the seabed (every way from \
                      start to goal crosses a hazard or a slope over the limit), so no reference \
                      length to measure the plan against",
-                    v.id
-                ),
-            },
-        );
+                v.id
+            ),
+        });
     }
     out
 }
 
+/// How much longer than `reference_m` a path of `length_m` is, per cent.
+pub fn gap_percent(length_m: f64, reference_m: f64) -> f64 {
+    100.0 * (length_m / reference_m - 1.0)
+}
+
 /// The notice for a crawler `id` of planned length `length_m` against `reference_m`.
 pub fn gap_notice(id: &str, length_m: f64, reference_m: f64, cell_m: f64) -> String {
-    let gap = 100.0 * (length_m / reference_m - 1.0);
+    let gap = gap_percent(length_m, reference_m);
     format!(
         "{id}: path {length_m:.1} m, {gap:+.2} % against the shortest admissible path a grid \
          search finds on the same seabed ({reference_m:.1} m on a {cell_m:.1} m grid)"
@@ -73,8 +74,9 @@ mod tests {
     ) -> Result<(), Box<dyn std::error::Error>> {
         let file = concat!(env!("CARGO_MANIFEST_DIR"), "/../scenarios/ipso-dsmv.toml");
         let s = Scenario::load(std::path::Path::new(file))?;
+        let model = s.crawler_model(0).ok_or("no crawler")?;
         let (_, reference) =
-            GridSearch::crawler_reference(&s, 0, 1.0, 0.0).ok_or("no reference")?;
+            GridSearch::crawler_reference(&model, 1.0, 0.0).ok_or("no reference")?;
         assert!(
             (reference.length_m / 282.307 - 1.0).abs() < 1e-4,
             "{}",

@@ -5,6 +5,8 @@
 use std::fmt::Write;
 
 use shoal_common::gridsearch::GridSearch;
+
+use crate::report::crawler_gap::gap_percent;
 use shoal_common::scenario::Scenario;
 
 pub use crate::report::crawler_stats::{mean_std, CrawlerStats};
@@ -33,7 +35,10 @@ pub fn references(scenarios: &[Scenario], cell_m: f64) -> Vec<Reference> {
     for s in scenarios {
         for (i, v) in s.vehicles.iter().enumerate() {
             let started = std::time::Instant::now();
-            if let Some((grid, refined)) = GridSearch::crawler_reference(s, i, cell_m, 0.0) {
+            let reference = s
+                .crawler_model(i)
+                .and_then(|model| GridSearch::crawler_reference(&model, cell_m, 0.0));
+            if let Some((grid, refined)) = reference {
                 out.push(Reference {
                     scenario: s.name.clone(),
                     vehicle: v.id.clone(),
@@ -65,7 +70,7 @@ pub fn markdown(cells: &[crate::report::compare::Cell], references: &[Reference]
             .iter()
             .find(|r| r.scenario == c.scenario)
             .map_or("–".to_string(), |r| {
-                format!("{:+.2} %", 100.0 * (k.length_m.1 / r.refined_m - 1.0))
+                format!("{:+.2} %", gap_percent(k.length_m.1, r.refined_m))
             });
         let _ = writeln!(
             s,
