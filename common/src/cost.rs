@@ -20,10 +20,11 @@
 //! swarm feels both how many and how bad.
 
 use crate::crawler::{CrawlerModel, CrawlerTerms};
-use crate::geometry::{chord_inside_sphere, pitch, Vec3, CONTACT_GUARD_M, MIN_HEADING_EXTENT};
+use crate::geometry::{pitch, Vec3, MIN_HEADING_EXTENT};
 use crate::scenario::{Scenario, Vehicle};
-use crate::separation::{motion_separation, Motion};
 use crate::terrain::Terrain;
+use spheres::{sphere_terms, SphereIndex};
+
 use crate::trajectory::{common_arrival, retime_legs, Layout, Path, Trajectory};
 
 /// A sphere the cost functions test against: centre and radius already inflated.
@@ -61,78 +62,6 @@ pub fn depth_term(points: &[Vec3], surface_z: f64, column: f64) -> f64 {
 /// almost nothing.
 pub fn soft_threat_term(points: &[Vec3], soft: &[Sphere], straight: f64) -> f64 {
     sphere_terms(points, &[], soft).soft_inside / straight.max(1e-9)
-}
-
-/// What the legs of a path do to the obstacles, computed in one pass.
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
-struct SphereTerms {
-    /// [`hard_penalty`]'s penalty.
-    hard_penalty: f64,
-    /// Leg × hard-sphere intrusions.
-    hard_hits: usize,
-    /// Metres inside soft spheres.
-    soft_inside: f64,
-}
-
-/// Legs per bounding box in [`sphere_terms`]'s cull.
-const CHUNK_LEGS: usize = 6;
-
-/// Every leg against every sphere. Legs are grouped in chunks of [`CHUNK_LEGS`] with a bounding
-/// box each; a sphere that cannot reach a chunk's box skips all its legs at once. The others get
-/// the exact squared distance, and roots and chords are taken only on a hit.
-fn sphere_terms(points: &[Vec3], hard: &[Sphere], soft: &[Sphere]) -> SphereTerms {
-    let mut out = SphereTerms::default();
-    let n_legs = points.len().saturating_sub(1);
-    let boxes: Vec<(Vec3, Vec3)> = (0..n_legs)
-        .step_by(CHUNK_LEGS)
-        .map(|start| {
-            let pts = &points[start..(start + CHUNK_LEGS + 1).min(points.len())];
-            let lo = pts.iter().fold(pts[0], |m, p| m.inf(p));
-            let hi = pts.iter().fold(pts[0], |m, p| m.sup(p));
-            (lo, hi)
-        })
-        .collect();
-    for (s, is_hard) in hard
-        .iter()
-        .map(|s| (s, true))
-        .chain(soft.iter().map(|s| (s, false)))
-    {
-        // Hard spheres are tested with the contact guard (see `CONTACT_GUARD_M`).
-        let reach = if is_hard {
-            s.radius + CONTACT_GUARD_M
-        } else {
-            s.radius
-        };
-        let r2 = reach * reach;
-        for (chunk, (lo, hi)) in boxes.iter().enumerate() {
-            let gap = (lo - s.centre).sup(&(s.centre - hi)).sup(&Vec3::zeros());
-            if gap.norm_squared() >= r2 {
-                continue;
-            }
-            let start = chunk * CHUNK_LEGS;
-            for j in start..(start + CHUNK_LEGS).min(n_legs) {
-                let (a, b) = (points[j], points[j + 1]);
-                let k = b - a;
-                let len2 = k.norm_squared();
-                let q = s.centre - a;
-                let u = if len2 > 0.0 {
-                    (q.dot(&k) / len2).clamp(0.0, 1.0)
-                } else {
-                    0.0
-                };
-                let d2 = (q - k * u).norm_squared();
-                if d2 < r2 {
-                    if is_hard {
-                        out.hard_penalty += 1.0 + ((s.radius - d2.sqrt()) / s.radius).max(0.0);
-                        out.hard_hits += 1;
-                    } else {
-                        out.soft_inside += chord_inside_sphere(&a, &b, &s.centre, s.radius);
-                    }
-                }
-            }
-        }
-    }
-    out
 }
 
 /// F_i(T) of eq. (10), over the mission time: how far the mission time `t_e` lies outside the
@@ -354,6 +283,8 @@ pub struct FleetModel {
     pub hard: Vec<Sphere>,
     /// Inflated soft spheres.
     pub soft: Vec<Sphere>,
+    /// `hard` and `soft` indexed by where they are, so a path meets only the spheres near it.
+    spheres: SphereIndex,
     /// Straight-line distance of every vehicle, metres.
     pub straight: Vec<f64>,
     /// Per vehicle: the crawler cost model and its straight path's terms (the standardisation
@@ -370,12 +301,15 @@ impl FleetModel {
             centre: o.centre(),
             radius: o.inflated_radius(),
         };
+        let hard: Vec<Sphere> = scenario.hard_obstacles().map(sphere).collect();
+        let soft: Vec<Sphere> = scenario.soft_obstacles().map(sphere).collect();
         FleetModel {
             layout,
             lower,
             upper,
-            hard: scenario.hard_obstacles().map(sphere).collect(),
-            soft: scenario.soft_obstacles().map(sphere).collect(),
+            spheres: SphereIndex::new(&hard, &soft),
+            hard,
+            soft,
             straight: scenario
                 .vehicles
                 .iter()
@@ -436,7 +370,7 @@ impl FleetModel {
         }
         let surface = s.bounds.max[2];
         let column = s.bounds.max[2] - s.bounds.min[2];
-        let spheres = sphere_terms(&path.points, &self.hard, &self.soft);
+        let spheres = self.spheres.terms(&path.points, &self.hard, &self.soft);
         let seabed = s
             .swimmer_seabed()
             .map_or(0.0, |(t, c)| seabed_penalty(&path.points, t, c).0);
@@ -516,20 +450,7 @@ impl FleetModel {
             .zip(&s.vehicles)
             .map(|((p, r), v)| retime_legs(p, &legs[r.clone()], v, arrival))
             .collect();
-        let motions: Vec<Motion> = trajectories.iter().map(Motion::new).collect();
-        let mut sep_penalty = 0.0;
-        for i in 0..motions.len() {
-            for j in i + 1..motions.len() {
-                let ps = motion_separation(&motions[i], &motions[j], s.fleet.d_min_m, false);
-                // eq. (12) sums F_i(S) over vehicles: a breach counts for both of the pair.
-                vehicles[i].space += space_term(ps.breach_s);
-                vehicles[j].space += space_term(ps.breach_s);
-                let sp = separation_penalty(ps.min_distance, s.fleet.d_min_m);
-                vehicles[i].separation += 0.5 * sp;
-                vehicles[j].separation += 0.5 * sp;
-                sep_penalty += sp;
-            }
-        }
+        let sep_penalty = coupling::add_pair_terms(&trajectories, s.fleet.d_min_m, &mut vehicles);
         let objective: f64 = vehicles.iter().map(|t| self.objective_of(t)).sum();
         let penalty: f64 = vehicles.iter().map(|t| t.hard + t.motion).sum::<f64>() + sep_penalty;
         FleetEvaluation {
@@ -544,5 +465,7 @@ impl FleetModel {
     }
 }
 
+mod coupling;
+mod spheres;
 #[cfg(test)]
 mod tests;

@@ -2,6 +2,7 @@
 //! fitness of Zhi & Zuo 2024 and the swarm optimizers.
 
 pub mod benchfns;
+pub mod broad_phase;
 pub mod bspline;
 pub mod cost;
 pub mod coverage;

@@ -1,6 +1,7 @@
 //! Unit tests of `cost`.
 
 use super::*;
+use crate::geometry::chord_inside_sphere;
 use crate::scenario::VehicleKind;
 use approx::assert_abs_diff_eq;
 
@@ -187,6 +188,9 @@ proptest::proptest! {
         proptest::prop_assert_eq!(fast.hard_hits, hits);
         proptest::prop_assert!((fast.hard_penalty - p).abs() < 1e-9);
         proptest::prop_assert!((fast.soft_inside - inside).abs() < 1e-6);
+        // The grid-culled pass gives the same terms to the last bit.
+        let indexed = spheres::SphereIndex::new(&hard, &soft).terms(&pts, &hard, &soft);
+        proptest::prop_assert_eq!(indexed, fast);
     }
 }
 

@@ -1,0 +1,308 @@
+//! Broad phases for the fleet's spatial terms. Vehicle–obstacle: [`spheres`]. Vehicle–vehicle
+//! (this module): which pairs of timed trajectories can come
+//! within `d_min` of each other at all, so only those pay for the exact, continuous separation
+//! of [`crate::separation`] (the narrow phase).
+//!
+//! The mission's time `[0, horizon]` is cut into equal slabs; in each slab every vehicle gets
+//! the axis-aligned box of every position it takes there (its trajectory is piecewise linear,
+//! so the box of the slab's end positions and the samples between them). Two vehicles closer
+//! than `reach` at some instant are, at that instant, inside their boxes of the same slab, so
+//! those boxes are closer than `reach`: a pair none of whose slab boxes come that close can be
+//! skipped without changing any term, which is what the property test below checks against all
+//! pairs. Within a slab a sweep and prune along the axis the boxes spread most over (Baraff
+//! 1992, "Dynamic simulation of non-penetrating rigid bodies", §6) finds the close boxes in
+//! `O(n log n)` rather than testing all `n²/2` pairs. Hand-written: the crates that do this
+//! (`parry`'s BVH, `broccoli`) index static shapes and allocate per query; this reuses its
+//! buffers across the swarm's evaluations.
+
+use crate::geometry::Vec3;
+
+pub mod spheres;
+
+/// Time slabs per mission. More slabs give smaller boxes (fewer pairs survive) but more boxes
+/// to sort; 32 slabs of a one-hour mission keep a box under 200 m along a 3-knot track.
+pub const SLABS: usize = 32;
+
+/// Every vehicle's box in every time slab, with the buffers the pair search reuses.
+#[derive(Debug, Clone, Default)]
+pub struct SlabBoxes {
+    /// Length of the time span the slabs cover, seconds (at least one slab's worth of time).
+    horizon: f64,
+    /// Lower corners, vehicle-major: vehicle `v`, slab `k` at `v * SLABS + k`.
+    lo: Vec<Vec3>,
+    /// Upper corners, in the same order.
+    hi: Vec<Vec3>,
+    /// One slab's sweep order: (lower end along the sweep axis, vehicle), reused.
+    order: Vec<(f64, u32)>,
+}
+
+impl SlabBoxes {
+    /// Empty, with no buffers yet.
+    pub fn new() -> SlabBoxes {
+        SlabBoxes::default()
+    }
+
+    /// Forgets every vehicle and sets the time span to `[0, horizon]` (keeping the buffers).
+    /// Positions after `horizon` fall in the last slab.
+    pub fn reset(&mut self, horizon: f64) {
+        self.horizon = if horizon.is_finite() && horizon > 0.0 {
+            horizon
+        } else {
+            1.0
+        };
+        self.lo.clear();
+        self.hi.clear();
+    }
+
+    /// Vehicles added so far.
+    pub fn len(&self) -> usize {
+        self.lo.len() / SLABS
+    }
+
+    /// True before any vehicle is added.
+    pub fn is_empty(&self) -> bool {
+        self.lo.is_empty()
+    }
+
+    /// Adds the next vehicle: a trajectory through `points` at `times` (non-decreasing from 0,
+    /// as every [`crate::trajectory::Trajectory`]), holding at its last point after its last time.
+    pub fn push(&mut self, times: &[f64], points: &[Vec3]) {
+        let n = times.len().min(points.len());
+        if n == 0 {
+            // A vehicle without samples is nowhere: a box no other box comes near.
+            let far = Vec3::repeat(f64::INFINITY);
+            self.lo.extend(std::iter::repeat_n(far, SLABS));
+            self.hi.extend(std::iter::repeat_n(far, SLABS));
+            return;
+        }
+        let slab = self.horizon / SLABS as f64;
+        let mut seg = 0usize;
+        let mut start = position(times, points, &mut seg, 0.0);
+        for k in 0..SLABS {
+            let t1 = if k + 1 == SLABS {
+                f64::INFINITY
+            } else {
+                (k + 1) as f64 * slab
+            };
+            let (mut lo, mut hi) = (start, start);
+            if k == 0 {
+                // The samples at t = 0 the start position skipped (the separation counts them).
+                for p in &points[..=seg] {
+                    lo = lo.inf(p);
+                    hi = hi.sup(p);
+                }
+            }
+            // Every sample up to and including t1 (a chain of samples at one instant too).
+            while seg + 1 < n && times[seg + 1] <= t1 {
+                seg += 1;
+                lo = lo.inf(&points[seg]);
+                hi = hi.sup(&points[seg]);
+            }
+            let end = position(times, points, &mut seg, t1);
+            self.lo.push(lo.inf(&end));
+            self.hi.push(hi.sup(&end));
+            start = end;
+        }
+    }
+
+    /// Whether vehicles `a` and `b` have boxes of some slab closer than `reach`: false proves
+    /// they never come closer than `reach` at the same instant.
+    pub fn near(&self, a: usize, b: usize, reach: f64) -> bool {
+        let r2 = guarded2(reach);
+        (0..SLABS).any(|k| self.box_gap2(a * SLABS + k, b * SLABS + k) < r2)
+    }
+
+    /// Whether vehicle `a` of `self` and vehicle `b` of `other` (with the same horizon) have
+    /// boxes of some slab closer than `reach`.
+    pub fn near_other(&self, a: usize, other: &SlabBoxes, b: usize, reach: f64) -> bool {
+        let r2 = guarded2(reach);
+        (0..SLABS).any(|k| {
+            let (i, j) = (a * SLABS + k, b * SLABS + k);
+            gap2(&self.lo[i], &self.hi[i], &other.lo[j], &other.hi[j]) < r2
+        })
+    }
+
+    /// Every pair `(i, j)`, `i < j`, whose boxes of some slab are closer than `reach`, marked
+    /// in `pairs` (which is cleared and sized first).
+    pub fn close_pairs(&mut self, reach: f64, pairs: &mut PairSet) {
+        let n = self.len();
+        pairs.reset(n);
+        let r2 = guarded2(reach);
+        let reach = r2.sqrt();
+        let mut last_axis = usize::MAX;
+        for k in 0..SLABS {
+            let axis = self.widest_axis(k);
+            // Sort by the boxes' lower ends along the axis. From one slab to the next the
+            // vehicles keep nearly the same order, so an insertion sort of the previous
+            // slab's order does almost no moves.
+            if axis != last_axis {
+                self.order.clear();
+                self.order.extend((0..n as u32).map(|v| (0.0, v)));
+            }
+            last_axis = axis;
+            for e in self.order.iter_mut() {
+                e.0 = self.lo[e.1 as usize * SLABS + k][axis];
+            }
+            insertion_sort(&mut self.order);
+            for (p, &(_, a)) in self.order.iter().enumerate() {
+                let ia = a as usize * SLABS + k;
+                let limit = self.hi[ia][axis] + reach;
+                for &(lo_b, b) in &self.order[p + 1..] {
+                    if lo_b >= limit {
+                        break;
+                    }
+                    let (a, b) = (a as usize, b as usize);
+                    if !pairs.contains(a, b) && self.box_gap2(ia, b * SLABS + k) < r2 {
+                        pairs.insert(a, b);
+                    }
+                }
+            }
+        }
+    }
+
+    /// The axis along which slab `k`'s box centres spread most: the sweep's axis.
+    fn widest_axis(&self, k: usize) -> usize {
+        let n = self.len();
+        let (mut lo, mut hi) = (Vec3::repeat(f64::INFINITY), Vec3::repeat(f64::NEG_INFINITY));
+        for v in 0..n {
+            let c = self.lo[v * SLABS + k] + self.hi[v * SLABS + k];
+            if c.iter().all(|x| x.is_finite()) {
+                lo = lo.inf(&c);
+                hi = hi.sup(&c);
+            }
+        }
+        let spread = hi - lo;
+        if spread.iter().any(|x| !x.is_finite()) {
+            return 0;
+        }
+        spread.imax()
+    }
+
+    /// Squared distance between boxes `i` and `j` of this set.
+    fn box_gap2(&self, i: usize, j: usize) -> f64 {
+        gap2(&self.lo[i], &self.hi[i], &self.lo[j], &self.hi[j])
+    }
+}
+
+/// How much farther than asked the broad phase looks, metres: the narrow phase computes
+/// positions with other roundings, so a pair whose closest approach is `reach` to the last
+/// bit is kept rather than pruned.
+const REACH_GUARD_M: f64 = 1e-6;
+
+/// `(reach + guard)²`.
+fn guarded2(reach: f64) -> f64 {
+    let r = reach + REACH_GUARD_M;
+    r * r
+}
+
+/// Sorts by the key, ascending (NaN-free keys; a vehicle without samples has an infinite one).
+/// Linear on an order that is already nearly sorted, which is what the slabs give.
+fn insertion_sort(items: &mut [(f64, u32)]) {
+    for i in 1..items.len() {
+        let item = items[i];
+        let mut j = i;
+        while j > 0 && items[j - 1].0 > item.0 {
+            items[j] = items[j - 1];
+            j -= 1;
+        }
+        items[j] = item;
+    }
+}
+
+/// Squared distance between two axis-aligned boxes (0 when they overlap; infinite for a box of
+/// a vehicle without samples).
+fn gap2(lo_a: &Vec3, hi_a: &Vec3, lo_b: &Vec3, hi_b: &Vec3) -> f64 {
+    let mut s = 0.0;
+    for d in 0..3 {
+        let g = (lo_a[d] - hi_b[d]).max(lo_b[d] - hi_a[d]);
+        if g > 0.0 {
+            s += g * g;
+        } else if g.is_nan() {
+            return f64::INFINITY;
+        }
+    }
+    s
+}
+
+/// Position at `t` of the trajectory through `points` at `times`, advancing the leg cursor
+/// `seg` (the last sample at or before `t`); held before the first and after the last sample.
+fn position(times: &[f64], points: &[Vec3], seg: &mut usize, t: f64) -> Vec3 {
+    let n = times.len().min(points.len());
+    while *seg + 1 < n && times[*seg + 1] <= t {
+        *seg += 1;
+    }
+    let i = *seg;
+    if i + 1 >= n || t <= times[i] {
+        return points[i];
+    }
+    let dt = times[i + 1] - times[i];
+    if dt <= 0.0 {
+        return points[i + 1];
+    }
+    points[i] + (points[i + 1] - points[i]) * ((t - times[i]) / dt)
+}
+
+/// A set of vehicle pairs `(i, j)`, `i < j`, as one bit per ordered pair: inserting is a bit
+/// set whatever the slab that found it, and iterating goes in row order `(0, 1), (0, 2), …`,
+/// the order the all-pairs loop sums in, so the fitness is the same to the last bit.
+#[derive(Debug, Clone, Default)]
+pub struct PairSet {
+    /// Vehicles.
+    n: usize,
+    /// Bit `i * n + j`.
+    words: Vec<u64>,
+}
+
+impl PairSet {
+    /// Empty.
+    pub fn new() -> PairSet {
+        PairSet::default()
+    }
+
+    /// Clears the set for `n` vehicles, keeping its buffer.
+    pub fn reset(&mut self, n: usize) {
+        self.n = n;
+        self.words.clear();
+        self.words.resize((n * n).div_ceil(64), 0);
+    }
+
+    /// Marks the pair of `a` and `b` (in either order; `a == b` is ignored).
+    pub fn insert(&mut self, a: usize, b: usize) {
+        let (i, j) = (a.min(b), a.max(b));
+        if i == j || j >= self.n {
+            return;
+        }
+        let bit = i * self.n + j;
+        self.words[bit / 64] |= 1 << (bit % 64);
+    }
+
+    /// Whether the pair of `a` and `b` is marked.
+    pub fn contains(&self, a: usize, b: usize) -> bool {
+        let (i, j) = (a.min(b), a.max(b));
+        if i == j || j >= self.n {
+            return false;
+        }
+        let bit = i * self.n + j;
+        self.words[bit / 64] & (1 << (bit % 64)) != 0
+    }
+
+    /// The marked pairs in row order.
+    pub fn iter(&self) -> impl Iterator<Item = (usize, usize)> + '_ {
+        let n = self.n.max(1);
+        self.words.iter().enumerate().flat_map(move |(w, &word)| {
+            let mut rest = word;
+            std::iter::from_fn(move || {
+                if rest == 0 {
+                    return None;
+                }
+                let b = rest.trailing_zeros() as usize;
+                rest &= rest - 1;
+                let bit = w * 64 + b;
+                Some((bit / n, bit % n))
+            })
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests;

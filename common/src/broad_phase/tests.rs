@@ -1,0 +1,159 @@
+use super::*;
+use crate::separation::pair_separation;
+use crate::trajectory::Trajectory;
+use approx::assert_abs_diff_eq;
+use proptest::prelude::*;
+
+fn boxes_of(horizon: f64, fleet: &[Trajectory]) -> SlabBoxes {
+    let mut b = SlabBoxes::new();
+    b.reset(horizon);
+    for t in fleet {
+        b.push(&t.times, &t.points);
+    }
+    b
+}
+
+fn line(t0: f64, from: [f64; 3], t1: f64, to: [f64; 3]) -> Trajectory {
+    Trajectory {
+        times: vec![t0, t1],
+        points: vec![Vec3::from(from), Vec3::from(to)],
+    }
+}
+
+#[test]
+fn a_straight_run_has_one_box_per_slab_by_hand() {
+    // 1 m/s along x for 320 s: slab k (10 s) spans x = 10k … 10k + 10.
+    let b = boxes_of(320.0, &[line(0.0, [0., 5., 7.], 320.0, [320., 5., 7.])]);
+    assert_eq!(b.len(), 1);
+    for k in 0..SLABS {
+        assert_abs_diff_eq!(b.lo[k], Vec3::new(10.0 * k as f64, 5., 7.), epsilon = 1e-9);
+        assert_abs_diff_eq!(
+            b.hi[k],
+            Vec3::new(10.0 * (k + 1) as f64, 5., 7.),
+            epsilon = 1e-9
+        );
+    }
+}
+
+#[test]
+fn a_vehicle_holds_before_its_first_and_after_its_last_sample() {
+    // Starts moving at 100 s and stops at 150 s, in a 320 s horizon of 10 s slabs.
+    let b = boxes_of(320.0, &[line(100.0, [0., 0., 0.], 150.0, [50., 0., 0.])]);
+    assert_abs_diff_eq!(b.hi[0], Vec3::zeros(), epsilon = 1e-12);
+    assert_abs_diff_eq!(b.lo[12], Vec3::new(20., 0., 0.), epsilon = 1e-9);
+    assert_abs_diff_eq!(b.hi[12], Vec3::new(30., 0., 0.), epsilon = 1e-9);
+    assert_abs_diff_eq!(b.lo[31], Vec3::new(50., 0., 0.), epsilon = 1e-12);
+}
+
+#[test]
+fn parallel_tracks_are_near_only_within_their_spacing() {
+    let fleet = [
+        line(0.0, [0., 0., 0.], 320.0, [320., 0., 0.]),
+        line(0.0, [0., 100., 0.], 320.0, [320., 100., 0.]),
+    ];
+    let b = boxes_of(320.0, &fleet);
+    assert!(!b.near(0, 1, 50.0));
+    assert!(!b.near(0, 1, 99.9));
+    assert!(b.near(0, 1, 100.1));
+}
+
+#[test]
+fn tracks_that_cross_at_different_times_are_pruned() {
+    // A runs east along y = 0 at 1 m/s; B leaves (160, 0) at t = 0 northwards at 1 m/s. The
+    // tracks cross at (160, 0), but A gets there 160 s after B left: the closest approach is
+    // 80·√2 = 113.1 m at t = 80 s, and the 10 s boxes come no closer than √(80² + 70²) = 106.3 m.
+    let fleet = [
+        line(0.0, [0., 0., 0.], 320.0, [320., 0., 0.]),
+        line(0.0, [160., 0., 0.], 320.0, [160., 320., 0.]),
+    ];
+    assert_abs_diff_eq!(
+        pair_separation(&fleet[0], &fleet[1], 50.0).min_distance,
+        80.0 * 2f64.sqrt(),
+        epsilon = 1e-9
+    );
+    let b = boxes_of(320.0, &fleet);
+    assert!(!b.near(0, 1, 50.0));
+    assert!(!b.near(0, 1, 106.2));
+    assert!(b.near(0, 1, 106.4));
+}
+
+#[test]
+fn pair_sets_iterate_in_row_order() {
+    let mut p = PairSet::new();
+    p.reset(5);
+    for (a, b) in [(3, 1), (0, 4), (2, 3), (0, 1), (4, 4)] {
+        p.insert(a, b);
+    }
+    assert_eq!(
+        p.iter().collect::<Vec<_>>(),
+        vec![(0, 1), (0, 4), (1, 3), (2, 3)]
+    );
+    assert!(p.contains(1, 3) && p.contains(3, 1) && !p.contains(1, 2) && !p.contains(4, 4));
+    p.reset(3);
+    assert_eq!(p.iter().count(), 0);
+}
+
+/// A random trajectory in a 400 m cube: 1–6 samples at non-decreasing times from 0, some of
+/// them repeated (a leg of zero length and zero duration, as a retimed path has where two
+/// waypoints coincide).
+fn trajectory() -> impl Strategy<Value = Trajectory> {
+    prop::collection::vec(
+        (
+            (0.0..400.0f64, 0.0..400.0f64, 0.0..400.0f64),
+            0..3u8,
+            0.0..120.0f64,
+        ),
+        1..7,
+    )
+    .prop_map(|samples| {
+        let mut out = Trajectory {
+            times: Vec::new(),
+            points: Vec::new(),
+        };
+        for ((x, y, z), kind, dt) in samples {
+            match (out.times.last().copied(), out.points.last().copied()) {
+                (Some(t), Some(p)) if kind == 0 => {
+                    out.times.push(t);
+                    out.points.push(p);
+                }
+                (Some(t), _) => {
+                    out.times.push(t + dt);
+                    out.points.push(Vec3::new(x, y, z));
+                }
+                _ => {
+                    out.times.push(0.0);
+                    out.points.push(Vec3::new(x, y, z));
+                }
+            }
+        }
+        out
+    })
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(300))]
+
+    /// Every pair the broad phase prunes is at least `d_min` apart at every instant, by the
+    /// exact separation; the pairs it keeps include every pair that comes closer.
+    #[test]
+    fn pruned_pairs_never_come_within_d_min(
+        fleet in prop::collection::vec(trajectory(), 2..9),
+        d_min in 5.0..150.0f64,
+        horizon_scale in 0.3..1.5f64,
+    ) {
+        let end = fleet.iter().filter_map(|t| t.times.last()).fold(1.0f64, |a, b| a.max(*b));
+        let mut b = boxes_of(end * horizon_scale, &fleet);
+        let mut pairs = PairSet::new();
+        b.close_pairs(d_min, &mut pairs);
+        for i in 0..fleet.len() {
+            for j in i + 1..fleet.len() {
+                let exact = pair_separation(&fleet[i], &fleet[j], d_min);
+                prop_assert_eq!(pairs.contains(i, j), b.near(i, j, d_min));
+                if !pairs.contains(i, j) {
+                    prop_assert!(exact.min_distance >= d_min, "{} {} {}", i, j, exact.min_distance);
+                    prop_assert_eq!(exact.breach_s, 0.0);
+                }
+            }
+        }
+    }
+}

@@ -1,0 +1,173 @@
+//! The legs of a path against the obstacle spheres: the hard-obstacle penalty and the metres
+//! inside soft spheres (F_i(O) of Zhi & Zuo 2024, eq. (9)), in one pass. A model's spheres are
+//! indexed once ([`SphereIndex`]); a path is then tested only against the spheres near its
+//! chunks of legs, in the same order as against all of them, so the sums are the same to the
+//! last bit.
+
+use std::cell::RefCell;
+
+use super::Sphere;
+use crate::broad_phase::spheres::SphereGrid;
+use crate::geometry::{chord_inside_sphere, Vec3, CONTACT_GUARD_M};
+
+/// What the legs of a path do to the obstacles.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub(super) struct SphereTerms {
+    /// [`super::hard_penalty`]'s penalty.
+    pub hard_penalty: f64,
+    /// Leg × hard-sphere intrusions.
+    pub hard_hits: usize,
+    /// Metres inside soft spheres.
+    pub soft_inside: f64,
+}
+
+/// Legs per bounding box in the cull.
+const CHUNK_LEGS: usize = 6;
+
+/// A model's hard and soft spheres with their horizontal grid (hard ones first, each with the
+/// reach it is tested at).
+#[derive(Debug, Clone, Default)]
+pub(super) struct SphereIndex {
+    /// The grid over every sphere, hard ones at indices `0..hard`, then the soft ones.
+    grid: SphereGrid,
+}
+
+/// A chunk of legs' bounding box (lower, upper corner).
+type ChunkBox = (Vec3, Vec3);
+
+thread_local! {
+    /// Chunk boxes and sphere marks, reused by every evaluation on this thread.
+    static SCRATCH: RefCell<(Vec<ChunkBox>, Vec<u64>)> = const { RefCell::new((Vec::new(), Vec::new())) };
+}
+
+impl SphereIndex {
+    /// Indexes `hard` then `soft`.
+    pub fn new(hard: &[Sphere], soft: &[Sphere]) -> SphereIndex {
+        let reaches: Vec<(Vec3, f64)> = hard
+            .iter()
+            .map(|s| (s.centre, s.radius + CONTACT_GUARD_M))
+            .chain(soft.iter().map(|s| (s.centre, s.radius)))
+            .collect();
+        SphereIndex {
+            grid: SphereGrid::new(&reaches),
+        }
+    }
+
+    /// [`sphere_terms`] of `points` against `hard` and `soft` (the spheres this index was built
+    /// from), testing only the spheres near the path.
+    pub fn terms(&self, points: &[Vec3], hard: &[Sphere], soft: &[Sphere]) -> SphereTerms {
+        SCRATCH.with(|cell| match cell.try_borrow_mut() {
+            Ok(mut scratch) => {
+                let (boxes, marks) = &mut *scratch;
+                self.terms_with(points, hard, soft, boxes, marks)
+            }
+            Err(_) => self.terms_with(points, hard, soft, &mut Vec::new(), &mut Vec::new()),
+        })
+    }
+
+    fn terms_with(
+        &self,
+        points: &[Vec3],
+        hard: &[Sphere],
+        soft: &[Sphere],
+        boxes: &mut Vec<ChunkBox>,
+        marks: &mut Vec<u64>,
+    ) -> SphereTerms {
+        chunk_boxes(points, boxes);
+        marks.clear();
+        marks.resize(self.grid.words(), 0);
+        for (lo, hi) in boxes.iter() {
+            self.grid.mark_near(lo, hi, marks);
+        }
+        let mut out = SphereTerms::default();
+        for (w, &word) in marks.iter().enumerate() {
+            let mut rest = word;
+            while rest != 0 {
+                let k = w * 64 + rest.trailing_zeros() as usize;
+                rest &= rest - 1;
+                match k.checked_sub(hard.len()) {
+                    None => add_sphere(&mut out, points, boxes, &hard[k], true),
+                    Some(j) => {
+                        if let Some(s) = soft.get(j) {
+                            add_sphere(&mut out, points, boxes, s, false);
+                        }
+                    }
+                }
+            }
+        }
+        out
+    }
+}
+
+/// Every leg against every sphere. Legs are grouped in chunks of [`CHUNK_LEGS`] with a bounding
+/// box each; a sphere that cannot reach a chunk's box skips all its legs at once. The others get
+/// the exact squared distance, and roots and chords are taken only on a hit.
+pub(super) fn sphere_terms(points: &[Vec3], hard: &[Sphere], soft: &[Sphere]) -> SphereTerms {
+    let mut boxes = Vec::new();
+    chunk_boxes(points, &mut boxes);
+    let mut out = SphereTerms::default();
+    for s in hard {
+        add_sphere(&mut out, points, &boxes, s, true);
+    }
+    for s in soft {
+        add_sphere(&mut out, points, &boxes, s, false);
+    }
+    out
+}
+
+/// The bounding box of every chunk of [`CHUNK_LEGS`] legs, into `boxes`.
+fn chunk_boxes(points: &[Vec3], boxes: &mut Vec<ChunkBox>) {
+    boxes.clear();
+    let n_legs = points.len().saturating_sub(1);
+    boxes.extend((0..n_legs).step_by(CHUNK_LEGS).map(|start| {
+        let pts = &points[start..(start + CHUNK_LEGS + 1).min(points.len())];
+        let lo = pts.iter().fold(pts[0], |m, p| m.inf(p));
+        let hi = pts.iter().fold(pts[0], |m, p| m.sup(p));
+        (lo, hi)
+    }));
+}
+
+/// One sphere against every leg whose chunk box it can reach.
+fn add_sphere(
+    out: &mut SphereTerms,
+    points: &[Vec3],
+    boxes: &[ChunkBox],
+    s: &Sphere,
+    is_hard: bool,
+) {
+    let n_legs = points.len().saturating_sub(1);
+    // Hard spheres are tested with the contact guard (see `CONTACT_GUARD_M`).
+    let reach = if is_hard {
+        s.radius + CONTACT_GUARD_M
+    } else {
+        s.radius
+    };
+    let r2 = reach * reach;
+    for (chunk, (lo, hi)) in boxes.iter().enumerate() {
+        let gap = (lo - s.centre).sup(&(s.centre - hi)).sup(&Vec3::zeros());
+        if gap.norm_squared() >= r2 {
+            continue;
+        }
+        let start = chunk * CHUNK_LEGS;
+        for j in start..(start + CHUNK_LEGS).min(n_legs) {
+            let (a, b) = (points[j], points[j + 1]);
+            let k = b - a;
+            let len2 = k.norm_squared();
+            let q = s.centre - a;
+            let u = if len2 > 0.0 {
+                (q.dot(&k) / len2).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            let d2 = (q - k * u).norm_squared();
+            if d2 < r2 {
+                if is_hard {
+                    out.hard_penalty += 1.0 + ((s.radius - d2.sqrt()) / s.radius).max(0.0);
+                    out.hard_hits += 1;
+                } else {
+                    out.soft_inside += chord_inside_sphere(&a, &b, &s.centre, s.radius);
+                }
+            }
+        }
+    }
+}
