@@ -23,6 +23,7 @@ use crate::crawler::{CrawlerModel, CrawlerTerms};
 use crate::geometry::{pitch, Vec3, MIN_HEADING_EXTENT};
 use crate::scenario::{Scenario, Vehicle};
 use crate::terrain::Terrain;
+pub use coupling::PairTerms;
 use spheres::{sphere_terms, SphereIndex};
 
 use crate::trajectory::{common_arrival, retime_legs, Layout, Path, Trajectory};
@@ -266,6 +267,9 @@ pub struct FleetEvaluation {
     pub penalty: f64,
     /// objective + W · P.
     pub total: f64,
+    /// The exact terms of every pair the broad phase kept, in row order (the others are at
+    /// least d_min apart throughout): what [`FleetModel::evaluate_change`] starts from.
+    pub pairs: Vec<PairTerms>,
 }
 
 /// The fleet planning problem of one scenario, precomputed for fast evaluation.
@@ -435,7 +439,7 @@ impl FleetModel {
                 .zip(&s.vehicles)
                 .map(|(l, v)| l / v.speed_max_mps),
         );
-        let mut vehicles: Vec<VehicleTerms> = paths
+        let vehicles: Vec<VehicleTerms> = paths
             .iter()
             .enumerate()
             .map(|(i, p)| {
@@ -450,7 +454,55 @@ impl FleetModel {
             .zip(&s.vehicles)
             .map(|((p, r), v)| retime_legs(p, &legs[r.clone()], v, arrival))
             .collect();
-        let sep_penalty = coupling::add_pair_terms(&trajectories, s.fleet.d_min_m, &mut vehicles);
+        let pairs = coupling::pair_terms(&trajectories, s.fleet.d_min_m);
+        self.summed(trajectories, arrival, vehicles, pairs)
+    }
+
+    /// [`FleetModel::evaluate`] of `x`, which differs from the position `base` scored only in
+    /// vehicle `i`'s chromosome: only vehicle `i` is decoded and scored and only its pairs are
+    /// measured, unless its new length moves the common arrival (every vehicle is then
+    /// retimed, and the whole fleet scored). The same result to the last bit.
+    pub fn evaluate_change(&self, base: &FleetEvaluation, x: &[f64], i: usize) -> FleetEvaluation {
+        let s = &self.scenario;
+        let path = self.decode(i, &x[self.layout.chromosome(i)]);
+        let legs = path.leg_lengths();
+        let length: f64 = legs.iter().sum();
+        let arrival = common_arrival(
+            s.fleet.mission_time_s,
+            (base.trajectories.iter().enumerate()).map(|(k, t)| {
+                let l = if k == i {
+                    length
+                } else {
+                    polyline_sum(&t.points)
+                };
+                l / s.vehicles[k].speed_max_mps
+            }),
+        );
+        if arrival.to_bits() != base.common_arrival.to_bits() || base.trajectories.len() <= i {
+            return self.evaluate(x);
+        }
+        let mut vehicles = base.vehicles.clone();
+        for t in vehicles.iter_mut() {
+            t.space = 0.0;
+            t.separation = 0.0;
+        }
+        vehicles[i] = self.vehicle_terms(i, &path, length);
+        vehicles[i].motion += early_arrival_penalty(length, &s.vehicles[i], arrival);
+        let mut trajectories = base.trajectories.clone();
+        trajectories[i] = retime_legs(path, &legs, &s.vehicles[i], arrival);
+        let pairs = coupling::pair_terms_changed(&trajectories, s.fleet.d_min_m, i, &base.pairs);
+        self.summed(trajectories, arrival, vehicles, pairs)
+    }
+
+    /// The evaluation from its parts: the pair terms added to the vehicles', then the sums.
+    fn summed(
+        &self,
+        trajectories: Vec<Trajectory>,
+        arrival: f64,
+        mut vehicles: Vec<VehicleTerms>,
+        pairs: Vec<PairTerms>,
+    ) -> FleetEvaluation {
+        let sep_penalty = coupling::add_pair_terms(&pairs, &mut vehicles);
         let objective: f64 = vehicles.iter().map(|t| self.objective_of(t)).sum();
         let penalty: f64 = vehicles.iter().map(|t| t.hard + t.motion).sum::<f64>() + sep_penalty;
         FleetEvaluation {
@@ -460,9 +512,15 @@ impl FleetModel {
             separation_penalty: sep_penalty,
             objective,
             penalty,
-            total: objective + s.optimizer.penalty_weight * penalty,
+            total: objective + self.scenario.optimizer.penalty_weight * penalty,
+            pairs,
         }
     }
+}
+
+/// Sum of a polyline's leg lengths, leg by leg in order (as [`FleetModel::evaluate`] sums them).
+fn polyline_sum(points: &[Vec3]) -> f64 {
+    points.windows(2).map(|w| (w[1] - w[0]).norm()).sum()
 }
 
 mod coupling;

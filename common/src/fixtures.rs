@@ -27,6 +27,25 @@ pub fn scenario(
     Scenario::parse(&text, std::path::Path::new("fixture.toml"))
 }
 
+/// Eight AUVs crossing the box both ways (their paths meet in the middle), a hard and a soft
+/// sphere: random particles breach separation, obstacles and limits in many ways.
+pub fn crossing_fleet() -> Result<Scenario, ScenarioError> {
+    let spheres = "[[obstacles]]\nid = \"H\"\nkind = \"hard\"\ncentre = [500.0, 300.0, 250.0]\nradius_m = 80.0\ninflation_m = 10.0\n\
+                   [[obstacles]]\nid = \"S\"\nkind = \"soft\"\ncentre = [500.0, 700.0, 250.0]\nradius_m = 80.0\ninflation_m = 10.0\n";
+    let vehicles: Vec<String> = (0..8)
+        .map(|k| {
+            let y = 100.0 + 110.0 * k as f64;
+            let (from, to) = if k % 2 == 0 {
+                (50.0, 950.0)
+            } else {
+                (950.0, 50.0)
+            };
+            vehicle_toml(&format!("v{k}"), [from, y, 200.0], [to, 1000.0 - y, 300.0])
+        })
+        .collect();
+    scenario(900.0, spheres, &vehicles)
+}
+
 /// Every vehicle on its straight line (waypoints evenly spaced) at a requested 1 m/s.
 pub fn straight_particle(model: &FleetModel) -> Vec<f64> {
     let m = model.layout.waypoints;

@@ -29,8 +29,9 @@ pub struct Motion<'a> {
     times: &'a [f64],
     /// Leg start points, then the final point.
     points: &'a [Vec3],
-    /// Velocity on each leg, m/s (zero for a leg of zero duration).
-    velocities: Vec<Vec3>,
+    /// Velocity on each leg, m/s (zero for a leg of zero duration); borrowed when prepared once
+    /// for many queries ([`Motion::prepared`]).
+    velocities: std::borrow::Cow<'a, [Vec3]>,
     /// Fastest leg speed, m/s: bounds how fast a distance can shrink.
     max_speed: f64,
 }
@@ -38,6 +39,28 @@ pub struct Motion<'a> {
 impl<'a> Motion<'a> {
     /// Prepares `t` (at least one sample).
     pub fn new(t: &'a Trajectory) -> Motion<'a> {
+        let (velocities, max_speed) = Motion::velocities_of(t);
+        Motion {
+            times: &t.times,
+            points: &t.points,
+            velocities: std::borrow::Cow::Owned(velocities),
+            max_speed,
+        }
+    }
+
+    /// `t` with its legs' velocities and top speed computed once by [`Motion::velocities_of`]:
+    /// a trajectory queried many times is prepared without allocating.
+    pub fn prepared(t: &'a Trajectory, velocities: &'a [Vec3], max_speed: f64) -> Motion<'a> {
+        Motion {
+            times: &t.times,
+            points: &t.points,
+            velocities: std::borrow::Cow::Borrowed(velocities),
+            max_speed,
+        }
+    }
+
+    /// Each leg's velocity and the fastest leg's speed, m/s.
+    pub fn velocities_of(t: &Trajectory) -> (Vec<Vec3>, f64) {
         let velocities: Vec<Vec3> = t
             .times
             .windows(2)
@@ -55,12 +78,7 @@ impl<'a> Motion<'a> {
             .iter()
             .map(|v: &Vec3| v.norm())
             .fold(0.0, f64::max);
-        Motion {
-            times: &t.times,
-            points: &t.points,
-            velocities,
-            max_speed,
-        }
+        (velocities, max_speed)
     }
 
     /// Position at `time` on leg `k` (or held at the end when `k` is past the last leg).

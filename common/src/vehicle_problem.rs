@@ -14,6 +14,7 @@
 
 use rand::rngs::StdRng;
 
+use crate::broad_phase::SlabBoxes;
 use crate::cost::{
     early_arrival_penalty, entry_turn_penalty, separation_penalty, space_term, FleetModel,
     VehicleTerms,
@@ -32,6 +33,14 @@ pub struct VehicleProblem<'a> {
     vehicle: usize,
     /// The other vehicles' trajectories, in scenario order without `vehicle`.
     others: Vec<Trajectory>,
+    /// Their legs' velocities and top speeds ([`Motion::velocities_of`]), computed once.
+    other_velocities: Vec<(Vec<Vec3>, f64)>,
+    /// Their space-time boxes ([`SlabBoxes`]) over `[0, horizon]`: a pair whose boxes never come
+    /// within d_min is skipped (its terms are exactly zero).
+    other_boxes: SlabBoxes,
+    /// The time span of `other_boxes`, seconds: the later of the others' last arrival and the
+    /// context's arrival (this vehicle's positions after it fall in the last slab).
+    horizon: f64,
     /// The arrival time the context was timed for, seconds.
     arrival: f64,
     /// Gene bounds of this vehicle's chromosome.
@@ -53,7 +62,8 @@ pub struct VehicleEvaluation {
     pub trajectory: Trajectory,
     /// Its terms (`separation` holds the whole penalty of its pairs).
     pub terms: VehicleTerms,
-    /// Smallest distance to any other vehicle, metres (`INFINITY` when alone).
+    /// Smallest distance to any other vehicle, metres, exact when under d_min; at least d_min
+    /// otherwise, and `INFINITY` when no other vehicle comes within d_min (or it is alone).
     pub min_separation: f64,
     /// The cost the swarm minimises.
     pub total: f64,
@@ -69,15 +79,28 @@ impl<'a> VehicleProblem<'a> {
         arrival: f64,
     ) -> Self {
         let range = model.layout.chromosome(vehicle);
+        let others: Vec<Trajectory> = context
+            .iter()
+            .enumerate()
+            .filter(|(j, _)| *j != vehicle)
+            .map(|(_, t)| t.clone())
+            .collect();
+        let horizon = others
+            .iter()
+            .filter_map(|t| t.times.last())
+            .fold(arrival, |a, b| a.max(*b));
+        let mut other_boxes = SlabBoxes::new();
+        other_boxes.reset(horizon);
+        for t in &others {
+            other_boxes.push(&t.times, &t.points);
+        }
         VehicleProblem {
             model,
             vehicle,
-            others: context
-                .iter()
-                .enumerate()
-                .filter(|(j, _)| *j != vehicle)
-                .map(|(_, t)| t.clone())
-                .collect(),
+            other_velocities: others.iter().map(Motion::velocities_of).collect(),
+            other_boxes,
+            horizon,
+            others,
             arrival,
             lower: model.lower[range.clone()].to_vec(),
             upper: model.upper[range].to_vec(),
@@ -145,9 +168,19 @@ impl<'a> VehicleProblem<'a> {
         }
         let trajectory = retime_legs(path, &legs, v, target);
         let mine = Motion::new(&trajectory);
+        let mut own = SlabBoxes::new();
+        own.reset(self.horizon);
+        own.push(&trajectory.times, &trajectory.points);
+        let d_min = s.fleet.d_min_m;
         let mut min_separation = f64::INFINITY;
-        for other in &self.others {
-            let p = motion_separation(&mine, &Motion::new(other), s.fleet.d_min_m, false);
+        for (k, (other, (velocities, top))) in
+            self.others.iter().zip(&self.other_velocities).enumerate()
+        {
+            if !own.near_other(0, &self.other_boxes, k, d_min) {
+                continue;
+            }
+            let other = Motion::prepared(other, velocities, *top);
+            let p = motion_separation(&mine, &other, d_min, false);
             terms.space += space_term(p.breach_s);
             terms.separation += separation_penalty(p.min_distance, s.fleet.d_min_m);
             min_separation = min_separation.min(p.min_distance);
@@ -330,6 +363,43 @@ mod tests {
         assert!((ne.total - base.total - weight * (1.0 + 10.0 / 35.0)).abs() < 1e-6);
         let east = p.entering_along(Vec3::new(3.0, 0.0, 0.0)).evaluate(x);
         assert_eq!(east.terms.motion, base.terms.motion);
+        Ok(())
+    }
+
+    #[test]
+    fn skipping_vehicles_that_never_come_near_changes_no_term(
+    ) -> Result<(), crate::scenario::ScenarioError> {
+        let model = FleetModel::new(&fixtures::crossing_fleet()?);
+        let d_min = model.scenario.fleet.d_min_m;
+        let mut rng = StdRng::seed_from_u64(3);
+        let (mut close, mut skipped) = (0, 0);
+        for _ in 0..30 {
+            let e = model.evaluate(&model.sample(&mut rng));
+            for i in 0..model.layout.vehicles {
+                let problem = VehicleProblem::new(&model, i, &e.trajectories, e.common_arrival);
+                let genes = model.sample(&mut rng)[model.layout.chromosome(i)].to_vec();
+                let got = problem.evaluate(&genes);
+                // Every other vehicle, as the fitness measures a pair.
+                let mine = Motion::new(&got.trajectory);
+                let (mut space, mut penalty, mut min) = (0.0, 0.0, f64::INFINITY);
+                for other in problem.others() {
+                    let p = motion_separation(&mine, &Motion::new(other), d_min, false);
+                    space += space_term(p.breach_s);
+                    penalty += separation_penalty(p.min_distance, d_min);
+                    min = min.min(p.min_distance);
+                    skipped += usize::from(p.min_distance >= d_min);
+                }
+                assert_eq!(got.terms.space.to_bits(), space.to_bits());
+                assert_eq!(got.terms.separation.to_bits(), penalty.to_bits());
+                if min < d_min {
+                    close += 1;
+                    assert_eq!(got.min_separation, min);
+                } else {
+                    assert!(got.min_separation >= d_min);
+                }
+            }
+        }
+        assert!(close > 20 && skipped > 20, "{close} {skipped}");
         Ok(())
     }
 }

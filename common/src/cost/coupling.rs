@@ -1,6 +1,7 @@
 //! The fleet's pair terms, F_i(S) of Zhi & Zuo 2024, eq. (11), and the separation penalty, summed
 //! over the pairs the broad phase ([`crate::broad_phase`]) cannot rule out: a pair it prunes is at
-//! least d_min apart at every instant, so both its terms are exactly zero.
+//! least d_min apart at every instant, so both its terms are exactly zero. An evaluation keeps
+//! its pairs' terms, so one that moves a single vehicle measures only that vehicle's pairs.
 
 use std::cell::RefCell;
 
@@ -15,36 +16,83 @@ thread_local! {
     static SCRATCH: RefCell<(SlabBoxes, PairSet)> = RefCell::new((SlabBoxes::new(), PairSet::new()));
 }
 
-/// Adds every pair's F(S) (to both vehicles) and half its separation penalty (to each) into
-/// `vehicles`, and returns the sum of the pairs' penalties. Pairs are visited in row order, as
-/// an all-pairs loop would, so the sums are the same to the last bit.
-pub(super) fn add_pair_terms(
-    trajectories: &[Trajectory],
-    d_min: f64,
-    vehicles: &mut [VehicleTerms],
-) -> f64 {
-    SCRATCH.with(|cell| match cell.try_borrow_mut() {
-        Ok(mut scratch) => {
-            let (boxes, pairs) = &mut *scratch;
-            close_pairs(trajectories, d_min, boxes, pairs);
-            sum_pairs(trajectories, d_min, pairs.iter(), vehicles)
-        }
-        // Re-entered on this thread (nothing does today): fall back to fresh buffers.
-        Err(_) => {
-            let (mut boxes, mut pairs) = (SlabBoxes::new(), PairSet::new());
-            close_pairs(trajectories, d_min, &mut boxes, &mut pairs);
-            sum_pairs(trajectories, d_min, pairs.iter(), vehicles)
-        }
+/// The exact terms of one pair the broad phase kept.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PairTerms {
+    /// The pair, `i < j`, in scenario order.
+    pub i: u32,
+    /// The other vehicle.
+    pub j: u32,
+    /// Seconds closer than d_min: F(S) of eq. (11) for each of the two.
+    pub breach_s: f64,
+    /// The pair's separation penalty ([`separation_penalty`]).
+    pub penalty: f64,
+}
+
+/// The terms of every pair the broad phase cannot rule out, in row order.
+pub(super) fn pair_terms(trajectories: &[Trajectory], d_min: f64) -> Vec<PairTerms> {
+    with_scratch(|boxes, pairs| {
+        boxes_of(trajectories, boxes);
+        boxes.close_pairs(d_min, pairs);
+        narrow(trajectories, d_min, pairs.iter())
     })
 }
 
-/// The pairs whose space-time boxes come within `d_min`.
-fn close_pairs(
+/// [`pair_terms`] after only vehicle `changed` moved: the pairs without it are `base`'s
+/// (the terms of an evaluation of the same fleet with `changed` elsewhere); only the pairs with
+/// it are found and measured again. Pairs the broad phase keeps but that never come within
+/// d_min have terms of exactly zero, so which of them are listed changes no sum.
+pub(super) fn pair_terms_changed(
     trajectories: &[Trajectory],
     d_min: f64,
-    boxes: &mut SlabBoxes,
-    pairs: &mut PairSet,
-) {
+    changed: usize,
+    base: &[PairTerms],
+) -> Vec<PairTerms> {
+    let fresh = with_scratch(|boxes, _| {
+        boxes_of(trajectories, boxes);
+        let near = (0..trajectories.len())
+            .filter(|&j| j != changed && boxes.near(changed, j, d_min))
+            .map(|j| (changed.min(j), changed.max(j)));
+        narrow(trajectories, d_min, near)
+    });
+    let kept = base
+        .iter()
+        .filter(|p| p.i as usize != changed && p.j as usize != changed);
+    let mut out: Vec<PairTerms> = kept.copied().chain(fresh).collect();
+    out.sort_unstable_by_key(|p| (p.i, p.j));
+    out
+}
+
+/// Adds every pair's F(S) (to both vehicles) and half its separation penalty (to each) into
+/// `vehicles`, and returns the sum of the pairs' penalties. `pairs` in row order, as an
+/// all-pairs loop would visit them, so the sums are the same to the last bit.
+pub(super) fn add_pair_terms(pairs: &[PairTerms], vehicles: &mut [VehicleTerms]) -> f64 {
+    let mut total = 0.0;
+    for p in pairs {
+        let (i, j) = (p.i as usize, p.j as usize);
+        // eq. (12) sums F_i(S) over vehicles: a breach counts for both of the pair.
+        vehicles[i].space += space_term(p.breach_s);
+        vehicles[j].space += space_term(p.breach_s);
+        vehicles[i].separation += 0.5 * p.penalty;
+        vehicles[j].separation += 0.5 * p.penalty;
+        total += p.penalty;
+    }
+    total
+}
+
+/// Runs `f` on this thread's broad-phase buffers (fresh ones if they are in use).
+fn with_scratch<T>(f: impl FnOnce(&mut SlabBoxes, &mut PairSet) -> T) -> T {
+    SCRATCH.with(|cell| match cell.try_borrow_mut() {
+        Ok(mut scratch) => {
+            let (boxes, pairs) = &mut *scratch;
+            f(boxes, pairs)
+        }
+        Err(_) => f(&mut SlabBoxes::new(), &mut PairSet::new()),
+    })
+}
+
+/// Every trajectory's slab boxes, over the time to the last arrival.
+fn boxes_of(trajectories: &[Trajectory], boxes: &mut SlabBoxes) {
     let horizon = trajectories
         .iter()
         .filter_map(|t| t.times.last())
@@ -53,41 +101,42 @@ fn close_pairs(
     for t in trajectories {
         boxes.push(&t.times, &t.points);
     }
-    boxes.close_pairs(d_min, pairs);
 }
 
-/// The exact narrow phase on `pairs`.
-fn sum_pairs(
+/// The exact separation (the narrow phase) of `pairs`, in the order given.
+fn narrow(
     trajectories: &[Trajectory],
     d_min: f64,
     pairs: impl Iterator<Item = (usize, usize)>,
-    vehicles: &mut [VehicleTerms],
-) -> f64 {
-    let motions: Vec<Motion> = trajectories.iter().map(Motion::new).collect();
-    let mut total = 0.0;
+) -> Vec<PairTerms> {
+    let mut motions: Vec<Option<Motion>> = vec![None; trajectories.len()];
+    let mut out = Vec::new();
     for (i, j) in pairs {
-        let ps = motion_separation(&motions[i], &motions[j], d_min, false);
-        // eq. (12) sums F_i(S) over vehicles: a breach counts for both of the pair.
-        vehicles[i].space += space_term(ps.breach_s);
-        vehicles[j].space += space_term(ps.breach_s);
-        let sp = separation_penalty(ps.min_distance, d_min);
-        vehicles[i].separation += 0.5 * sp;
-        vehicles[j].separation += 0.5 * sp;
-        total += sp;
+        for k in [i, j] {
+            if motions[k].is_none() {
+                motions[k] = Some(Motion::new(&trajectories[k]));
+            }
+        }
+        let (Some(a), Some(b)) = (&motions[i], &motions[j]) else {
+            continue;
+        };
+        let ps = motion_separation(a, b, d_min, false);
+        out.push(PairTerms {
+            i: i as u32,
+            j: j as u32,
+            breach_s: ps.breach_s,
+            penalty: separation_penalty(ps.min_distance, d_min),
+        });
     }
-    total
+    out
 }
 
-/// Every pair, for the tests: what [`add_pair_terms`] must equal.
+/// Every pair, for the tests: what the pruned terms must sum to.
 #[cfg(test)]
-pub(super) fn add_all_pair_terms(
-    trajectories: &[Trajectory],
-    d_min: f64,
-    vehicles: &mut [VehicleTerms],
-) -> f64 {
+pub(super) fn all_pair_terms(trajectories: &[Trajectory], d_min: f64) -> Vec<PairTerms> {
     let n = trajectories.len();
     let all = (0..n).flat_map(move |i| (i + 1..n).map(move |j| (i, j)));
-    sum_pairs(trajectories, d_min, all, vehicles)
+    narrow(trajectories, d_min, all)
 }
 
 #[cfg(test)]
@@ -131,8 +180,8 @@ mod tests {
         ) {
             let mut pruned = vec![VehicleTerms::default(); fleet.len()];
             let mut all = pruned.clone();
-            let p = add_pair_terms(&fleet, d_min, &mut pruned);
-            let a = add_all_pair_terms(&fleet, d_min, &mut all);
+            let p = add_pair_terms(&pair_terms(&fleet, d_min), &mut pruned);
+            let a = add_pair_terms(&all_pair_terms(&fleet, d_min), &mut all);
             prop_assert_eq!(p.to_bits(), a.to_bits());
             prop_assert_eq!(pruned, all);
         }

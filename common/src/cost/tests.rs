@@ -301,3 +301,36 @@ fn the_fleet_fitness_adds_the_weighted_terms_by_hand() -> Result<(), crate::scen
     assert_abs_diff_eq!(e.total, 0.5, epsilon = 1e-9);
     Ok(())
 }
+
+#[test]
+fn changing_one_vehicle_scores_as_a_whole_evaluation_to_the_last_bit(
+) -> Result<(), crate::scenario::ScenarioError> {
+    use crate::swarm::Problem;
+    use rand::SeedableRng;
+    let model = FleetModel::new(&crate::fixtures::crossing_fleet()?);
+    let mut rng = rand::rngs::StdRng::seed_from_u64(7);
+    let (mut incremental, mut breaches) = (0, 0);
+    for _ in 0..40 {
+        let x = model.sample(&mut rng);
+        let base = model.evaluate(&x);
+        for i in 0..model.layout.vehicles {
+            let other = model.sample(&mut rng);
+            let mut y = x.clone();
+            let r = model.layout.chromosome(i);
+            y[r.clone()].copy_from_slice(&other[r]);
+            let whole = model.evaluate(&y);
+            let changed = model.evaluate_change(&base, &y, i);
+            assert_eq!(changed.total.to_bits(), whole.total.to_bits());
+            assert_eq!(changed.vehicles, whole.vehicles);
+            assert_eq!(changed.trajectories, whole.trajectories);
+            assert_eq!(changed.pairs, whole.pairs);
+            assert_eq!(changed.penalty.to_bits(), whole.penalty.to_bits());
+            incremental += usize::from(whole.common_arrival == base.common_arrival);
+            breaches += usize::from(whole.separation_penalty > 0.0);
+        }
+    }
+    // Both ways through evaluate_change were taken, and pairs did breach.
+    assert!(incremental > 20 && incremental < 320, "{incremental}");
+    assert!(breaches > 20, "{breaches}");
+    Ok(())
+}

@@ -192,6 +192,10 @@ impl Arena for FleetArena<'_> {
         self.model.evaluate(x)
     }
 
+    fn evaluate_change(&self, base: &FleetEvaluation, x: &[f64], i: usize) -> FleetEvaluation {
+        self.model.evaluate_change(base, x, i)
+    }
+
     fn genes(&self, i: usize) -> Range<usize> {
         self.model.layout.chromosome(i)
     }

@@ -23,6 +23,12 @@ pub(super) trait Arena {
     fn model(&self) -> &FleetModel;
     /// Scores position `x`.
     fn evaluate(&self, x: &[f64]) -> Self::Eval;
+    /// Scores `x`, which differs from the position `base` scored only in vehicle `i`'s genes
+    /// (an arena that can reuse the rest of `base` overrides this).
+    fn evaluate_change(&self, base: &Self::Eval, x: &[f64], i: usize) -> Self::Eval {
+        let _ = (base, i);
+        self.evaluate(x)
+    }
     /// Where vehicle `i`'s chromosome sits in a position.
     fn genes(&self, i: usize) -> Range<usize>;
     /// What a step must lower.
@@ -144,7 +150,7 @@ impl<'a, A: Arena> Search<'a, A> {
                 return;
             }
             let longest = step.d.iter().fold(0.0_f64, |m, d| m.max(d.abs()));
-            match self.try_step(&coords, &step.d) {
+            match self.try_step(i, &coords, &step.d) {
                 Some((scale, actual)) => {
                     self.steps += 1;
                     let ratio = actual / step.predicted;
@@ -168,7 +174,7 @@ impl<'a, A: Arena> Search<'a, A> {
     /// does not lower the merit (a step the linearised limits allowed may cross a curved
     /// limit: halving it quarters that second-order error). Returns the fraction kept and the
     /// change of merit, or `None` when no fraction lowered it.
-    fn try_step(&mut self, coords: &Range<usize>, d: &[f64]) -> Option<(f64, f64)> {
+    fn try_step(&mut self, i: usize, coords: &Range<usize>, d: &[f64]) -> Option<(f64, f64)> {
         let mut scale = 1.0;
         let now = self.arena.merit(&self.eval);
         for _ in 0..3 {
@@ -176,7 +182,7 @@ impl<'a, A: Arena> Search<'a, A> {
             for (g, d) in coords.clone().zip(d) {
                 trial[g] += scale * d;
             }
-            let e = self.arena.evaluate(&trial);
+            let e = self.arena.evaluate_change(&self.eval, &trial, i);
             self.evaluations += 1;
             let actual = self.arena.merit(&e) - now;
             if actual < 0.0 {

@@ -79,6 +79,9 @@ pub enum Command {
     BenchCages(bench::cages::BenchCagesArgs),
     /// Measure the coordinator's CPU use and telemetry latency with N simulated vehicles.
     BenchTelemetry(bench::telemetry::BenchTelemetryArgs),
+    /// Plan generated fleets of growing size at one budget: wall time, evaluations per second,
+    /// CPU per evaluation and the exponent of its growth with the fleet.
+    BenchScale(bench::scale::BenchScaleArgs),
     /// Compare CPP-DSMV's arc-smoothed Boustrophedon with the Hybrid A* baseline on seeded maps
     /// (coverage, planning time, clearance, cross-track error; Table 2 and Figure 7).
     BenchCoverage(bench::coverage::BenchCoverageArgs),
@@ -111,6 +114,7 @@ pub fn run(command: Command, shutdown: Arc<AtomicBool>) -> anyhow::Result<i32> {
         Command::BenchEnergy(args) => bench::energy::command(&args, &shutdown),
         Command::BenchCages(args) => bench::cages::command(&args, &shutdown),
         Command::BenchTelemetry(args) => bench::telemetry::command(&args, &shutdown),
+        Command::BenchScale(args) => bench::scale::command(&args, &shutdown),
         Command::BenchCoverage(args) => bench::coverage::bench_coverage(&args, &shutdown),
     }
 }

@@ -1,5 +1,6 @@
 //! The benchmark commands: the papers' tables re-run (`bench-functions`, `bench-energy`,
-//! `bench-cages`, `bench-coverage`) and the coordinator's own load (`bench-telemetry`); [`pool`]
+//! `bench-cages`, `bench-coverage`), the coordinator's own load (`bench-telemetry`) and how
+//! planning scales with the fleet (`bench-scale`); [`pool`]
 //! runs their independent jobs on worker threads.
 
 pub mod cages;
@@ -7,4 +8,5 @@ pub mod coverage;
 pub mod energy;
 pub mod functions;
 pub mod pool;
+pub mod scale;
 pub mod telemetry;
