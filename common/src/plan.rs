@@ -404,6 +404,25 @@ pub struct DistributedFigures {
     pub agents: Vec<AgentFigures>,
     /// Vehicles whose followers the coordinator ran itself, and why.
     pub degraded: Vec<DegradedVehicle>,
+    /// What a leader/follower round cost the coordinator (absent for one-shot missions).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rounds: Option<RoundFigures>,
+}
+
+/// The coordinator's time per leader/follower round, averaged over the run's rounds: how the
+/// exchange and the leader's own step grow with the fleet.
+#[derive(Debug, Clone, Copy, Default, Serialize, Deserialize, PartialEq)]
+pub struct RoundFigures {
+    /// Rounds run.
+    pub rounds: u32,
+    /// Mean wall time from asking for a round's elites to holding every agent's, seconds: the
+    /// agents' iterations plus the exchange over the network.
+    pub collect_s: f64,
+    /// Mean wall time of the leader's step (its populations, the migrants, the context),
+    /// seconds.
+    pub leader_s: f64,
+    /// Mean CPU time of the coordinator's process per round, seconds (Linux; 0 elsewhere).
+    pub coordinator_cpu_s: f64,
 }
 
 /// One agent's share of a distributed run.

@@ -16,12 +16,14 @@
 //!   the comparison tables, the SVG charts and the GeoJSON/QGroundControl exports.
 //! - [`distributed`] (planning over agents on Zenoh) and [`execute`] (driving a plan, watching
 //!   the fleet, replanning).
+//! - [`cpu`]: the process's CPU time, for the figures that report a step's cost.
 //! - The rule: `commands` → `mission` → `planning`, `report`, `distributed`, `execute`, never
 //!   back (`commands` may also call the lower layers directly); no cycle between files
 //!   (`.ci/module-cycles` checks it).
 
 pub mod acl;
 pub mod commands;
+pub mod cpu;
 pub mod distributed;
 pub mod execute;
 pub mod mission;

@@ -6,7 +6,7 @@
 //! logs in `DIR/logs/<vehicle>.log`) or separately (`--agents external --listen tcp/HOST:PORT`,
 //! `shoal-agent --vehicle ID --connect tcp/HOST:PORT [--once]`). `plan.json` then has
 //! `"mode": "distributed"` and a `distributed` object (mission, exchanges, messages_dropped,
-//! agents[], degraded[]); a vehicle whose agent is lost is planned by the coordinator
+//! agents[], degraded[], rounds: the coordinator's time per round); a vehicle whose agent is lost is planned by the coordinator
 //! ("degraded") and a notice says so.
 
 mod common;
@@ -134,6 +134,16 @@ fn assert_every_agent_planned(json: &Value, mission: Option<&str>) {
         exchanges > 0.0,
         "no exchanges: {}",
         key(json, "distributed")
+    );
+    // Every exchange is a round the coordinator timed: waiting for the elites, and its step.
+    assert_eq!(number(json, "distributed.rounds.rounds"), exchanges);
+    let collect = number(json, "distributed.rounds.collect_s");
+    let leader = number(json, "distributed.rounds.leader_s");
+    let cpu = number(json, "distributed.rounds.coordinator_cpu_s");
+    assert!(
+        collect > 0.0 && leader > 0.0 && cpu >= 0.0,
+        "{}",
+        key(json, "distributed.rounds")
     );
     let agents = key(json, "distributed.agents");
     assert_eq!(

@@ -12,7 +12,7 @@ use std::time::Instant;
 use shoal_common::plan::Plan;
 use shoal_common::scenario::Scenario;
 
-use super::telemetry::cpu_time;
+use crate::cpu::cpu_time;
 use crate::mission::NetworkOptions;
 use crate::planning::generated::scenario_text;
 use crate::planning::planner::plan_in_process;

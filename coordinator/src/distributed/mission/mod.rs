@@ -16,7 +16,7 @@ use shoal_common::distributed::follower::FollowerSettings;
 use shoal_common::distributed::leader::Leader;
 use shoal_common::distributed::lockstep::context_due;
 use shoal_common::distributed::{round_iterations, rounds, Chromosome, Context};
-use shoal_common::plan::{AgentFigures, DistributedFigures};
+use shoal_common::plan::{AgentFigures, DistributedFigures, RoundFigures};
 use shoal_common::scenario::Scenario;
 use shoal_common::swarm::{Progress, Termination};
 use shoal_common::wire::agent_to_coordinator::AgentToCoordinator;
@@ -36,6 +36,7 @@ pub use state::{Status, Timing};
 
 use super::agents::LocalAgents;
 use super::network::{Event, Network};
+use crate::cpu::cpu_time;
 use crate::planning::finish::CHECKPOINT_EVERY;
 use crate::planning::solver::RunResult;
 
@@ -63,6 +64,7 @@ pub fn run(
     let mut stale = false;
     let mut interrupted = false;
     let mut checkpoints = Vec::new();
+    let mut clock = RoundClock::default();
     for round in 0..total_rounds {
         if stop.load(Ordering::Relaxed) {
             interrupted = true;
@@ -74,7 +76,9 @@ pub fn run(
             start: iteration,
             len: n,
         };
+        let asked = clock.start();
         r.collect(span, &context, local.as_deref_mut())?;
+        let collected = Instant::now();
         for seat in &mut r.seats {
             // An agent lost after it sent this round's elites is planned here from the next.
             if seat.this_round.is_some() {
@@ -135,6 +139,7 @@ pub fn run(
         if let Some(last) = convergence.last_mut() {
             *last = leader.best_cost();
         }
+        clock.end(asked, collected);
         if round + 1 < total_rounds {
             r.send_migrants(round as u32, context.round, migrants)?;
         }
@@ -179,6 +184,7 @@ pub fn run(
             })
             .collect(),
         degraded: r.seats.iter().filter_map(|s| s.degraded.clone()).collect(),
+        rounds: Some(clock.figures()),
     };
     let result = RunResult {
         best_x: leader.best_x().to_vec(),
@@ -451,6 +457,50 @@ impl Run<'_> {
                 Some(_) => {}
                 None => break,
             }
+        }
+    }
+}
+
+/// Sums what the rounds cost the coordinator ([`RoundFigures`]).
+#[derive(Debug, Default)]
+struct RoundClock {
+    /// Rounds timed.
+    rounds: u32,
+    /// Summed collect time, seconds.
+    collect_s: f64,
+    /// Summed leader time (from holding the elites to the migrants ready), seconds.
+    leader_s: f64,
+    /// Process CPU time when the current round started.
+    cpu_at_start: Duration,
+    /// Summed process CPU time, seconds.
+    cpu_s: f64,
+}
+
+impl RoundClock {
+    /// A round starts now.
+    fn start(&mut self) -> Instant {
+        self.cpu_at_start = cpu_time().unwrap_or_default();
+        Instant::now()
+    }
+
+    /// The round that started at `asked` held every agent's elites at `collected` and its
+    /// leader step is done now.
+    fn end(&mut self, asked: Instant, collected: Instant) {
+        self.rounds += 1;
+        self.collect_s += (collected - asked).as_secs_f64();
+        self.leader_s += collected.elapsed().as_secs_f64();
+        let cpu = cpu_time().unwrap_or_default();
+        self.cpu_s += cpu.saturating_sub(self.cpu_at_start).as_secs_f64();
+    }
+
+    /// The means.
+    fn figures(&self) -> RoundFigures {
+        let n = f64::from(self.rounds.max(1));
+        RoundFigures {
+            rounds: self.rounds,
+            collect_s: self.collect_s / n,
+            leader_s: self.leader_s / n,
+            coordinator_cpu_s: self.cpu_s / n,
         }
     }
 }

@@ -254,6 +254,7 @@ pub fn run_shares(
             .iter()
             .filter_map(|s| s.degraded.clone())
             .collect(),
+        rounds: None,
     };
     Ok((shares, figures))
 }
