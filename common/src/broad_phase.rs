@@ -112,6 +112,30 @@ impl SlabBoxes {
         (0..SLABS).any(|k| self.box_gap2(a * SLABS + k, b * SLABS + k) < r2)
     }
 
+    /// The time windows `(from, to)` of the slabs in which vehicles `a` and `b` have boxes
+    /// closer than `reach`, adjacent ones merged, into `out` (cleared first); the last slab's
+    /// window ends at infinity (both hold at their last points).
+    pub fn near_windows(&self, a: usize, b: usize, reach: f64, out: &mut Vec<(f64, f64)>) {
+        out.clear();
+        let r2 = guarded2(reach);
+        let slab = self.horizon / SLABS as f64;
+        for k in 0..SLABS {
+            if self.box_gap2(a * SLABS + k, b * SLABS + k) >= r2 {
+                continue;
+            }
+            let from = k as f64 * slab;
+            let to = if k + 1 == SLABS {
+                f64::INFINITY
+            } else {
+                (k + 1) as f64 * slab
+            };
+            match out.last_mut() {
+                Some(last) if last.1 == from => last.1 = to,
+                _ => out.push((from, to)),
+            }
+        }
+    }
+
     /// Whether vehicle `a` of `self` and vehicle `b` of `other` (with the same horizon) have
     /// boxes of some slab closer than `reach`.
     pub fn near_other(&self, a: usize, other: &SlabBoxes, b: usize, reach: f64) -> bool {
@@ -179,6 +203,7 @@ impl SlabBoxes {
     }
 
     /// Squared distance between boxes `i` and `j` of this set.
+    #[inline]
     fn box_gap2(&self, i: usize, j: usize) -> f64 {
         gap2(&self.lo[i], &self.hi[i], &self.lo[j], &self.hi[j])
     }
@@ -211,6 +236,7 @@ fn insertion_sort(items: &mut [(f64, u32)]) {
 
 /// Squared distance between two axis-aligned boxes (0 when they overlap; infinite for a box of
 /// a vehicle without samples).
+#[inline]
 fn gap2(lo_a: &Vec3, hi_a: &Vec3, lo_b: &Vec3, hi_b: &Vec3) -> f64 {
     let mut s = 0.0;
     for d in 0..3 {

@@ -199,6 +199,46 @@ pub fn motion_separation(
     best
 }
 
+/// The smallest distance between `a` and `b` at any instant of `[from, to]` (`to` may be
+/// infinite: both hold at their last points), by the same piecewise-linear motion as
+/// [`motion_separation`] but over that window only. The broad phase's last test: a pair of
+/// vehicles whose near windows all stay at least `d_min` apart has terms of exactly zero.
+pub fn closest_within(a: &Motion<'_>, b: &Motion<'_>, from: f64, to: f64) -> f64 {
+    let (na, nb) = (a.velocities.len(), b.velocities.len());
+    let leg = |m: &Motion<'_>, n: usize, t: f64| {
+        // The last leg starting at or before t (legs of zero duration skipped), or n (held).
+        m.times[1..=n].partition_point(|&end| end <= t)
+    };
+    let (mut i, mut j) = (leg(a, na, from), leg(b, nb, from));
+    let mut t0 = from;
+    let mut d0 = b.at(j, t0) - a.at(i, t0);
+    let mut best = d0.norm_squared();
+    while t0 < to {
+        let t1 = a
+            .times
+            .get(i + 1)
+            .copied()
+            .unwrap_or(f64::INFINITY)
+            .min(b.times.get(j + 1).copied().unwrap_or(f64::INFINITY))
+            .min(to);
+        if !t1.is_finite() {
+            break;
+        }
+        let d1 = b.at(j, t1) - a.at(i, t1);
+        let gap = crate::geometry::closest_approach(&d0, &d1);
+        best = best.min(gap * gap);
+        t0 = t1;
+        d0 = d1;
+        while i < na && a.times[i + 1] <= t0 {
+            i += 1;
+        }
+        while j < nb && b.times[j + 1] <= t0 {
+            j += 1;
+        }
+    }
+    best.sqrt()
+}
+
 fn consider_point(best: &mut PairSeparation, d: &Vec3, t: f64) {
     let n = d.norm();
     if n < best.min_distance {
@@ -244,6 +284,29 @@ mod tests {
         assert_abs_diff_eq!(s.min_time, 50.0, epsilon = 1e-9);
         // Closer than 50 m while the x gap (closing at 2 m/s) is under 40 m: 40 s in all.
         assert_abs_diff_eq!(s.breach_s, 40.0, epsilon = 1e-9);
+    }
+
+    #[test]
+    fn closest_within_a_window_by_hand() {
+        // The head-on crossing below: x gap 100 − 2t, y gap 30, held apart after t = 100.
+        let a = traj(&[(0.0, [0., 0., 0.]), (100.0, [100., 0., 0.])]);
+        let b = traj(&[(0.0, [100., 30., 0.]), (100.0, [0., 30., 0.])]);
+        let (ma, mb) = (Motion::new(&a), Motion::new(&b));
+        let at_40 = (20f64 * 20.0 + 30.0 * 30.0).sqrt();
+        assert_abs_diff_eq!(closest_within(&ma, &mb, 0.0, 40.0), at_40, epsilon = 1e-9);
+        assert_abs_diff_eq!(closest_within(&ma, &mb, 40.0, 60.0), 30.0, epsilon = 1e-9);
+        assert_abs_diff_eq!(
+            closest_within(&ma, &mb, 60.0, f64::INFINITY),
+            at_40,
+            epsilon = 1e-9
+        );
+        // After both arrive they hold 100 m apart in x.
+        let held = (100f64 * 100.0 + 30.0 * 30.0).sqrt();
+        assert_abs_diff_eq!(
+            closest_within(&ma, &mb, 150.0, f64::INFINITY),
+            held,
+            epsilon = 1e-9
+        );
     }
 
     #[test]

@@ -2,8 +2,9 @@
 //! fleet size it plans a generated scenario ([`crate::planning::generated`], same layout seed)
 //! at the same budget, in process and, with `--distributed`, with one embedded agent process
 //! per vehicle, and prints wall time, fitness evaluations per second, CPU time per evaluation,
-//! fitness and feasibility, then the exponent `b` of a least-squares fit `cost ∝ N^b` of the
-//! CPU time per evaluation (1 is linear in vehicles).
+//! fitness and feasibility (distributed: what a round cost the coordinator), then the exponent
+//! `b` of a least-squares fit `cost ∝ N^b` (1 is linear in vehicles) of the CPU time per
+//! evaluation in process and of the coordinator's CPU time per round distributed.
 
 use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
@@ -64,6 +65,15 @@ impl ScaleRow {
     pub fn cpu_per_evaluation_us(&self) -> f64 {
         1e6 * self.cpu_s / self.plan.evaluations.max(1) as f64
     }
+
+    /// What the row's growth is fitted on: CPU µs per evaluation in process; the coordinator's
+    /// CPU seconds per round distributed (the agents' evaluations are not its own).
+    pub fn cost(&self) -> f64 {
+        match self.plan.distributed.as_ref().and_then(|d| d.rounds) {
+            Some(r) => r.coordinator_cpu_s,
+            None => self.cpu_per_evaluation_us(),
+        }
+    }
 }
 
 /// Runs the benchmark and prints its table.
@@ -99,11 +109,16 @@ pub fn command(args: &BenchScaleArgs, stop: &Arc<AtomicBool>) -> anyhow::Result<
         let points: Vec<(f64, f64)> = rows
             .iter()
             .filter(|r| r.mode == mode)
-            .map(|r| (r.vehicles as f64, r.cpu_per_evaluation_us()))
+            .map(|r| (r.vehicles as f64, r.cost()))
             .collect();
+        let what = if mode == "in-process" {
+            "CPU per evaluation"
+        } else {
+            "the coordinator's CPU per round"
+        };
         if let Some(b) = fitted_exponent(&points) {
             say(&format!(
-                "{mode}: CPU per evaluation grows as N^{b:.2} over {} fleet sizes\n",
+                "{mode}: {what} grows as N^{b:.2} over {} fleet sizes\n",
                 points.len()
             ));
         }
@@ -166,10 +181,17 @@ fn plan_one(
     })
 }
 
-/// One table line.
+/// One table line; a distributed one ends with what a round cost the coordinator.
 fn line(r: &ScaleRow) -> String {
+    let rounds = match r.plan.distributed.as_ref().and_then(|d| d.rounds) {
+        Some(x) => format!(
+            " | per round: elites {:.3} s, leader {:.3} s, coordinator CPU {:.3} s",
+            x.collect_s, x.leader_s, x.coordinator_cpu_s
+        ),
+        None => String::new(),
+    };
     format!(
-        "{} | {} | {:.2} | {} | {:.0} | {:.1} | {:.4} | {}",
+        "{} | {} | {:.2} | {} | {:.0} | {:.1} | {:.4} | {}{rounds}",
         r.vehicles,
         r.mode,
         r.wall_s,
