@@ -23,19 +23,11 @@ use crate::crawler::{CrawlerModel, CrawlerTerms};
 use crate::geometry::{pitch, Vec3, MIN_HEADING_EXTENT};
 use crate::scenario::{Scenario, Vehicle};
 use crate::terrain::Terrain;
-pub use coupling::PairTerms;
+use crate::trajectory::{common_arrival, retime_legs, Layout, Path, Trajectory};
 use spheres::{sphere_terms, SphereIndex};
 
-use crate::trajectory::{common_arrival, retime_legs, Layout, Path, Trajectory};
-
-/// A sphere the cost functions test against: centre and radius already inflated.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Sphere {
-    /// Centre, metres.
-    pub centre: Vec3,
-    /// Radius including the inflation margin, metres.
-    pub radius: f64,
-}
+pub use coupling::{separation_penalty, space_term, PairTerms};
+pub use spheres::Sphere;
 
 /// F_i(L) of eq. (9): path length over straight-line distance (1 for a straight path).
 pub fn length_term(length: f64, straight: f64) -> f64 {
@@ -97,12 +89,6 @@ pub fn early_arrival_penalty(length: f64, vehicle: &Vehicle, target: f64) -> f64
     } else {
         0.0
     }
-}
-
-/// F_i(S) of eq. (11) on timed trajectories: eq. (11) is 1 at every instant a pair is closer than
-/// d_min; counted once per second, the sum is the breach time in seconds.
-pub fn space_term(breach_seconds: f64) -> f64 {
-    breach_seconds
 }
 
 /// Hard-obstacle penalty: for every (leg, obstacle) whose leg enters the inflated sphere, `1 + how
@@ -210,16 +196,6 @@ pub fn pitch_penalty(points: &[Vec3], max_pitch: f64) -> f64 {
         }
     }
     p
-}
-
-/// Separation penalty of one pair: `1 + (d_min − closest) / d_min` when the pair ever comes
-/// closer than d_min, else 0.
-pub fn separation_penalty(min_distance: f64, d_min: f64) -> f64 {
-    if min_distance < d_min && d_min > 0.0 {
-        1.0 + (d_min - min_distance) / d_min
-    } else {
-        0.0
-    }
 }
 
 /// Each term of one vehicle, unweighted.
@@ -502,7 +478,7 @@ impl FleetModel {
         mut vehicles: Vec<VehicleTerms>,
         pairs: Vec<PairTerms>,
     ) -> FleetEvaluation {
-        let sep_penalty = coupling::add_pair_terms(&pairs, &mut vehicles);
+        let sep_penalty = add_pair_terms(&pairs, &mut vehicles);
         let objective: f64 = vehicles.iter().map(|t| self.objective_of(t)).sum();
         let penalty: f64 = vehicles.iter().map(|t| t.hard + t.motion).sum::<f64>() + sep_penalty;
         FleetEvaluation {
@@ -516,6 +492,23 @@ impl FleetModel {
             pairs,
         }
     }
+}
+
+/// Adds every pair's F(S) (to both vehicles) and half its separation penalty (to each) into
+/// `vehicles`, and returns the sum of the pairs' penalties. `pairs` in row order, as an
+/// all-pairs loop would visit them, so the sums are the same to the last bit.
+fn add_pair_terms(pairs: &[PairTerms], vehicles: &mut [VehicleTerms]) -> f64 {
+    let mut total = 0.0;
+    for p in pairs {
+        let (i, j) = (p.i as usize, p.j as usize);
+        // eq. (12) sums F_i(S) over vehicles: a breach counts for both of the pair.
+        vehicles[i].space += space_term(p.breach_s);
+        vehicles[j].space += space_term(p.breach_s);
+        vehicles[i].separation += 0.5 * p.penalty;
+        vehicles[j].separation += 0.5 * p.penalty;
+        total += p.penalty;
+    }
+    total
 }
 
 /// Sum of a polyline's leg lengths, leg by leg in order (as [`FleetModel::evaluate`] sums them).

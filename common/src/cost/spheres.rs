@@ -6,9 +6,17 @@
 
 use std::cell::RefCell;
 
-use super::Sphere;
 use crate::broad_phase::spheres::SphereGrid;
 use crate::geometry::{chord_inside_sphere, Vec3, CONTACT_GUARD_M};
+
+/// A sphere the cost functions test against: centre and radius already inflated.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Sphere {
+    /// Centre, metres.
+    pub centre: Vec3,
+    /// Radius including the inflation margin, metres.
+    pub radius: f64,
+}
 
 /// What the legs of a path do to the obstacles.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -20,6 +28,10 @@ pub(super) struct SphereTerms {
     /// Metres inside soft spheres.
     pub soft_inside: f64,
 }
+
+/// Up to this many spheres a path meets all of them: the grid's lookups cost about as much as
+/// the chunk boxes they spare (the paper's scenarios have 6–12).
+const FEW_SPHERES: usize = 12;
 
 /// Legs per bounding box in the cull.
 const CHUNK_LEGS: usize = 6;
@@ -56,6 +68,9 @@ impl SphereIndex {
     /// [`sphere_terms`] of `points` against `hard` and `soft` (the spheres this index was built
     /// from), testing only the spheres near the path.
     pub fn terms(&self, points: &[Vec3], hard: &[Sphere], soft: &[Sphere]) -> SphereTerms {
+        if hard.len() + soft.len() <= FEW_SPHERES {
+            return sphere_terms(points, hard, soft);
+        }
         SCRATCH.with(|cell| match cell.try_borrow_mut() {
             Ok(mut scratch) => {
                 let (boxes, marks) = &mut *scratch;
