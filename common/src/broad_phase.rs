@@ -1,7 +1,7 @@
-//! Broad phases for the fleet's spatial terms. Vehicle–obstacle: [`spheres`]. Vehicle–vehicle
-//! (this module): which pairs of timed trajectories can come
-//! within `d_min` of each other at all, so only those pay for the exact, continuous separation
-//! of [`crate::separation`] (the narrow phase).
+//! Broad phases for the fleet's spatial terms: vehicle–obstacle in [`spheres`]; vehicle–vehicle
+//! here, which pairs of timed trajectories can come within `d_min` of each other at all, so
+//! only those pay for the exact, continuous separation of [`crate::separation`] (the narrow
+//! phase).
 //!
 //! The mission's time `[0, horizon]` is cut into equal slabs; in each slab every vehicle gets
 //! the axis-aligned box of every position it takes there (its trajectory is piecewise linear,
