@@ -108,8 +108,7 @@ impl SlabBoxes {
     /// Whether vehicles `a` and `b` have boxes of some slab closer than `reach`: false proves
     /// they never come closer than `reach` at the same instant.
     pub fn near(&self, a: usize, b: usize, reach: f64) -> bool {
-        let r2 = guarded2(reach);
-        (0..SLABS).any(|k| self.box_gap2(a * SLABS + k, b * SLABS + k) < r2)
+        self.near_other(a, self, b, reach)
     }
 
     /// The time windows `(from, to)` of the slabs in which vehicles `a` and `b` have boxes

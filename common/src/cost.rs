@@ -19,6 +19,7 @@
 //! separation breaches, each as `count + depth of the breach relative to its limit`, so the
 //! swarm feels both how many and how bad.
 
+use crate::bspline::polyline_length;
 use crate::crawler::{CrawlerModel, CrawlerTerms};
 use crate::geometry::{pitch, Vec3, MIN_HEADING_EXTENT};
 use crate::scenario::{Scenario, Vehicle};
@@ -439,6 +440,9 @@ impl FleetModel {
     /// measured, unless its new length moves the common arrival (every vehicle is then
     /// retimed, and the whole fleet scored). The same result to the last bit.
     pub fn evaluate_change(&self, base: &FleetEvaluation, x: &[f64], i: usize) -> FleetEvaluation {
+        if base.trajectories.len() <= i {
+            return self.evaluate(x);
+        }
         let s = &self.scenario;
         let path = self.decode(i, &x[self.layout.chromosome(i)]);
         let legs = path.leg_lengths();
@@ -449,12 +453,12 @@ impl FleetModel {
                 let l = if k == i {
                     length
                 } else {
-                    polyline_sum(&t.points)
+                    polyline_length(&t.points)
                 };
                 l / s.vehicles[k].speed_max_mps
             }),
         );
-        if arrival.to_bits() != base.common_arrival.to_bits() || base.trajectories.len() <= i {
+        if arrival.to_bits() != base.common_arrival.to_bits() {
             return self.evaluate(x);
         }
         let mut vehicles = base.vehicles.clone();
@@ -509,11 +513,6 @@ fn add_pair_terms(pairs: &[PairTerms], vehicles: &mut [VehicleTerms]) -> f64 {
         total += p.penalty;
     }
     total
-}
-
-/// Sum of a polyline's leg lengths, leg by leg in order (as [`FleetModel::evaluate`] sums them).
-fn polyline_sum(points: &[Vec3]) -> f64 {
-    points.windows(2).map(|w| (w[1] - w[0]).norm()).sum()
 }
 
 mod coupling;

@@ -71,10 +71,10 @@ pub(super) fn pair_terms_changed(
     }
     let fresh = with_scratch(|boxes, _| {
         boxes_of(trajectories, boxes);
-        let near = (0..trajectories.len())
-            .filter(|&j| j != changed && boxes.near(changed, j, d_min))
+        let with_changed = (0..trajectories.len())
+            .filter(|&j| j != changed)
             .map(|j| (changed.min(j), changed.max(j)));
-        narrow(trajectories, d_min, boxes, near)
+        narrow(trajectories, d_min, boxes, with_changed)
     });
     let kept = base
         .iter()
@@ -107,7 +107,8 @@ fn boxes_of(trajectories: &[Trajectory], boxes: &mut SlabBoxes) {
     }
 }
 
-/// The exact separation (the narrow phase) of `pairs`, in the order given. A pair that stays
+/// The exact separation (the narrow phase) of `pairs`, in the order given. A pair whose boxes
+/// never come within d_min is skipped; one that stays
 /// at least d_min apart throughout the slabs where its boxes come near ([`closest_within`],
 /// over those windows only) has terms of exactly zero and is left out; the others get
 /// [`motion_separation`] over the whole mission, as an all-pairs loop would.
@@ -121,6 +122,10 @@ fn narrow(
     let mut windows = Vec::new();
     let mut out = Vec::new();
     for (i, j) in pairs {
+        boxes.near_windows(i, j, d_min, &mut windows);
+        if windows.is_empty() {
+            continue;
+        }
         for k in [i, j] {
             if motions[k].is_none() {
                 motions[k] = Some(Motion::new(&trajectories[k]));
@@ -129,7 +134,6 @@ fn narrow(
         let (Some(a), Some(b)) = (&motions[i], &motions[j]) else {
             continue;
         };
-        boxes.near_windows(i, j, d_min, &mut windows);
         let apart = d_min + CLEAR_GUARD_M;
         if windows
             .iter()

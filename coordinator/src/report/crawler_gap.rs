@@ -1,8 +1,8 @@
 //! How far each crawler's planned path is from the shortest admissible one: the yardstick of
 //! Lu et al. 2023's §5.1 (smoothed path length), here a grid search on the same seabed
-//! ([`GridSearch::crawler_reference`]: Dijkstra over 32 directions, every move kept off the
-//! hazards and under the slope limit, then string pulling). `compare` reports the same gap over
-//! many seeds; a plan reports it for itself.
+//! ([`GridSearch::crawler_reference`]: A* with Dijkstra's lengths over 32 directions, every
+//! move kept off the hazards and under the slope limit, then string pulling). `compare` reports
+//! the same gap over many seeds; a plan reports it for itself.
 
 use shoal_common::gridsearch::GridSearch;
 use shoal_common::plan::Plan;

@@ -5,9 +5,9 @@
 use std::fmt::Write;
 
 use shoal_common::gridsearch::GridSearch;
+use shoal_common::scenario::Scenario;
 
 use crate::report::crawler_gap::gap_percent;
-use shoal_common::scenario::Scenario;
 
 pub use crate::report::crawler_stats::{mean_std, CrawlerStats};
 

@@ -1,6 +1,7 @@
 //! What the commands write and print: `plan.json` and `plan.svg` ([`out`], [`svg`]), progress,
 //! plan and coverage summaries, the comparison tables ([`compare`], [`significance`],
-//! [`crawler_table`]), a crawler plan's gap to its reference path ([`crawler_gap`]) and the exports for maps and ground stations ([`geo_export`]).
+//! [`crawler_table`]), a crawler plan's gap to its reference path ([`crawler_gap`]) and the
+//! exports for maps and ground stations ([`geo_export`]).
 
 pub mod compare;
 pub mod crawler_gap;
