@@ -32,8 +32,33 @@ pub struct SlabBoxes {
     lo: Vec<Vec3>,
     /// Upper corners, in the same order.
     hi: Vec<Vec3>,
-    /// One slab's sweep order: (lower end along the sweep axis, vehicle), reused.
-    order: Vec<(f64, u32)>,
+    /// One slab's boxes in sweep order, reused: contiguous, so the sweep reads no strided
+    /// memory, and kept in the previous slab's order, which the next slab changes little.
+    sweep: Vec<SweepBox>,
+}
+
+/// A vehicle's box in the slab being swept.
+#[derive(Debug, Clone, Copy)]
+struct SweepBox {
+    /// Lower corner.
+    lo: [f64; 3],
+    /// Upper corner.
+    hi: [f64; 3],
+    /// The vehicle.
+    v: u32,
+}
+
+/// Squared distance between two swept boxes, without branches: most box pairs the sweep
+/// meets are neither clearly apart nor clearly overlapping, so branching on each axis
+/// mispredicts. (Boxes at infinity never get here; see [`SlabBoxes::close_pairs`].)
+#[inline]
+fn sweep_gap2(a: &SweepBox, b: &SweepBox) -> f64 {
+    let mut s = 0.0;
+    for d in 0..3 {
+        let g = (a.lo[d] - b.hi[d]).max(b.lo[d] - a.hi[d]).max(0.0);
+        s += g * g;
+    }
+    s
 }
 
 impl SlabBoxes {
@@ -111,27 +136,33 @@ impl SlabBoxes {
         self.near_other(a, self, b, reach)
     }
 
-    /// The time windows `(from, to)` of the slabs in which vehicles `a` and `b` have boxes
-    /// closer than `reach`, adjacent ones merged, into `out` (cleared first); the last slab's
-    /// window ends at infinity (both hold at their last points).
-    pub fn near_windows(&self, a: usize, b: usize, reach: f64, out: &mut Vec<(f64, f64)>) {
-        out.clear();
+    /// The slabs in which vehicles `a` and `b` have boxes closer than `reach`, as a mask (bit
+    /// `k` for slab `k`).
+    pub fn near_slabs(&self, a: usize, b: usize, reach: f64) -> SlabMask {
         let r2 = guarded2(reach);
+        (0..SLABS)
+            .filter(|&k| self.box_gap2(a * SLABS + k, b * SLABS + k) < r2)
+            .fold(0, |m, k| m | 1 << k)
+    }
+
+    /// The time windows `(from, to)` of the slabs in `mask`, adjacent ones merged, into `out`
+    /// (cleared first); the last slab's window ends at infinity (every vehicle holds at its
+    /// last point).
+    pub fn windows(&self, mask: SlabMask, out: &mut Vec<(f64, f64)>) {
+        out.clear();
         let slab = self.horizon / SLABS as f64;
-        for k in 0..SLABS {
-            if self.box_gap2(a * SLABS + k, b * SLABS + k) >= r2 {
-                continue;
-            }
-            let from = k as f64 * slab;
-            let to = if k + 1 == SLABS {
+        let mut rest = mask;
+        while rest != 0 {
+            let first = rest.trailing_zeros() as usize;
+            let run = (rest >> first).trailing_ones() as usize;
+            let end = first + run;
+            let to = if end >= SLABS {
                 f64::INFINITY
             } else {
-                (k + 1) as f64 * slab
+                end as f64 * slab
             };
-            match out.last_mut() {
-                Some(last) if last.1 == from => last.1 = to,
-                _ => out.push((from, to)),
-            }
+            out.push((first as f64 * slab, to));
+            rest &= if end >= SLABS { 0 } else { !0 << end };
         }
     }
 
@@ -146,48 +177,57 @@ impl SlabBoxes {
     }
 
     /// Every pair `(i, j)`, `i < j`, whose boxes of some slab are closer than `reach`, marked
-    /// in `pairs` (which is cleared and sized first).
+    /// in `pairs` (which is cleared and sized first) with the slabs where they are.
     pub fn close_pairs(&mut self, reach: f64, pairs: &mut PairSet) {
         let n = self.len();
         pairs.reset(n);
         let r2 = guarded2(reach);
         let reach = r2.sqrt();
-        let mut last_axis = usize::MAX;
+        let axis = self.widest_axis(SLABS / 2);
+        if self.sweep.len() != n {
+            self.sweep.clear();
+            self.sweep.extend((0..n as u32).map(|v| SweepBox {
+                lo: [f64::INFINITY; 3],
+                hi: [f64::INFINITY; 3],
+                v,
+            }));
+        }
         for k in 0..SLABS {
-            let axis = self.widest_axis(k);
-            // Sort by the boxes' lower ends along the axis. From one slab to the next the
+            for e in self.sweep.iter_mut() {
+                let i = e.v as usize * SLABS + k;
+                e.lo = self.lo[i].into();
+                e.hi = self.hi[i].into();
+            }
+            // Sorted by the boxes' lower ends along the axis. From one slab to the next the
             // vehicles keep nearly the same order, so an insertion sort of the previous
-            // slab's order does almost no moves.
-            if axis != last_axis {
-                self.order.clear();
-                self.order.extend((0..n as u32).map(|v| (0.0, v)));
+            // slab's order does almost no moves; the first slab starts from a full sort.
+            if k == 0 {
+                self.sweep
+                    .sort_unstable_by(|a, b| a.lo[axis].total_cmp(&b.lo[axis]));
+            } else {
+                insertion_sort(&mut self.sweep, axis);
             }
-            last_axis = axis;
-            for e in self.order.iter_mut() {
-                e.0 = self.lo[e.1 as usize * SLABS + k][axis];
-            }
-            insertion_sort(&mut self.order);
-            for (p, &(_, a)) in self.order.iter().enumerate() {
-                let ia = a as usize * SLABS + k;
-                let limit = self.hi[ia][axis] + reach;
-                for &(lo_b, b) in &self.order[p + 1..] {
-                    if lo_b >= limit {
+            for (p, a) in self.sweep.iter().enumerate() {
+                let limit = a.hi[axis] + reach;
+                for b in &self.sweep[p + 1..] {
+                    // A box of a vehicle without samples is at infinity: it ends every sweep
+                    // before it is tested.
+                    if b.lo[axis] >= limit {
                         break;
                     }
-                    let (a, b) = (a as usize, b as usize);
-                    if !pairs.contains(a, b) && self.box_gap2(ia, b * SLABS + k) < r2 {
-                        pairs.insert(a, b);
+                    if sweep_gap2(a, b) < r2 {
+                        pairs.mark(a.v as usize, b.v as usize, k);
                     }
                 }
             }
         }
     }
 
-    /// The axis along which slab `k`'s box centres spread most: the sweep's axis.
+    /// The axis along which slab `k`'s box centres spread most: the sweep's axis (any axis
+    /// gives the same pairs; the widest makes the fewest boxes overlap along it).
     fn widest_axis(&self, k: usize) -> usize {
-        let n = self.len();
         let (mut lo, mut hi) = (Vec3::repeat(f64::INFINITY), Vec3::repeat(f64::NEG_INFINITY));
-        for v in 0..n {
+        for v in 0..self.len() {
             let c = self.lo[v * SLABS + k] + self.hi[v * SLABS + k];
             if c.iter().all(|x| x.is_finite()) {
                 lo = lo.inf(&c);
@@ -219,13 +259,14 @@ fn guarded2(reach: f64) -> f64 {
     r * r
 }
 
-/// Sorts by the key, ascending (NaN-free keys; a vehicle without samples has an infinite one).
-/// Linear on an order that is already nearly sorted, which is what the slabs give.
-fn insertion_sort(items: &mut [(f64, u32)]) {
+/// Sorts by the lower end along `axis`, ascending. Linear on an order that is already nearly
+/// sorted, which is what the slabs give.
+fn insertion_sort(items: &mut [SweepBox], axis: usize) {
     for i in 1..items.len() {
         let item = items[i];
+        let key = item.lo[axis];
         let mut j = i;
-        while j > 0 && items[j - 1].0 > item.0 {
+        while j > 0 && items[j - 1].lo[axis] > key {
             items[j] = items[j - 1];
             j -= 1;
         }
@@ -267,15 +308,23 @@ fn position(times: &[f64], points: &[Vec3], seg: &mut usize, t: f64) -> Vec3 {
     points[i] + (points[i + 1] - points[i]) * ((t - times[i]) / dt)
 }
 
-/// A set of vehicle pairs `(i, j)`, `i < j`, as one bit per ordered pair: inserting is a bit
-/// set whatever the slab that found it, and iterating goes in row order `(0, 1), (0, 2), …`,
-/// the order the all-pairs loop sums in, so the fitness is the same to the last bit.
+/// The slabs a pair's boxes come near in: bit `k` for slab `k`.
+pub type SlabMask = u32;
+
+const _: () = assert!(SLABS <= SlabMask::BITS as usize);
+
+/// A set of vehicle pairs `(i, j)`, `i < j`, each with the slabs it was found in: one bit per
+/// ordered pair, so inserting is a bit set whatever the slab that found it, and iterating goes
+/// in row order `(0, 1), (0, 2), …`, the order the all-pairs loop sums in, so the fitness is the
+/// same to the last bit.
 #[derive(Debug, Clone, Default)]
 pub struct PairSet {
     /// Vehicles.
     n: usize,
     /// Bit `i * n + j`.
     words: Vec<u64>,
+    /// The pair's slabs at `i * n + j`.
+    slabs: Vec<SlabMask>,
 }
 
 impl PairSet {
@@ -284,31 +333,46 @@ impl PairSet {
         PairSet::default()
     }
 
-    /// Clears the set for `n` vehicles, keeping its buffer.
+    /// Clears the set for `n` vehicles, keeping its buffers.
     pub fn reset(&mut self, n: usize) {
         self.n = n;
         self.words.clear();
         self.words.resize((n * n).div_ceil(64), 0);
+        self.slabs.clear();
+        self.slabs.resize(n * n, 0);
+    }
+
+    /// The index of the pair of `a` and `b` (in either order), or `None` for `a == b` or a
+    /// vehicle out of range.
+    fn index(&self, a: usize, b: usize) -> Option<usize> {
+        let (i, j) = (a.min(b), a.max(b));
+        (i != j && j < self.n).then_some(i * self.n + j)
     }
 
     /// Marks the pair of `a` and `b` (in either order; `a == b` is ignored).
     pub fn insert(&mut self, a: usize, b: usize) {
-        let (i, j) = (a.min(b), a.max(b));
-        if i == j || j >= self.n {
-            return;
+        if let Some(bit) = self.index(a, b) {
+            self.words[bit / 64] |= 1 << (bit % 64);
         }
-        let bit = i * self.n + j;
-        self.words[bit / 64] |= 1 << (bit % 64);
+    }
+
+    /// Marks the pair of `a` and `b` as near in slab `k`.
+    pub fn mark(&mut self, a: usize, b: usize, k: usize) {
+        if let Some(bit) = self.index(a, b) {
+            self.words[bit / 64] |= 1 << (bit % 64);
+            self.slabs[bit] |= 1 << (k % SLABS);
+        }
     }
 
     /// Whether the pair of `a` and `b` is marked.
     pub fn contains(&self, a: usize, b: usize) -> bool {
-        let (i, j) = (a.min(b), a.max(b));
-        if i == j || j >= self.n {
-            return false;
-        }
-        let bit = i * self.n + j;
-        self.words[bit / 64] & (1 << (bit % 64)) != 0
+        self.index(a, b)
+            .is_some_and(|bit| self.words[bit / 64] & (1 << (bit % 64)) != 0)
+    }
+
+    /// The slabs the pair of `a` and `b` was marked in (none for a pair only inserted).
+    pub fn slabs(&self, a: usize, b: usize) -> SlabMask {
+        self.index(a, b).map_or(0, |bit| self.slabs[bit])
     }
 
     /// The marked pairs in row order.

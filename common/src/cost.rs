@@ -24,7 +24,7 @@ use crate::crawler::{CrawlerModel, CrawlerTerms};
 use crate::geometry::{pitch, Vec3, MIN_HEADING_EXTENT};
 use crate::scenario::{Scenario, Vehicle};
 use crate::terrain::Terrain;
-use crate::trajectory::{common_arrival, retime_legs, Layout, Path, Trajectory};
+use crate::trajectory::{common_arrival, leg_times, retime_legs, Layout, Path, Trajectory};
 use spheres::{sphere_terms, SphereIndex};
 
 pub use coupling::{separation_penalty, space_term, PairTerms};
@@ -228,7 +228,7 @@ pub struct VehicleTerms {
 }
 
 /// Everything the fitness computed for one fleet particle.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, Default)]
 pub struct FleetEvaluation {
     /// Timed trajectories (what the vehicles fly), in vehicle order.
     pub trajectories: Vec<Trajectory>,
@@ -313,37 +313,47 @@ impl FleetModel {
     /// on the seabed (Lu et al. 2023, eq. (12)–(13)), each sample leg taking the speed gene of the
     /// control leg it belongs to.
     pub fn decode(&self, i: usize, genes: &[f64]) -> Path {
+        let mut path = Path {
+            points: Vec::new(),
+            speeds: Vec::new(),
+        };
+        self.decode_into(i, genes, &mut path.points, &mut path.speeds);
+        path
+    }
+
+    /// [`FleetModel::decode`] appending the points to `points` and the legs' speeds to
+    /// `speeds`, buffers the caller reuses. A swimmer's decoding allocates nothing; a crawler's
+    /// drapes a fresh spline on the seabed.
+    fn decode_into(&self, i: usize, genes: &[f64], points: &mut Vec<Vec3>, speeds: &mut Vec<f64>) {
         let v = &self.scenario.vehicles[i];
         let Some((crawler, _)) = &self.crawlers[i] else {
-            return Path::decode(v, genes);
+            return Path::decode_into(v, genes, points, speeds);
         };
         let m = genes.len() / crate::trajectory::GENES_PER_WAYPOINT;
         let (coords, status) = genes.split_at(3 * m);
-        let points = crawler.path_through(coords.chunks_exact(3).map(|g| [g[0], g[1]]));
-        let legs = points.len().saturating_sub(1);
-        let speeds = (0..legs)
-            .map(|k| {
-                let control_leg = k * (m + 1) / legs.max(1);
-                status
-                    .get(control_leg.min(m.saturating_sub(1)))
-                    .copied()
-                    .unwrap_or(v.speed_max_mps)
-            })
-            .collect();
-        Path { points, speeds }
+        let draped = crawler.path_through(coords.chunks_exact(3).map(|g| [g[0], g[1]]));
+        let legs = draped.len().saturating_sub(1);
+        speeds.extend((0..legs).map(|k| {
+            let control_leg = k * (m + 1) / legs.max(1);
+            status
+                .get(control_leg.min(m.saturating_sub(1)))
+                .copied()
+                .unwrap_or(v.speed_max_mps)
+        }));
+        points.extend(draped);
     }
 
     /// Vehicle-local terms of vehicle `i` (everything but F(S) and the separation penalty).
-    pub fn vehicle_terms(&self, i: usize, path: &Path, length: f64) -> VehicleTerms {
+    pub fn vehicle_terms(&self, i: usize, points: &[Vec3], length: f64) -> VehicleTerms {
         let s = &self.scenario;
         let v = &s.vehicles[i];
         if let Some((crawler, reference)) = &self.crawlers[i] {
-            let t = crawler.terms(&path.points);
+            let t = crawler.terms(points);
             return VehicleTerms {
                 length: length_term(length, self.straight[i]),
                 time: time_term(length, v, s.fleet.mission_time_s),
                 hard: t.hazard_penalty,
-                motion: turn_penalty(&path.points, v.max_turn_deg.to_radians()) + t.slope_penalty,
+                motion: turn_penalty(points, v.max_turn_deg.to_radians()) + t.slope_penalty,
                 hard_hits: t.hazard_intrusions,
                 crawler: Some(crawler.objective_of(&t, reference)),
                 ..VehicleTerms::default()
@@ -351,20 +361,20 @@ impl FleetModel {
         }
         let surface = s.bounds.max[2];
         let column = s.bounds.max[2] - s.bounds.min[2];
-        let spheres = self.spheres.terms(&path.points, &self.hard, &self.soft);
+        let spheres = self.spheres.terms(points, &self.hard, &self.soft);
         let seabed = s
             .swimmer_seabed()
-            .map_or(0.0, |(t, c)| seabed_penalty(&path.points, t, c).0);
+            .map_or(0.0, |(t, c)| seabed_penalty(points, t, c).0);
         VehicleTerms {
             length: length_term(length, self.straight[i]),
-            depth: depth_term(&path.points, surface, column),
+            depth: depth_term(points, surface, column),
             soft: spheres.soft_inside / self.straight[i].max(1e-9),
             time: time_term(length, v, s.fleet.mission_time_s),
             space: 0.0,
             separation: 0.0,
             hard: spheres.hard_penalty + seabed,
-            motion: turn_penalty(&path.points, v.max_turn_deg.to_radians())
-                + pitch_penalty(&path.points, v.max_pitch_deg.to_radians()),
+            motion: turn_penalty(points, v.max_turn_deg.to_radians())
+                + pitch_penalty(points, v.max_pitch_deg.to_radians()),
             hard_hits: spheres.hard_hits,
             crawler: None,
         }
@@ -390,25 +400,45 @@ impl FleetModel {
 
     /// Decodes and scores a fleet particle.
     pub fn evaluate(&self, x: &[f64]) -> FleetEvaluation {
+        let mut out = FleetEvaluation::default();
+        self.evaluate_into(x, &mut out);
+        out
+    }
+
+    /// [`FleetModel::evaluate`] into `out`, reusing its buffers (and this thread's): once they
+    /// have grown, scoring a fleet of swimmers allocates nothing, which is how the swarm calls
+    /// it hundreds of thousands of times.
+    pub fn evaluate_into(&self, x: &[f64], out: &mut FleetEvaluation) {
+        SCRATCH.with(|cell| match cell.try_borrow_mut() {
+            Ok(mut scratch) => self.evaluate_with(x, out, &mut scratch),
+            Err(_) => self.evaluate_with(x, out, &mut Scratch::default()),
+        })
+    }
+
+    fn evaluate_with(&self, x: &[f64], out: &mut FleetEvaluation, scratch: &mut Scratch) {
         let s = &self.scenario;
-        let paths: Vec<Path> = s
-            .vehicles
-            .iter()
-            .enumerate()
-            .map(|(i, _)| self.decode(i, &x[self.layout.chromosome(i)]))
-            .collect();
-        // Every vehicle's leg lengths in one buffer (one allocation per evaluation, not one
-        // per vehicle), vehicle i's at `spans[i]`.
-        let mut legs = Vec::with_capacity(paths.iter().map(|p| p.points.len()).sum());
-        let spans: Vec<std::ops::Range<usize>> = paths
-            .iter()
-            .map(|p| {
-                let start = legs.len();
-                legs.extend(p.points.windows(2).map(|w| (w[1] - w[0]).norm()));
-                start..legs.len()
-            })
-            .collect();
-        let lengths: Vec<f64> = spans.iter().map(|r| legs[r.clone()].iter().sum()).collect();
+        let n = s.vehicles.len();
+        out.trajectories.truncate(n);
+        out.trajectories.resize_with(n, Trajectory::default);
+        // Every vehicle's leg lengths and speeds in one buffer each, vehicle i's at `spans[i]`.
+        let Scratch {
+            legs,
+            speeds,
+            spans,
+            lengths,
+        } = scratch;
+        legs.clear();
+        speeds.clear();
+        spans.clear();
+        lengths.clear();
+        for (i, t) in out.trajectories.iter_mut().enumerate() {
+            t.points.clear();
+            self.decode_into(i, &x[self.layout.chromosome(i)], &mut t.points, speeds);
+            let start = legs.len();
+            legs.extend(t.points.windows(2).map(|w| (w[1] - w[0]).norm()));
+            spans.push(start..legs.len());
+            lengths.push(legs[start..].iter().sum());
+        }
         let arrival = common_arrival(
             s.fleet.mission_time_s,
             lengths
@@ -416,23 +446,24 @@ impl FleetModel {
                 .zip(&s.vehicles)
                 .map(|(l, v)| l / v.speed_max_mps),
         );
-        let vehicles: Vec<VehicleTerms> = paths
-            .iter()
-            .enumerate()
-            .map(|(i, p)| {
-                let mut t = self.vehicle_terms(i, p, lengths[i]);
-                t.motion += early_arrival_penalty(lengths[i], &s.vehicles[i], arrival);
-                t
-            })
-            .collect();
-        let trajectories: Vec<Trajectory> = paths
-            .into_iter()
-            .zip(&spans)
-            .zip(&s.vehicles)
-            .map(|((p, r), v)| retime_legs(p, &legs[r.clone()], v, arrival))
-            .collect();
-        let pairs = coupling::pair_terms(&trajectories, s.fleet.d_min_m);
-        self.summed(trajectories, arrival, vehicles, pairs)
+        out.vehicles.clear();
+        for (i, t) in out.trajectories.iter_mut().enumerate() {
+            let v = &s.vehicles[i];
+            let mut terms = self.vehicle_terms(i, &t.points, lengths[i]);
+            terms.motion += early_arrival_penalty(lengths[i], v, arrival);
+            out.vehicles.push(terms);
+            let span = spans[i].clone();
+            leg_times(
+                &legs[span.clone()],
+                &mut speeds[span],
+                v,
+                arrival,
+                &mut t.times,
+            );
+        }
+        out.common_arrival = arrival;
+        coupling::pair_terms_into(&out.trajectories, s.fleet.d_min_m, &mut out.pairs);
+        self.sum_into(out);
     }
 
     /// [`FleetModel::evaluate`] of `x`, which differs from the position `base` scored only in
@@ -461,41 +492,54 @@ impl FleetModel {
         if arrival.to_bits() != base.common_arrival.to_bits() {
             return self.evaluate(x);
         }
-        let mut vehicles = base.vehicles.clone();
-        for t in vehicles.iter_mut() {
+        let mut out = FleetEvaluation {
+            trajectories: base.trajectories.clone(),
+            common_arrival: arrival,
+            vehicles: base.vehicles.clone(),
+            ..FleetEvaluation::default()
+        };
+        out.vehicles[i] = self.vehicle_terms(i, &path.points, length);
+        out.vehicles[i].motion += early_arrival_penalty(length, &s.vehicles[i], arrival);
+        out.trajectories[i] = retime_legs(path, &legs, &s.vehicles[i], arrival);
+        let d_min = s.fleet.d_min_m;
+        coupling::pair_terms_changed(&out.trajectories, d_min, i, &base.pairs, &mut out.pairs);
+        self.sum_into(&mut out);
+        out
+    }
+
+    /// Completes an evaluation whose trajectories, arrival, vehicle-local terms and pair terms
+    /// are in place: the pair terms added to the vehicles', then the sums.
+    fn sum_into(&self, out: &mut FleetEvaluation) {
+        for t in out.vehicles.iter_mut() {
             t.space = 0.0;
             t.separation = 0.0;
         }
-        vehicles[i] = self.vehicle_terms(i, &path, length);
-        vehicles[i].motion += early_arrival_penalty(length, &s.vehicles[i], arrival);
-        let mut trajectories = base.trajectories.clone();
-        trajectories[i] = retime_legs(path, &legs, &s.vehicles[i], arrival);
-        let pairs = coupling::pair_terms_changed(&trajectories, s.fleet.d_min_m, i, &base.pairs);
-        self.summed(trajectories, arrival, vehicles, pairs)
+        let sep_penalty = add_pair_terms(&out.pairs, &mut out.vehicles);
+        let objective: f64 = out.vehicles.iter().map(|t| self.objective_of(t)).sum();
+        let penalty: f64 =
+            out.vehicles.iter().map(|t| t.hard + t.motion).sum::<f64>() + sep_penalty;
+        out.separation_penalty = sep_penalty;
+        out.objective = objective;
+        out.penalty = penalty;
+        out.total = objective + self.scenario.optimizer.penalty_weight * penalty;
     }
+}
 
-    /// The evaluation from its parts: the pair terms added to the vehicles', then the sums.
-    fn summed(
-        &self,
-        trajectories: Vec<Trajectory>,
-        arrival: f64,
-        mut vehicles: Vec<VehicleTerms>,
-        pairs: Vec<PairTerms>,
-    ) -> FleetEvaluation {
-        let sep_penalty = add_pair_terms(&pairs, &mut vehicles);
-        let objective: f64 = vehicles.iter().map(|t| self.objective_of(t)).sum();
-        let penalty: f64 = vehicles.iter().map(|t| t.hard + t.motion).sum::<f64>() + sep_penalty;
-        FleetEvaluation {
-            trajectories,
-            common_arrival: arrival,
-            vehicles,
-            separation_penalty: sep_penalty,
-            objective,
-            penalty,
-            total: objective + self.scenario.optimizer.penalty_weight * penalty,
-            pairs,
-        }
-    }
+/// The buffers of [`FleetModel::evaluate_into`] besides the evaluation's own.
+#[derive(Debug, Default)]
+struct Scratch {
+    /// Every vehicle's leg lengths, vehicle after vehicle.
+    legs: Vec<f64>,
+    /// Every vehicle's leg speeds (then paces), in the same places.
+    speeds: Vec<f64>,
+    /// Where vehicle `i`'s legs are.
+    spans: Vec<std::ops::Range<usize>>,
+    /// Every vehicle's path length, metres.
+    lengths: Vec<f64>,
+}
+
+thread_local! {
+    static SCRATCH: std::cell::RefCell<Scratch> = std::cell::RefCell::new(Scratch::default());
 }
 
 /// Adds every pair's F(S) (to both vehicles) and half its separation penalty (to each) into

@@ -4,10 +4,16 @@
 use rand::rngs::StdRng;
 use rand::Rng;
 
-use crate::cost::FleetModel;
+use crate::cost::{FleetEvaluation, FleetModel};
 use crate::geometry::Vec3;
 use crate::swarm::Problem;
 use crate::trajectory::{required_horizontal_length, GENES_PER_WAYPOINT};
+
+thread_local! {
+    /// The evaluation the swarm's calls on this thread score into.
+    static EVALUATION: std::cell::RefCell<FleetEvaluation> =
+        std::cell::RefCell::new(FleetEvaluation::default());
+}
 
 impl Problem for FleetModel {
     fn lower(&self) -> &[f64] {
@@ -19,7 +25,7 @@ impl Problem for FleetModel {
     }
 
     fn cost(&self, x: &[f64]) -> f64 {
-        self.evaluate(x).total
+        self.cost_parts(x, &mut [])
     }
 
     /// One block per vehicle: eq. (12) is a sum over vehicles.
@@ -36,12 +42,19 @@ impl Problem for FleetModel {
         self.layout.move_groups()
     }
 
+    /// Scored into this thread's reused evaluation: the swarm's calls allocate nothing.
     fn cost_parts(&self, x: &[f64], parts: &mut [f64]) -> f64 {
-        let e = self.evaluate(x);
-        for (p, t) in parts.iter_mut().zip(&e.vehicles) {
-            *p = self.share_of(t);
-        }
-        e.total
+        let mut score = |e: &mut FleetEvaluation| {
+            self.evaluate_into(x, e);
+            for (p, t) in parts.iter_mut().zip(&e.vehicles) {
+                *p = self.share_of(t);
+            }
+            e.total
+        };
+        EVALUATION.with(|cell| match cell.try_borrow_mut() {
+            Ok(mut e) => score(&mut e),
+            Err(_) => score(&mut FleetEvaluation::default()),
+        })
     }
 
     /// Initial particles (Zhi & Zuo 2024, §3.1: uniform draws "adjusting the range"). Each vehicle's

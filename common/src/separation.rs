@@ -61,24 +61,26 @@ impl<'a> Motion<'a> {
 
     /// Each leg's velocity and the fastest leg's speed, m/s.
     pub fn velocities_of(t: &Trajectory) -> (Vec<Vec3>, f64) {
-        let velocities: Vec<Vec3> = t
-            .times
-            .windows(2)
-            .zip(t.points.windows(2))
-            .map(|(tt, pp)| {
-                let dt = tt[1] - tt[0];
-                if dt > 0.0 {
-                    (pp[1] - pp[0]) / dt
-                } else {
-                    Vec3::zeros()
-                }
-            })
-            .collect();
-        let max_speed = velocities
-            .iter()
-            .map(|v: &Vec3| v.norm())
-            .fold(0.0, f64::max);
+        let mut velocities = Vec::with_capacity(t.times.len().saturating_sub(1));
+        let max_speed = Motion::velocities_into(t, &mut velocities);
         (velocities, max_speed)
+    }
+
+    /// [`Motion::velocities_of`] appending the velocities to a buffer the caller reuses;
+    /// returns the fastest leg's speed.
+    pub fn velocities_into(t: &Trajectory, out: &mut Vec<Vec3>) -> f64 {
+        let mut max_speed = 0.0f64;
+        for (tt, pp) in t.times.windows(2).zip(t.points.windows(2)) {
+            let dt = tt[1] - tt[0];
+            let v = if dt > 0.0 {
+                (pp[1] - pp[0]) / dt
+            } else {
+                Vec3::zeros()
+            };
+            max_speed = max_speed.max(v.norm());
+            out.push(v);
+        }
+        max_speed
     }
 
     /// Position at `time` on leg `k` (or held at the end when `k` is past the last leg).

@@ -97,15 +97,27 @@ impl Path {
     /// Decodes one chromosome (`genes.len() == 4 M`: coordinates, then speeds) for `vehicle`.
     pub fn decode(vehicle: &Vehicle, genes: &[f64]) -> Path {
         let m = genes.len() / GENES_PER_WAYPOINT;
-        let (coords, status) = genes.split_at(3 * m);
         let mut points = Vec::with_capacity(m + 2);
         let mut speeds = Vec::with_capacity(m + 1);
+        Path::decode_into(vehicle, genes, &mut points, &mut speeds);
+        Path { points, speeds }
+    }
+
+    /// [`Path::decode`] appending to buffers the caller reuses: the points to `points`, the
+    /// legs' speeds to `speeds`.
+    pub fn decode_into(
+        vehicle: &Vehicle,
+        genes: &[f64],
+        points: &mut Vec<Vec3>,
+        speeds: &mut Vec<f64>,
+    ) {
+        let m = genes.len() / GENES_PER_WAYPOINT;
+        let (coords, status) = genes.split_at(3 * m);
         points.push(vehicle.start());
         points.extend(coords.chunks_exact(3).map(|g| Vec3::new(g[0], g[1], g[2])));
-        speeds.extend_from_slice(status);
         points.push(vehicle.goal());
-        speeds.push(speeds.last().copied().unwrap_or(vehicle.speed_max_mps));
-        Path { points, speeds }
+        speeds.extend_from_slice(status);
+        speeds.push(status.last().copied().unwrap_or(vehicle.speed_max_mps));
     }
 
     /// Length of every leg, metres.
@@ -125,7 +137,7 @@ impl Path {
 
 /// A timed trajectory: the vehicle moves in a straight line at constant speed between consecutive
 /// samples, and holds at its last sample afterwards.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Default)]
 pub struct Trajectory {
     /// Sample times, seconds, non-decreasing, starting at 0.
     pub times: Vec<f64>,
@@ -287,15 +299,30 @@ pub fn retime(path: &Path, vehicle: &Vehicle, target: f64) -> Trajectory {
 
 /// [`retime`] with the leg lengths already known, taking the path's points over.
 pub fn retime_legs(path: Path, lengths: &[f64], vehicle: &Vehicle, target: f64) -> Trajectory {
+    let Path { points, mut speeds } = path;
+    let mut times = Vec::with_capacity(points.len());
+    leg_times(lengths, &mut speeds, vehicle, target, &mut times);
+    Trajectory { times, points }
+}
+
+/// The sample times of [`retime`] for legs of `lengths` at the requested `speeds` (one per leg,
+/// overwritten with the legs' requested paces), into `times` (cleared first; one more than
+/// legs): what the fitness calls on buffers it reuses, so timing a path allocates nothing.
+pub fn leg_times(
+    lengths: &[f64],
+    speeds: &mut [f64],
+    vehicle: &Vehicle,
+    target: f64,
+    times: &mut Vec<f64>,
+) {
     let (p_lo, p_hi) = (1.0 / vehicle.speed_max_mps, 1.0 / vehicle.speed_min_mps);
     let total: f64 = lengths.iter().sum();
     // Each leg's requested pace (s/m), computed once: the search below revisits every leg
-    // several times. The speeds' own storage is reused, so this allocates nothing.
-    let Path { points, speeds } = path;
-    let mut paces = speeds;
-    for v in paces.iter_mut() {
+    // several times.
+    for v in speeds.iter_mut() {
         *v = 1.0 / v.clamp(vehicle.speed_min_mps, vehicle.speed_max_mps);
     }
+    let paces = &*speeds;
     let alpha = if total * p_lo >= target {
         None
     } else if total * p_hi <= target {
@@ -304,7 +331,7 @@ pub fn retime_legs(path: Path, lengths: &[f64], vehicle: &Vehicle, target: f64) 
         // T(α) and its slope on the current piece (the free legs' Σ l p).
         let eval = |a: f64| -> (f64, f64) {
             let (mut t, mut slope) = (0.0, 0.0);
-            for (l, &p) in lengths.iter().zip(&paces) {
+            for (l, &p) in lengths.iter().zip(paces) {
                 let q = a * p;
                 if q <= p_lo {
                     t += l * p_lo;
@@ -322,7 +349,7 @@ pub fn retime_legs(path: Path, lengths: &[f64], vehicle: &Vehicle, target: f64) 
             .fold((f64::MIN, f64::MAX), |(hi, lo), p| (hi.max(*p), lo.min(*p)));
         let (mut lo, mut hi) = (p_lo / max_p, p_hi / min_p);
         // Start from the unclamped solution.
-        let free: f64 = lengths.iter().zip(&paces).map(|(l, p)| l * p).sum();
+        let free: f64 = lengths.iter().zip(paces).map(|(l, p)| l * p).sum();
         let mut a = (target / free).clamp(lo, hi);
         for _ in 0..100 {
             let (t, slope) = eval(a);
@@ -351,10 +378,10 @@ pub fn retime_legs(path: Path, lengths: &[f64], vehicle: &Vehicle, target: f64) 
         }
         Some(a)
     };
-    let mut times = Vec::with_capacity(points.len());
     let mut t = 0.0;
+    times.clear();
     times.push(0.0);
-    for (l, p) in lengths.iter().zip(&paces) {
+    for (l, p) in lengths.iter().zip(paces) {
         let pace = match alpha {
             None => p_lo,
             Some(a) if a.is_infinite() => p_hi,
@@ -363,7 +390,6 @@ pub fn retime_legs(path: Path, lengths: &[f64], vehicle: &Vehicle, target: f64) 
         t += l * pace;
         times.push(t);
     }
-    Trajectory { times, points }
 }
 
 #[cfg(test)]

@@ -93,6 +93,33 @@ fn pair_sets_iterate_in_row_order() {
     assert_eq!(p.iter().count(), 0);
 }
 
+#[test]
+fn slab_masks_become_merged_windows_by_hand() {
+    // 32 slabs of 10 s: slabs 0–1, 5 and 30–31 give [0, 20), [50, 60) and [300, ∞).
+    let b = boxes_of(320.0, &[line(0.0, [0., 0., 0.], 320.0, [1., 0., 0.])]);
+    let mut w = Vec::new();
+    b.windows(0b11 | 1 << 5 | 0b11 << 30, &mut w);
+    assert_eq!(w, vec![(0.0, 20.0), (50.0, 60.0), (300.0, f64::INFINITY)]);
+    b.windows(1 << 31, &mut w);
+    assert_eq!(w, vec![(310.0, f64::INFINITY)]);
+    b.windows(!0, &mut w);
+    assert_eq!(w, vec![(0.0, f64::INFINITY)]);
+    b.windows(0, &mut w);
+    assert!(w.is_empty());
+}
+
+#[test]
+fn marked_pairs_keep_their_slabs() {
+    let mut p = PairSet::new();
+    p.reset(4);
+    p.mark(2, 1, 3);
+    p.mark(1, 2, 31);
+    p.insert(0, 3);
+    assert_eq!(p.slabs(1, 2), 1 << 3 | 1 << 31);
+    assert_eq!(p.slabs(0, 3), 0);
+    assert_eq!(p.iter().collect::<Vec<_>>(), vec![(0, 3), (1, 2)]);
+}
+
 /// A random trajectory in a 400 m cube: 1–6 samples at non-decreasing times from 0, some of
 /// them repeated (a leg of zero length and zero duration, as a retimed path has where two
 /// waypoints coincide).
@@ -149,6 +176,7 @@ proptest! {
             for j in i + 1..fleet.len() {
                 let exact = pair_separation(&fleet[i], &fleet[j], d_min);
                 prop_assert_eq!(pairs.contains(i, j), b.near(i, j, d_min));
+                prop_assert_eq!(pairs.slabs(i, j), b.near_slabs(i, j, d_min));
                 if !pairs.contains(i, j) {
                     prop_assert!(exact.min_distance >= d_min, "{} {} {}", i, j, exact.min_distance);
                     prop_assert_eq!(exact.breach_s, 0.0);

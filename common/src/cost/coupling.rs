@@ -5,14 +5,70 @@
 
 use std::cell::RefCell;
 
-use crate::broad_phase::{PairSet, SlabBoxes};
+use crate::broad_phase::{PairSet, SlabBoxes, SlabMask};
+use crate::geometry::Vec3;
 use crate::separation::{closest_within, motion_separation, Motion};
 use crate::trajectory::Trajectory;
 
+/// The buffers of the pair terms, reused by every evaluation on a thread (the swarm evaluates
+/// on a few worker threads, hundreds of thousands of times), so measuring the pairs allocates
+/// nothing once they have grown.
+#[derive(Debug, Default)]
+struct Scratch {
+    /// The broad phase's boxes.
+    boxes: SlabBoxes,
+    /// The pairs the boxes keep.
+    pairs: PairSet,
+    /// The vehicles' leg velocities.
+    velocities: Velocities,
+    /// One pair's near windows.
+    windows: Vec<(f64, f64)>,
+}
+
 thread_local! {
-    /// The broad phase's boxes and pair set, reused by every evaluation on this thread (the
-    /// swarm evaluates on a few worker threads, hundreds of thousands of times).
-    static SCRATCH: RefCell<(SlabBoxes, PairSet)> = RefCell::new((SlabBoxes::new(), PairSet::new()));
+    static SCRATCH: RefCell<Scratch> = RefCell::new(Scratch::default());
+}
+
+/// Every vehicle's leg velocities and top speed ([`Motion::velocities_into`]), computed the
+/// first time one of its pairs needs them, in one buffer.
+#[derive(Debug, Default)]
+struct Velocities {
+    /// The velocities, vehicle after vehicle in the order they were needed.
+    all: Vec<Vec3>,
+    /// Per vehicle: where its velocities are in `all`, and its top speed.
+    of: Vec<Option<(usize, usize, f64)>>,
+}
+
+impl Velocities {
+    /// Forgets every vehicle; `n` vehicles follow.
+    fn reset(&mut self, n: usize) {
+        self.all.clear();
+        self.of.clear();
+        self.of.resize(n, None);
+    }
+
+    /// The prepared motions of vehicles `i` and `j` of `trajectories`.
+    fn pair<'a>(
+        &'a mut self,
+        trajectories: &'a [Trajectory],
+        i: usize,
+        j: usize,
+    ) -> (Motion<'a>, Motion<'a>) {
+        for k in [i, j] {
+            if self.of[k].is_none() {
+                let start = self.all.len();
+                let top = Motion::velocities_into(&trajectories[k], &mut self.all);
+                self.of[k] = Some((start, self.all.len(), top));
+            }
+        }
+        let this = &*self;
+        let motion = |k: usize| {
+            // Both were prepared just above.
+            let (from, to, top) = this.of[k].unwrap_or((0, 0, 0.0));
+            Motion::prepared(&trajectories[k], &this.all[from..to], top)
+        };
+        (motion(i), motion(j))
+    }
 }
 
 /// F_i(S) of eq. (11) on timed trajectories: eq. (11) is 1 at every instant a pair is closer than
@@ -44,19 +100,34 @@ pub struct PairTerms {
     pub penalty: f64,
 }
 
-/// The terms of every pair the broad phase cannot rule out, in row order.
-pub(super) fn pair_terms(trajectories: &[Trajectory], d_min: f64) -> Vec<PairTerms> {
-    if trajectories.len() <= SMALL_FLEET {
-        return all_pair_terms(trajectories, d_min);
-    }
-    with_scratch(|boxes, pairs| {
+/// The terms of every pair the broad phase cannot rule out, in row order, into `out` (cleared
+/// first).
+pub(super) fn pair_terms_into(trajectories: &[Trajectory], d_min: f64, out: &mut Vec<PairTerms>) {
+    out.clear();
+    with_scratch(|scratch| {
+        let Scratch {
+            boxes,
+            pairs,
+            velocities,
+            windows,
+        } = scratch;
+        velocities.reset(trajectories.len());
+        if trajectories.len() <= SMALL_FLEET {
+            return all_pair_terms_into(trajectories, d_min, velocities, out);
+        }
         boxes_of(trajectories, boxes);
         boxes.close_pairs(d_min, pairs);
-        narrow(trajectories, d_min, boxes, pairs.iter())
-    })
+        let kept = pairs.iter().map(|(i, j)| (i, j, pairs.slabs(i, j)));
+        let fleet = Fleet {
+            trajectories,
+            d_min,
+            boxes,
+        };
+        fleet.narrow(kept, velocities, windows, out);
+    });
 }
 
-/// [`pair_terms`] after only vehicle `changed` moved: the pairs without it are `base`'s
+/// [`pair_terms_into`] after only vehicle `changed` moved: the pairs without it are `base`'s
 /// (the terms of an evaluation of the same fleet with `changed` elsewhere); only the pairs with
 /// it are found and measured again. Pairs the broad phase keeps but that never come within
 /// d_min have terms of exactly zero, so which of them are listed changes no sum.
@@ -65,33 +136,44 @@ pub(super) fn pair_terms_changed(
     d_min: f64,
     changed: usize,
     base: &[PairTerms],
-) -> Vec<PairTerms> {
-    if trajectories.len() <= SMALL_FLEET {
-        return all_pair_terms(trajectories, d_min);
-    }
-    let fresh = with_scratch(|boxes, _| {
+    out: &mut Vec<PairTerms>,
+) {
+    out.clear();
+    with_scratch(|scratch| {
+        let Scratch {
+            boxes,
+            velocities,
+            windows,
+            ..
+        } = scratch;
+        velocities.reset(trajectories.len());
+        if trajectories.len() <= SMALL_FLEET {
+            return all_pair_terms_into(trajectories, d_min, velocities, out);
+        }
         boxes_of(trajectories, boxes);
-        let with_changed = (0..trajectories.len())
-            .filter(|&j| j != changed)
-            .map(|j| (changed.min(j), changed.max(j)));
-        narrow(trajectories, d_min, boxes, with_changed)
+        out.extend(
+            base.iter()
+                .filter(|p| p.i as usize != changed && p.j as usize != changed),
+        );
+        let fleet = Fleet {
+            trajectories,
+            d_min,
+            boxes,
+        };
+        let with_changed = (0..trajectories.len()).filter(|&j| j != changed).map(|j| {
+            let (a, b) = (changed.min(j), changed.max(j));
+            (a, b, boxes.near_slabs(a, b, d_min))
+        });
+        fleet.narrow(with_changed, velocities, windows, out);
+        out.sort_unstable_by_key(|p| (p.i, p.j));
     });
-    let kept = base
-        .iter()
-        .filter(|p| p.i as usize != changed && p.j as usize != changed);
-    let mut out: Vec<PairTerms> = kept.copied().chain(fresh).collect();
-    out.sort_unstable_by_key(|p| (p.i, p.j));
-    out
 }
 
-/// Runs `f` on this thread's broad-phase buffers (fresh ones if they are in use).
-fn with_scratch<T>(f: impl FnOnce(&mut SlabBoxes, &mut PairSet) -> T) -> T {
+/// Runs `f` on this thread's buffers (fresh ones if they are in use).
+fn with_scratch<T>(f: impl FnOnce(&mut Scratch) -> T) -> T {
     SCRATCH.with(|cell| match cell.try_borrow_mut() {
-        Ok(mut scratch) => {
-            let (boxes, pairs) = &mut *scratch;
-            f(boxes, pairs)
-        }
-        Err(_) => f(&mut SlabBoxes::new(), &mut PairSet::new()),
+        Ok(mut scratch) => f(&mut scratch),
+        Err(_) => f(&mut Scratch::default()),
     })
 }
 
@@ -107,43 +189,43 @@ fn boxes_of(trajectories: &[Trajectory], boxes: &mut SlabBoxes) {
     }
 }
 
-/// The exact separation (the narrow phase) of `pairs`, in the order given. A pair whose boxes
-/// never come within d_min is skipped; one that stays
-/// at least d_min apart throughout the slabs where its boxes come near ([`closest_within`],
-/// over those windows only) has terms of exactly zero and is left out; the others get
-/// [`motion_separation`] over the whole mission, as an all-pairs loop would.
-fn narrow(
-    trajectories: &[Trajectory],
+/// A fleet's trajectories with their slab boxes: what the narrow phase measures.
+struct Fleet<'a> {
+    trajectories: &'a [Trajectory],
     d_min: f64,
-    boxes: &SlabBoxes,
-    pairs: impl Iterator<Item = (usize, usize)>,
-) -> Vec<PairTerms> {
-    let mut motions: Vec<Option<Motion>> = vec![None; trajectories.len()];
-    let mut windows = Vec::new();
-    let mut out = Vec::new();
-    for (i, j) in pairs {
-        boxes.near_windows(i, j, d_min, &mut windows);
-        if windows.is_empty() {
-            continue;
-        }
-        for k in [i, j] {
-            if motions[k].is_none() {
-                motions[k] = Some(Motion::new(&trajectories[k]));
+    boxes: &'a SlabBoxes,
+}
+
+impl Fleet<'_> {
+    /// The exact separation (the narrow phase) of `pairs` (each with the slabs where its boxes
+    /// come within d_min), in the order given, appended to `out`. A pair with no such slab is
+    /// skipped; one that stays at least d_min apart throughout those slabs
+    /// ([`closest_within`], over their windows only) has terms of exactly zero and is left
+    /// out; the others get [`motion_separation`] over the whole mission, as an all-pairs loop
+    /// would.
+    fn narrow(
+        &self,
+        pairs: impl Iterator<Item = (usize, usize, SlabMask)>,
+        velocities: &mut Velocities,
+        windows: &mut Vec<(f64, f64)>,
+        out: &mut Vec<PairTerms>,
+    ) {
+        let apart = self.d_min + CLEAR_GUARD_M;
+        for (i, j, slabs) in pairs {
+            if slabs == 0 {
+                continue;
             }
+            self.boxes.windows(slabs, windows);
+            let (a, b) = velocities.pair(self.trajectories, i, j);
+            if windows
+                .iter()
+                .all(|&(from, to)| closest_within(&a, &b, from, to) >= apart)
+            {
+                continue;
+            }
+            out.push(exact_pair(i, j, &a, &b, self.d_min));
         }
-        let (Some(a), Some(b)) = (&motions[i], &motions[j]) else {
-            continue;
-        };
-        let apart = d_min + CLEAR_GUARD_M;
-        if windows
-            .iter()
-            .all(|&(from, to)| closest_within(a, b, from, to) >= apart)
-        {
-            continue;
-        }
-        out.push(exact_pair(i, j, a, b, d_min));
     }
-    out
 }
 
 /// The pair's terms by [`motion_separation`] over the whole mission.
@@ -167,24 +249,40 @@ const CLEAR_GUARD_M: f64 = 1e-6;
 const SMALL_FLEET: usize = 5;
 
 /// Every pair by the exact separation (small fleets, and what the tests check the pruned
-/// terms against).
-fn all_pair_terms(trajectories: &[Trajectory], d_min: f64) -> Vec<PairTerms> {
+/// terms against), appended to `out`.
+fn all_pair_terms_into(
+    trajectories: &[Trajectory],
+    d_min: f64,
+    velocities: &mut Velocities,
+    out: &mut Vec<PairTerms>,
+) {
     let n = trajectories.len();
-    let motions: Vec<Motion> = trajectories.iter().map(Motion::new).collect();
-    let mut out = Vec::new();
     for i in 0..n {
         for j in i + 1..n {
-            out.push(exact_pair(i, j, &motions[i], &motions[j], d_min));
+            let (a, b) = velocities.pair(trajectories, i, j);
+            out.push(exact_pair(i, j, &a, &b, d_min));
         }
     }
-    out
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geometry::Vec3;
     use proptest::prelude::*;
+
+    fn pair_terms(fleet: &[Trajectory], d_min: f64) -> Vec<PairTerms> {
+        let mut out = Vec::new();
+        pair_terms_into(fleet, d_min, &mut out);
+        out
+    }
+
+    fn all_pair_terms(fleet: &[Trajectory], d_min: f64) -> Vec<PairTerms> {
+        let mut out = Vec::new();
+        let mut velocities = Velocities::default();
+        velocities.reset(fleet.len());
+        all_pair_terms_into(fleet, d_min, &mut velocities, &mut out);
+        out
+    }
 
     /// A vehicle crossing a 1 km box in 2–5 straight legs at 0.5–2.5 m/s, from t = 0.
     fn crossing() -> impl Strategy<Value = Trajectory> {

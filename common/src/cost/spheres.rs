@@ -71,13 +71,7 @@ impl SphereIndex {
         if hard.len() + soft.len() <= FEW_SPHERES {
             return sphere_terms(points, hard, soft);
         }
-        SCRATCH.with(|cell| match cell.try_borrow_mut() {
-            Ok(mut scratch) => {
-                let (boxes, marks) = &mut *scratch;
-                self.terms_with(points, hard, soft, boxes, marks)
-            }
-            Err(_) => self.terms_with(points, hard, soft, &mut Vec::new(), &mut Vec::new()),
-        })
+        with_scratch(|boxes, marks| self.terms_with(points, hard, soft, boxes, marks))
     }
 
     fn terms_with(
@@ -118,16 +112,28 @@ impl SphereIndex {
 /// box each; a sphere that cannot reach a chunk's box skips all its legs at once. The others get
 /// the exact squared distance, and roots and chords are taken only on a hit.
 pub(super) fn sphere_terms(points: &[Vec3], hard: &[Sphere], soft: &[Sphere]) -> SphereTerms {
-    let mut boxes = Vec::new();
-    chunk_boxes(points, &mut boxes);
-    let mut out = SphereTerms::default();
-    for s in hard {
-        add_sphere(&mut out, points, &boxes, s, true);
-    }
-    for s in soft {
-        add_sphere(&mut out, points, &boxes, s, false);
-    }
-    out
+    with_scratch(|boxes, _| {
+        chunk_boxes(points, boxes);
+        let mut out = SphereTerms::default();
+        for s in hard {
+            add_sphere(&mut out, points, boxes, s, true);
+        }
+        for s in soft {
+            add_sphere(&mut out, points, boxes, s, false);
+        }
+        out
+    })
+}
+
+/// Runs `f` on this thread's chunk boxes and sphere marks (fresh ones if they are in use).
+fn with_scratch<T>(f: impl FnOnce(&mut Vec<ChunkBox>, &mut Vec<u64>) -> T) -> T {
+    SCRATCH.with(|cell| match cell.try_borrow_mut() {
+        Ok(mut scratch) => {
+            let (boxes, marks) = &mut *scratch;
+            f(boxes, marks)
+        }
+        Err(_) => f(&mut Vec::new(), &mut Vec::new()),
+    })
 }
 
 /// The bounding box of every chunk of [`CHUNK_LEGS`] legs, into `boxes`.

@@ -11,6 +11,7 @@ use super::constraints::{self, Limits, Row};
 use super::objective::{model_hessian, objective_gradient};
 use super::qp::Program;
 use super::settings::RefineSettings;
+use crate::broad_phase::SlabBoxes;
 use crate::cost::FleetModel;
 use crate::geometry::Vec3;
 use crate::trajectory::Trajectory;
@@ -210,7 +211,8 @@ impl<'a, A: Arena> Search<'a, A> {
         self.arena.extra_rows(points, limits, &mut rows);
         let mine = self.arena.mine(&self.eval, i);
         let step = self.settings.sample_step_s;
-        for other in self.arena.others(&self.eval, i) {
+        let others = self.arena.others(&self.eval, i);
+        for other in coming_near(mine, others, limits.separation + reach) {
             constraints::separation_rows(mine, other, limits, step, reach, &mut rows);
         }
         let latest = v.speed_max_mps * self.target;
@@ -220,5 +222,74 @@ impl<'a, A: Arena> Search<'a, A> {
             rows.extend(constraints::length_row(points, earliest, -1.0));
         }
         rows
+    }
+}
+
+/// The trajectories of `others` whose slab boxes ([`SlabBoxes`]) come within `reach` of
+/// `mine`'s at some instant: only those can come within `reach` of it, so only they can add a
+/// separation row (which sampling every one over the whole mission would find out far more
+/// slowly).
+fn coming_near<'e>(
+    mine: &Trajectory,
+    others: Vec<&'e Trajectory>,
+    reach: f64,
+) -> impl Iterator<Item = &'e Trajectory> {
+    let horizon = others
+        .iter()
+        .map(|t| t.arrival())
+        .fold(mine.arrival(), f64::max);
+    let (mut own, mut other_boxes) = (SlabBoxes::new(), SlabBoxes::new());
+    own.reset(horizon);
+    own.push(&mine.times, &mine.points);
+    others.into_iter().filter(move |t| {
+        other_boxes.reset(horizon);
+        other_boxes.push(&t.times, &t.points);
+        own.near_other(0, &other_boxes, 0, reach)
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn line(from: [f64; 3], to: [f64; 3], seconds: f64) -> Trajectory {
+        Trajectory {
+            times: vec![0.0, seconds],
+            points: vec![Vec3::from(from), Vec3::from(to)],
+        }
+    }
+
+    /// Of three others, the one that passes 30 m from `mine` is kept; the parallel one 400 m
+    /// away and the one that crosses `mine`'s track 500 s after `mine` has passed are left out,
+    /// and neither adds a separation row when sampled over the whole mission.
+    #[test]
+    fn only_others_that_come_near_are_sampled() {
+        let mine = line([0., 0., 100.], [1000., 0., 100.], 1000.0);
+        let near = line([0., 30., 100.], [1000., 30., 100.], 1000.0);
+        let parallel = line([0., 400., 100.], [1000., 400., 100.], 1000.0);
+        let late = line([100., 1000., 100.], [100., -1000., 100.], 2000.0);
+        let limits = Limits {
+            max_pitch: 0.3,
+            max_turn: 0.6,
+            clearance_margin: 1.0,
+            separation: 55.0,
+            d_min: 50.0,
+        };
+        let reach = 60.0;
+        let kept: Vec<&Trajectory> = coming_near(
+            &mine,
+            vec![&near, &parallel, &late],
+            limits.separation + reach,
+        )
+        .collect();
+        assert_eq!(kept, vec![&near]);
+        for other in [&parallel, &late] {
+            let mut rows = Vec::new();
+            constraints::separation_rows(&mine, other, &limits, 2.0, reach, &mut rows);
+            assert!(rows.is_empty());
+        }
+        let mut rows = Vec::new();
+        constraints::separation_rows(&mine, &near, &limits, 2.0, reach, &mut rows);
+        assert!(!rows.is_empty());
     }
 }
