@@ -17,7 +17,10 @@
 
 use crate::geometry::Vec3;
 
+mod index;
 pub mod spheres;
+
+pub use index::SlabIndex;
 
 /// Time slabs per mission. More slabs give smaller boxes (fewer pairs survive) but more boxes
 /// to sort; 32 slabs of a one-hour mission keep a box under 200 m along a 3-knot track.

@@ -14,7 +14,7 @@
 
 use rand::rngs::StdRng;
 
-use crate::broad_phase::SlabBoxes;
+use crate::broad_phase::{SlabBoxes, SlabIndex};
 use crate::cost::{
     early_arrival_penalty, entry_turn_penalty, separation_penalty, space_term, FleetModel,
     VehicleTerms,
@@ -38,6 +38,9 @@ pub struct VehicleProblem<'a> {
     /// Their space-time boxes ([`SlabBoxes`]) over `[0, horizon]`: a pair whose boxes never come
     /// within d_min is skipped (its terms are exactly zero).
     other_boxes: SlabBoxes,
+    /// `other_boxes` sorted per slab, so a candidate path finds the others near it by
+    /// bisection.
+    other_index: SlabIndex,
     /// The time span of `other_boxes`, seconds: the later of the others' last arrival and the
     /// context's arrival (this vehicle's positions after it fall in the last slab).
     horizon: f64,
@@ -98,6 +101,7 @@ impl<'a> VehicleProblem<'a> {
             model,
             vehicle,
             other_velocities: others.iter().map(Motion::velocities_of).collect(),
+            other_index: SlabIndex::new(&other_boxes),
             other_boxes,
             horizon,
             others,
@@ -172,11 +176,14 @@ impl<'a> VehicleProblem<'a> {
         own.reset(self.horizon);
         own.push(&trajectory.times, &trajectory.points);
         let d_min = s.fleet.d_min_m;
+        let mut near = Vec::new();
+        self.other_index
+            .near(&self.other_boxes, &own, 0, d_min, &mut near);
         let mut min_separation = f64::INFINITY;
         for (k, (other, (velocities, top))) in
             self.others.iter().zip(&self.other_velocities).enumerate()
         {
-            if !own.near_other(0, &self.other_boxes, k, d_min) {
+            if !near[k] {
                 continue;
             }
             let other = Motion::prepared(other, velocities, *top);

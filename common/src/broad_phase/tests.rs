@@ -185,3 +185,24 @@ proptest! {
         }
     }
 }
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(300))]
+
+    /// The index finds exactly the others [`SlabBoxes::near_other`] finds near a vehicle.
+    #[test]
+    fn the_index_finds_the_others_every_box_test_finds(
+        others in prop::collection::vec(trajectory(), 1..12),
+        mine in trajectory(),
+        reach in 5.0..150.0f64,
+        horizon_scale in 0.3..1.5f64,
+    ) {
+        let end = others.iter().chain([&mine]).filter_map(|t| t.times.last()).fold(1.0f64, |a, b| a.max(*b));
+        let indexed = boxes_of(end * horizon_scale, &others);
+        let own = boxes_of(end * horizon_scale, std::slice::from_ref(&mine));
+        let mut near = Vec::new();
+        SlabIndex::new(&indexed).near(&indexed, &own, 0, reach, &mut near);
+        let every: Vec<bool> = (0..others.len()).map(|k| own.near_other(0, &indexed, k, reach)).collect();
+        prop_assert_eq!(near, every);
+    }
+}
