@@ -103,19 +103,13 @@ pub struct PairTerms {
 /// The terms of every pair the broad phase cannot rule out, in row order, into `out` (cleared
 /// first).
 pub(super) fn pair_terms_into(trajectories: &[Trajectory], d_min: f64, out: &mut Vec<PairTerms>) {
-    out.clear();
-    with_scratch(|scratch| {
+    with_boxes(trajectories, d_min, out, |scratch, out| {
         let Scratch {
             boxes,
             pairs,
             velocities,
             windows,
         } = scratch;
-        velocities.reset(trajectories.len());
-        if trajectories.len() <= SMALL_FLEET {
-            return all_pair_terms_into(trajectories, d_min, velocities, out);
-        }
-        boxes_of(trajectories, boxes);
         boxes.close_pairs(d_min, pairs);
         let kept = pairs.iter().map(|(i, j)| (i, j, pairs.slabs(i, j)));
         let fleet = Fleet {
@@ -138,19 +132,13 @@ pub(super) fn pair_terms_changed(
     base: &[PairTerms],
     out: &mut Vec<PairTerms>,
 ) {
-    out.clear();
-    with_scratch(|scratch| {
+    with_boxes(trajectories, d_min, out, |scratch, out| {
         let Scratch {
             boxes,
             velocities,
             windows,
             ..
         } = scratch;
-        velocities.reset(trajectories.len());
-        if trajectories.len() <= SMALL_FLEET {
-            return all_pair_terms_into(trajectories, d_min, velocities, out);
-        }
-        boxes_of(trajectories, boxes);
         out.extend(
             base.iter()
                 .filter(|p| p.i as usize != changed && p.j as usize != changed),
@@ -166,6 +154,25 @@ pub(super) fn pair_terms_changed(
         });
         fleet.narrow(with_changed, velocities, windows, out);
         out.sort_unstable_by_key(|p| (p.i, p.j));
+    });
+}
+
+/// Clears `out`, then runs `measure` on this thread's buffers with the fleet's slab boxes
+/// built; a small fleet ([`SMALL_FLEET`]) gets every pair measured instead.
+fn with_boxes(
+    trajectories: &[Trajectory],
+    d_min: f64,
+    out: &mut Vec<PairTerms>,
+    measure: impl FnOnce(&mut Scratch, &mut Vec<PairTerms>),
+) {
+    out.clear();
+    with_scratch(|scratch| {
+        scratch.velocities.reset(trajectories.len());
+        if trajectories.len() <= SMALL_FLEET {
+            return all_pair_terms_into(trajectories, d_min, &mut scratch.velocities, out);
+        }
+        boxes_of(trajectories, &mut scratch.boxes);
+        measure(scratch, out);
     });
 }
 
