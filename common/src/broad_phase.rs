@@ -310,10 +310,9 @@ fn position(times: &[f64], points: &[Vec3], seg: &mut usize, t: f64) -> Vec3 {
 
 /// Fixed vehicles' slab boxes indexed for one moving vehicle: an agent's followers, the
 /// touch-up and a replan score one vehicle's candidate paths against the same others thousands
-/// of times. Per slab the others' boxes are sorted along one axis, so a candidate's box finds
-/// the others that may come near it by bisection, not by testing every other vehicle.
-///
-/// The boxes of a [`SlabBoxes`] sorted per slab along the axis where they spread most.
+/// of times. Per slab the others' boxes are sorted along the axis where they spread most, so a
+/// candidate's box finds the others that may come near it by bisection, not by testing every
+/// other vehicle.
 #[derive(Debug, Clone, Default)]
 pub struct SlabIndex {
     /// The sort axis.
