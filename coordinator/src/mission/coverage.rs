@@ -27,7 +27,7 @@ use shoal_common::coverage::drive::drive_trajectory;
 use shoal_common::scenario::Scenario;
 use shoal_common::trajectory::Trajectory;
 
-use super::executable::{executable, Executable};
+use super::executable::{executable, with_tracking_room, Executable};
 use super::options::MissionOptions;
 use super::plan::plan_coverage_mission;
 use crate::distributed::DistributedOptions;
@@ -44,16 +44,9 @@ pub fn plan(
     let Some(settings) = scenario.coverage.as_ref() else {
         bail!("{}: no [coverage] table", m.scenario.display());
     };
-    let mut planning = scenario.clone();
+    let mut planning = with_tracking_room(scenario, separation_buffer_m);
     if let Some(c) = planning.coverage.as_mut() {
         c.track = false;
-    }
-    if scenario.vehicles.len() > 1 && separation_buffer_m > 0.0 {
-        planning.fleet.d_min_m += separation_buffer_m;
-        eprintln!(
-            "note: the crawlers are timed {:.0} m apart, d_min {:.0} m plus the --separation-buffer {:.0} m for the tracking error of both (plan.json's d_min is that sum)",
-            planning.fleet.d_min_m, scenario.fleet.d_min_m, separation_buffer_m
-        );
     }
     let planned = plan_coverage_mission(m, &planning, shutdown, || Ok(options.clone()))?;
     if !executable(planned.feasible, shutdown) {

@@ -31,3 +31,20 @@ pub fn executable(feasible: bool, shutdown: &AtomicBool) -> bool {
         true
     }
 }
+
+/// The scenario a fleet to be executed is planned with: d_min plus the separation buffer, so
+/// that a plan pressed against its d_min (the refinement pulls paths tight) still keeps the
+/// scenario's d_min while the vehicles track it with errors of their own; planned at d_min
+/// itself, the executor's predictions from noisy fixes see a conflict at the first close pass.
+/// The execution keeps the scenario's d_min.
+pub fn with_tracking_room(scenario: &Scenario, separation_buffer_m: f64) -> Scenario {
+    let mut planning = scenario.clone();
+    if scenario.vehicles.len() > 1 && separation_buffer_m > 0.0 {
+        planning.fleet.d_min_m += separation_buffer_m;
+        eprintln!(
+            "note: the vehicles are planned {:.0} m apart, d_min {:.0} m plus the --separation-buffer {:.0} m for the tracking error of both (plan.json's d_min is that sum)",
+            planning.fleet.d_min_m, scenario.fleet.d_min_m, separation_buffer_m
+        );
+    }
+    planning
+}

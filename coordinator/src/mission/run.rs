@@ -11,7 +11,7 @@ use shoal_common::scenario::{Obstacle, ObstacleKind, Scenario};
 use shoal_common::trajectory::Trajectory;
 
 use super::coverage;
-use super::executable::{executable, Executable};
+use super::executable::{executable, with_tracking_room, Executable};
 use super::options::{
     load_scenario, ExecutionSettings, Injection, MissionOptions, Place, RunOptions, AHEAD_S,
 };
@@ -93,8 +93,11 @@ fn plan_trajectories(
     m: &MissionOptions,
     scenario: &Scenario,
     options: &DistributedOptions,
+    separation_buffer_m: f64,
     shutdown: &Arc<AtomicBool>,
 ) -> anyhow::Result<Option<Executable>> {
+    let executed = scenario;
+    let scenario = &with_tracking_room(scenario, separation_buffer_m);
     let mut progress = Progress::new(scenario.optimizer.iterations, m.quiet);
     let plan = if m.in_process {
         planner::plan_in_process(scenario, Some(Arc::clone(shutdown)), &mut |r| {
@@ -113,7 +116,7 @@ fn plan_trajectories(
         return Ok(None);
     }
     Ok(Some(Executable {
-        scenario: scenario.clone(),
+        scenario: executed.clone(),
         trajectories: plan
             .vehicles
             .iter()
@@ -194,7 +197,7 @@ pub fn run_mission(options: &RunOptions, shutdown: Arc<AtomicBool>) -> anyhow::R
     let executable = if scenario.coverage.is_some() {
         coverage::plan(m, &scenario, &net, buffer, &shutdown)?
     } else {
-        plan_trajectories(m, &scenario, &net, &shutdown)?
+        plan_trajectories(m, &scenario, &net, buffer, &shutdown)?
     };
     let Some(Executable {
         scenario,
