@@ -243,3 +243,83 @@ fn the_checker_catches_tampered_energy_and_tour_plans() -> TestResult {
     );
     Ok(())
 }
+
+/// The number before " %" in the notice that contains `marker`.
+fn percent_in(json: &Value, marker: &str) -> f64 {
+    let notices = key(json, "notices").as_array().cloned().unwrap_or_default();
+    let text = notices
+        .iter()
+        .filter_map(Value::as_str)
+        .find(|n| n.contains(marker))
+        .unwrap_or_else(|| panic!("no notice with {marker:?} in {notices:?}"));
+    let number = text
+        .split(" %")
+        .next()
+        .and_then(|head| head.rsplit(' ').next())
+        .and_then(|n| n.parse::<f64>().ok());
+    number.unwrap_or_else(|| panic!("no percentage in {text:?}"))
+}
+
+/// The plan's curve ends at its fitness (the refinement adds the last point).
+fn curve_ends_at_fitness(json: &Value) {
+    let curve = key(json, "convergence")
+        .as_array()
+        .cloned()
+        .unwrap_or_default();
+    let last = curve.last().and_then(Value::as_f64).unwrap_or(f64::NAN);
+    let fitness = num(json, "fitness");
+    assert!(
+        (last - fitness).abs() <= 1e-9 * fitness.abs().max(1.0),
+        "{last} vs {fitness}"
+    );
+}
+
+#[test]
+fn energy_and_tour_plans_are_refined_and_state_their_gap_to_a_reference() -> TestResult {
+    let short = ["--iterations", "40", "--seed", "2"];
+    let dir = tempfile::tempdir()?;
+    let refined = plan_and_check("epa-pso", dir.path(), &short)?;
+    let dir = tempfile::tempdir()?;
+    let alone = plan_and_check(
+        "epa-pso",
+        dir.path(),
+        &[&short[..], &["--no-refine"]].concat(),
+    )?;
+    assert!(
+        num(&refined, "fitness") < num(&alone, "fitness"),
+        "the refinement lowers the cost"
+    );
+    curve_ends_at_fitness(&refined);
+    let says = |j: &Value, what: &str| {
+        let notices = key(j, "notices").as_array().cloned().unwrap_or_default();
+        notices
+            .iter()
+            .filter_map(Value::as_str)
+            .any(|n| n.starts_with(what))
+    };
+    assert!(says(&refined, "refinement:") && !says(&alone, "refinement:"));
+    // The reference is the same for both; the refined plan is nearer to it.
+    let (gap_refined, gap_alone) = (
+        percent_in(&refined, "cheapest path"),
+        percent_in(&alone, "cheapest path"),
+    );
+    assert!(gap_refined < gap_alone, "{gap_refined} vs {gap_alone}");
+    for group in ["cages-a", "cages-b"] {
+        let args = ["--iterations", "80", "--particles", "30", "--seed", "3"];
+        let dir = tempfile::tempdir()?;
+        let refined = plan_and_check(group, dir.path(), &args)?;
+        let dir = tempfile::tempdir()?;
+        let alone = plan_and_check(group, dir.path(), &[&args[..], &["--no-refine"]].concat())?;
+        let length = |j: &Value| num(&vehicle(j, 0)["tour"], "tour_length_m");
+        assert!(
+            length(&refined) < length(&alone),
+            "{group}: legs pulled tighter"
+        );
+        curve_ends_at_fitness(&refined);
+        // The order is the swarm's either way, and never shorter than the exact optimum.
+        let order_gap = percent_in(&refined, "shortest order");
+        assert_eq!(order_gap, percent_in(&alone, "shortest order"), "{group}");
+        assert!(order_gap >= 0.0, "{group}: {order_gap}");
+    }
+    Ok(())
+}

@@ -23,6 +23,7 @@
 //!   the fitness only.
 
 pub mod problem;
+pub mod reference;
 
 use std::f64::consts::PI;
 use std::sync::Arc;
@@ -170,7 +171,50 @@ pub struct Pieces {
     pub angle: Vec<f64>,
 }
 
+/// The work of one straight segment flown at the model's ground speed.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SegmentWork {
+    /// Eq. (10) times the time on the segment, joules.
+    pub thrust_j: f64,
+    /// Eq. (11) times the time on the segment, joules.
+    pub current_j: f64,
+    /// Speed through the water, m/s.
+    pub water_speed_mps: f64,
+}
+
 impl EnergyModel {
+    /// The work of flying from `a` to `b` in the current at the segment's midpoint (zero for a
+    /// segment of no length).
+    pub fn segment_work(&self, a: &Vec3, b: &Vec3) -> SegmentWork {
+        let d = b - a;
+        let p = d.norm();
+        let mut w = SegmentWork {
+            thrust_j: 0.0,
+            current_j: 0.0,
+            water_speed_mps: 0.0,
+        };
+        if p <= 0.0 {
+            return w;
+        }
+        let v = self.ground_speed_mps.max(1e-9);
+        let pitch = d.z.atan2(d.x.hypot(d.y)).to_degrees();
+        let dt = p / v;
+        let ground = d * (v / p);
+        let c = self.current.velocity(&(0.5 * (a + b)));
+        let water = water_velocity(&ground, &c);
+        let x = resistance(pitch);
+        // Zhang et al. 2022, eq. (10), times Δt.
+        w.thrust_j = (x * water.norm()).abs() * dt;
+        // Zhang et al. 2022, eq. (11), times Δt.
+        let (cw, cc) = (water.norm(), c.norm());
+        if cw > 0.0 && cc > 0.0 {
+            let cos = water.dot(&c) / (cw * cc);
+            w.current_j = heading_factor(cos) * (x * cos * cc).abs() * dt;
+        }
+        w.water_speed_mps = cw;
+        w
+    }
+
     /// The figures and the per-segment pieces of a path.
     pub fn terms(&self, points: &[Vec3]) -> (EnergyTerms, Pieces) {
         let n = points.len();
@@ -199,21 +243,10 @@ impl EnergyModel {
             if p > 0.0 {
                 t.max_pitch_deg = t.max_pitch_deg.max(pitch);
                 t.min_pitch_deg = t.min_pitch_deg.min(pitch);
-                let dt = p / v;
-                let ground = d * (v / p);
-                let c = self.current.velocity(&(0.5 * (w[0] + w[1])));
-                let water = water_velocity(&ground, &c);
-                let x = resistance(pitch);
-                // Zhang et al. 2022, eq. (10), times Δt.
-                e_t = (x * water.norm()).abs() * dt;
-                // Zhang et al. 2022, eq. (11), times Δt.
-                let (cw, cc) = (water.norm(), c.norm());
-                if cw > 0.0 && cc > 0.0 {
-                    let cos = water.dot(&c) / (cw * cc);
-                    e_a = heading_factor(cos) * (x * cos * cc).abs() * dt;
-                }
-                t.duration_s += dt;
-                t.max_water_speed_mps = t.max_water_speed_mps.max(water.norm());
+                let work = self.segment_work(&w[0], &w[1]);
+                (e_t, e_a) = (work.thrust_j, work.current_j);
+                t.duration_s += p / v;
+                t.max_water_speed_mps = t.max_water_speed_mps.max(work.water_speed_mps);
             }
             let excess = if pitch > hi {
                 (pitch - hi).powi(2)

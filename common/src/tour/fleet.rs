@@ -107,6 +107,7 @@ impl FleetTours {
                     waypoints: o.waypoints,
                     clearance_m: 0.0,
                     velocity_cap: o.max_velocity_fraction,
+                    refine: o.refine,
                 },
                 stop: None,
             },

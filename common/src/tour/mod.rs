@@ -32,7 +32,8 @@ pub use leg::{
     CHORD_WEIGHT, HIT_PENALTY_M,
 };
 pub use order::{
-    distance_matrix, open_order_length, swap_sequence, tour_length, two_opt, Ordered, SwapPso,
+    distance_matrix, open_order_length, optimal_tour_length, swap_sequence, tour_length, two_opt,
+    Ordered, SwapPso, MAX_EXACT_POINTS,
 };
 pub use plan::{
     plan_leg, plan_tour, summed_curve, Leg, LegSettings, TourPlan, TourSettings, LEG_CLEARANCE_M,

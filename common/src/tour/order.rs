@@ -279,6 +279,46 @@ pub fn distance_matrix(nodes: &[crate::geometry::Vec3]) -> Vec<Vec<f64>> {
         .collect()
 }
 
+/// Most points [`optimal_tour_length`] takes: its table holds `2ⁿ · n` lengths (16: about a
+/// million, 8 MB).
+pub const MAX_EXACT_POINTS: usize = 16;
+
+/// The length of the shortest closed tour from node 0 through every other node of `dist` and
+/// back (Held & Karp 1962's dynamic programme): the reference the swap-operator PSO's order is
+/// measured against. `None` over [`MAX_EXACT_POINTS`] points.
+pub fn optimal_tour_length(dist: &[Vec<f64>]) -> Option<f64> {
+    let n = dist.len().checked_sub(1)?;
+    if n > MAX_EXACT_POINTS {
+        return None;
+    }
+    if n == 0 {
+        return Some(0.0);
+    }
+    // best[set · n + last]: shortest path from node 0 through the points of `set` (bit k is
+    // node k + 1), ending at node `last + 1`.
+    let full = 1usize << n;
+    let mut best = vec![f64::INFINITY; full * n];
+    for k in 0..n {
+        best[(1 << k) * n + k] = dist_at(dist, 0, k + 1);
+    }
+    for set in 1..full {
+        for last in 0..n {
+            let here = best[set * n + last];
+            if set & (1 << last) == 0 || !here.is_finite() {
+                continue;
+            }
+            for next in (0..n).filter(|k| set & (1 << k) == 0) {
+                let to = (set | (1 << next)) * n + next;
+                best[to] = best[to].min(here + dist_at(dist, last + 1, next + 1));
+            }
+        }
+    }
+    let shortest = (0..n)
+        .map(|last| best[(full - 1) * n + last] + dist_at(dist, last + 1, 0))
+        .fold(f64::INFINITY, f64::min);
+    Some(shortest)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -430,5 +470,53 @@ mod tests {
         stop.store(false, Ordering::Relaxed);
         let full = p.order_counted(&d);
         assert_eq!((full.evaluations, full.interrupted), (100 * 2001, false));
+    }
+
+    #[test]
+    fn the_exact_tour_is_the_shortest_of_every_order() {
+        // Four points on a square's corners and one off it: the exact length equals the best of
+        // all 4! orders, computed by brute force, and a hand value for the square.
+        let square = [[0.0, 0.0], [10.0, 0.0], [10.0, 10.0], [0.0, 10.0]];
+        let d = |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).hypot(a[1] - b[1]);
+        let matrix = |p: &[[f64; 2]]| -> Vec<Vec<f64>> {
+            p.iter()
+                .map(|a| p.iter().map(|b| d(*a, *b)).collect())
+                .collect()
+        };
+        assert_eq!(optimal_tour_length(&matrix(&square)), Some(40.0));
+        let pts = [
+            [0.0, 0.0],
+            [7.0, 1.0],
+            [3.0, 9.0],
+            [9.0, 8.0],
+            [1.0, 4.0],
+            [5.0, 5.0],
+        ];
+        let m = matrix(&pts);
+        let mut brute = f64::INFINITY;
+        let mut order: Vec<usize> = (1..pts.len()).collect();
+        permute(&mut order, 0, &mut |o| {
+            let tour: Vec<usize> = std::iter::once(0)
+                .chain(o.iter().copied())
+                .chain([0])
+                .collect();
+            brute = brute.min(tour_length(&m, &tour));
+        });
+        let exact = optimal_tour_length(&m).unwrap_or(f64::NAN);
+        assert!((exact - brute).abs() < 1e-9, "{exact} vs {brute}");
+        assert_eq!(optimal_tour_length(&[vec![0.0]]), Some(0.0));
+        let big = vec![vec![1.0; MAX_EXACT_POINTS + 2]; MAX_EXACT_POINTS + 2];
+        assert_eq!(optimal_tour_length(&big), None);
+    }
+
+    fn permute(v: &mut Vec<usize>, k: usize, visit: &mut dyn FnMut(&[usize])) {
+        if k == v.len() {
+            return visit(v);
+        }
+        for i in k..v.len() {
+            v.swap(k, i);
+            permute(v, k + 1, visit);
+            v.swap(k, i);
+        }
     }
 }

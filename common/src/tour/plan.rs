@@ -9,6 +9,7 @@ use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
 
 use crate::geometry::Vec3;
+use crate::refine::descent::{self, DescentSettings};
 use crate::swarm::catalog::{with_solver, LegAlgorithm, SolverSettings, SolverVisitor};
 use crate::swarm::population::stream_seed;
 use crate::swarm::{Executor, Solver, SolverState, Termination};
@@ -33,6 +34,9 @@ pub struct LegSettings {
     /// Velocity cap for the leg's swarm (a fraction of each range); `None` keeps the
     /// algorithm's own (Table 5's solvers: 0.2).
     pub velocity_cap: Option<f64>,
+    /// Descend from the swarm's best on the same cost ([`descent`]): not part of Hu et al.'s
+    /// algorithm, which ends with the swarm.
+    pub refine: bool,
 }
 
 impl LegSettings {
@@ -44,6 +48,7 @@ impl LegSettings {
             waypoints: 29,
             clearance_m: LEG_CLEARANCE_M,
             velocity_cap: None,
+            refine: false,
         }
     }
 }
@@ -102,8 +107,9 @@ pub struct TourPlan {
     /// leg swarms' intersection penalty, [`LegProblem::path_cost`]) when every leg swarm has run
     /// `t + 1` iterations. A leg that needs no swarm, or whose swarm stopped early, counts at its
     /// final cost; each leg counts at most its straight chord's cost, as [`plan_leg`] keeps the
-    /// cheaper. One entry per leg-swarm iteration run; a tour none of whose legs needed a swarm
-    /// has one entry, its cost.
+    /// cheaper. One entry per leg-swarm iteration run, and one more with the legs' final summed
+    /// cost when their refinement ([`LegSettings::refine`]) lowered it; a tour none of whose
+    /// legs needed a swarm has one entry, its cost.
     pub convergence: Vec<f64>,
 }
 
@@ -155,7 +161,17 @@ pub fn plan_leg(
         &solver,
         LegRunner { problem, executor },
     );
-    let path = problem.path(&run.best);
+    let mut evaluations = run.evaluations;
+    let mut best = run.best;
+    if settings.refine && !run.interrupted {
+        let stop = stop.map(|s| s.as_ref());
+        let d = descent::descend(problem, &best, &LEG_DESCENT, stop);
+        evaluations += d.evaluations as u64;
+        if d.cost.1 < d.cost.0 {
+            best = d.x;
+        }
+    }
+    let path = problem.path(&best);
     let (swarm_cost, straight_cost) = (problem.path_cost(&path), problem.path_cost(&straight));
     let (path, cost) = if swarm_cost <= straight_cost {
         (path, swarm_cost)
@@ -164,7 +180,7 @@ pub fn plan_leg(
     };
     Leg {
         path,
-        evaluations: run.evaluations,
+        evaluations,
         interrupted: run.interrupted,
         convergence: run
             .convergence
@@ -174,6 +190,14 @@ pub fn plan_leg(
         cost,
     }
 }
+
+/// The refinement's budget for one leg: its gradient over 29 waypoints takes 174 evaluations,
+/// so this is about fifty steps, a tenth of Table 5's leg swarm (60 × 400).
+const LEG_DESCENT: DescentSettings = DescentSettings {
+    max_evaluations: 10_000,
+    difference_step: 1e-7,
+    tolerance: 1e-9,
+};
 
 /// What [`plan_leg`] keeps of a swarm's run.
 struct LegRun {
@@ -289,8 +313,10 @@ pub fn plan_tour(
         path.extend(leg.path.into_iter().skip(1));
     }
     let mut convergence = summed_curve(curves.iter().map(|(c, cost)| (c.as_slice(), *cost)));
-    if convergence.is_empty() {
-        convergence.push(curves.iter().map(|(_, cost)| cost).sum());
+    // The legs' refinement (when asked) ends below their swarms' curves: one last entry.
+    let total: f64 = curves.iter().map(|(_, cost)| cost).sum();
+    if convergence.last().is_none_or(|last| total < *last) {
+        convergence.push(total);
     }
     let tour_length_m: f64 = leg_lengths.iter().sum();
     let straight_tour_length_m = tour_length(&dist, &tour);

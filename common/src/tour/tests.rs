@@ -19,6 +19,7 @@ fn small() -> TourSettings {
             waypoints: 9,
             clearance_m: LEG_CLEARANCE_M,
             velocity_cap: None,
+            refine: false,
         },
         stop: None,
     }

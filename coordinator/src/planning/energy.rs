@@ -7,12 +7,14 @@ use std::sync::Arc;
 
 use shoal_common::energy::problem::{EnergyProblem, Objective};
 use shoal_common::plan::{assess, FleetFigures, Plan};
+use shoal_common::refine::descent::{self, DescentSettings};
 use shoal_common::scenario::{Algorithm, Scenario};
 use shoal_common::swarm::catalog::{family, Family};
 use shoal_common::swarm::{Executor, IterationReport, Termination};
 use shoal_common::trajectory::Trajectory;
 
 use crate::planning::solver::{run_algorithm, RunResult};
+use crate::report::energy_gap;
 
 /// The objective an algorithm plans with: the path length alone for Zhang et al.'s length
 /// baseline, the full cost of eq. (6) otherwise.
@@ -41,8 +43,48 @@ pub fn plan(
         stop,
         ..Executor::default()
     };
-    let run = run_algorithm(&problem, o, &executor, observe);
-    to_plan(scenario, &problem, run)
+    let mut run = run_algorithm(&problem, o, &executor, observe);
+    let refined = (o.refine && run.termination != Termination::Interrupted)
+        .then(|| refine(&problem, &mut run, executor.stop.as_deref()))
+        .flatten();
+    let mut plan = to_plan(scenario, &problem, run);
+    plan.notices.extend(refined);
+    if let Some(terms) = plan.vehicles.first().and_then(|v| v.energy) {
+        let id = &scenario.vehicles[0].id;
+        plan.notices.push(energy_gap::notice(id, &problem, &terms));
+    }
+    plan
+}
+
+/// Descends from the swarm's best on the same cost ([`descent`]); when that lowers it, the run
+/// ends there (its curve gains the last point) and the notice says what changed.
+fn refine(
+    problem: &EnergyProblem,
+    run: &mut RunResult,
+    stop: Option<&AtomicBool>,
+) -> Option<String> {
+    let started = std::time::Instant::now();
+    let before = problem.evaluate(&run.best_x);
+    // As many evaluations as the swarm made: the refinement at most doubles the plan's work.
+    let settings = DescentSettings {
+        max_evaluations: usize::try_from(run.evaluations).unwrap_or(usize::MAX),
+        ..DescentSettings::default()
+    };
+    let d = descent::descend(problem, &run.best_x, &settings, stop);
+    run.evaluations += d.evaluations as u64;
+    run.runtime_s += started.elapsed().as_secs_f64();
+    if d.cost.1 >= d.cost.0 {
+        return None;
+    }
+    let after = problem.evaluate(&d.x);
+    run.best_x = d.x;
+    run.convergence.push(after.cost);
+    let (b, a) = (&before.terms, &after.terms);
+    Some(format!(
+        "refinement: {} local steps after the swarm lowered the cost {:.4} -> {:.4}: energy \
+         {:.0} J -> {:.0} J, length {:.1} m -> {:.1} m (--no-refine gives the swarm's plan)",
+        d.steps, before.cost, after.cost, b.q_e, a.q_e, b.q_path, a.q_path
+    ))
 }
 
 /// The plan of the best particle: the path flown at the constant ground speed of §2.2.

@@ -12,6 +12,7 @@ use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
 use std::time::Instant;
 
+use shoal_common::geometry::Vec3;
 use shoal_common::plan::{assess, Plan};
 use shoal_common::scenario::Scenario;
 use shoal_common::swarm::IterationReport;
@@ -19,6 +20,7 @@ use shoal_common::tour::{summed_curve, FleetTours, TourFigures, TourPlan};
 use shoal_common::trajectory::Trajectory;
 
 use crate::planning::energy::unplannable;
+use crate::report::tour_gap;
 
 /// Plans the scenario's inspection tours in this process, one thread per vehicle. A raised
 /// `stop` cuts every swarm short; the tours are still complete (see [`assemble`]).
@@ -152,6 +154,14 @@ pub fn assemble(
             "planning was interrupted: the tours of {} were finished from what their swarms had found so far (every point is still visited); this is the best plan found so far",
             cut.join(", ")
         ));
+    }
+    let bases = scenario.vehicles.iter().zip(&job.bases);
+    for (((v, base), t), share) in bases.zip(tours).zip(shares) {
+        let visited: Vec<Vec3> = share
+            .iter()
+            .filter_map(|&k| points.get(k).map(|p| p.position))
+            .collect();
+        notices.push(tour_gap::notice(&v.id, *base, &visited, t));
     }
     if n > 1 {
         notices.push(format!(
@@ -302,10 +312,10 @@ mod tests {
         assert!(!with.notices.iter().any(|n| n.contains("interrupted")));
         assert_eq!(with.fitness, without.fitness);
         assert_eq!(with.evaluations, without.evaluations);
-        // The curve: one entry per leg-swarm iteration, ending at the tours' summed length
-        // (no tour crosses a cage here).
+        // The curve: one entry per leg-swarm iteration and one for the refined legs, ending at
+        // the tours' summed length (no tour crosses a cage here).
         assert_eq!(with.convergence, without.convergence);
-        assert_eq!(with.convergence.len(), 20);
+        assert_eq!(with.convergence.len(), 21);
         assert!(with.convergence.windows(2).all(|w| w[1] <= w[0]));
         assert_eq!(with.penalty, 0.0);
         let last = with.convergence.last().copied().unwrap_or(f64::NAN);
