@@ -1,6 +1,7 @@
 //! Planning a mission, then executing the plan with one agent per vehicle driving it through
 //! its vehicle link, and reporting the execution's figures (`<out>/execution.json`, the
-//! mission log `<out>/mission.ndjson`): what `run` does, and each mission `serve` takes.
+//! mission log `<out>/mission.ndjson` and its MCAP copy `mission.mcap`): what `run` does, and
+//! each mission `serve` takes.
 
 use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
