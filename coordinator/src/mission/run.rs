@@ -246,7 +246,17 @@ pub fn run_mission(options: &RunOptions, shutdown: Arc<AtomicBool>) -> anyhow::R
     let json = serde_json::to_string_pretty(&report).context("cannot serialise the execution")?;
     std::fs::write(&path, json).with_context(|| format!("cannot write {}", path.display()))?;
     say(&execution_summary(&report));
-    say(&format!("Wrote {} and {}\n", path.display(), log.display()));
+    let mcap = execute::log::mcap_path(&log);
+    if mcap.is_file() {
+        say(&format!(
+            "Wrote {}, {} and {}\n",
+            path.display(),
+            log.display(),
+            mcap.display()
+        ));
+    } else {
+        say(&format!("Wrote {} and {}\n", path.display(), log.display()));
+    }
     Ok(execution_ok(&report))
 }
 
