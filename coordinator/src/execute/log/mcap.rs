@@ -1,6 +1,6 @@
 //! The MCAP mission log (`mission.mcap`): the records of the NDJSON log as MCAP messages, for
 //! robotics tools (Foxglove, the `mcap` command-line tool and libraries). Channels, topics and
-//! schemas are in [`super::channels`].
+//! schemas are in the sibling `channels` module.
 //!
 //! The file is unchunked: each record goes to disk as it is written (at the next flush, every
 //! second), so a run that is killed leaves whole records up to its last flush, as the NDJSON
