@@ -54,7 +54,10 @@ def read_mcap(path):
         reader = make_reader(f)
         header = reader.get_header()
         need(header.library.startswith("shoal-coordinator"), f"{path}: library {header.library!r}")
-        for schema, channel, message in reader.iter_messages():
+        # File order: log times follow each record's own time, so they may run a little
+        # backwards between records (a report is stamped when it arrived, an event when the
+        # loop made it); the sequence numbers give the order, checked below.
+        for schema, channel, message in reader.iter_messages(log_time_order=False):
             topic = channel.topic
             need(channel.message_encoding == "json", f"{path}: {topic} is encoded {channel.message_encoding!r}")
             need(schema is not None, f"{path}: {topic} has no schema")
@@ -73,6 +76,7 @@ def read_mcap(path):
             need(not errors, f"{path}: message {message.sequence} on {topic} does not match its schema: "
                  + "; ".join(e.message for e in errors[:3]))
             messages.append((message.sequence, topic, message.log_time, message.publish_time, data))
+    messages.sort(key=lambda m: m[0])
     return messages, validators
 
 

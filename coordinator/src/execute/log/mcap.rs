@@ -12,7 +12,10 @@
 //! no time of their own, take the latest log time before them (they are logged as they happen,
 //! so that is at most one report interval early). A report's publish time is when its agent
 //! sent it; every other record's is its log time. So the same records always make the same
-//! file, whether `run` writes it or `export` converts an NDJSON log.
+//! file, whether `run` writes it or `export` converts an NDJSON log. Log times may run a little
+//! backwards from one message to the next (a report is stamped when it arrived, an event when
+//! the loop made it, which can be before it got to the report): a message's sequence number is
+//! its place in the file, from 1.
 
 use std::collections::BTreeMap;
 use std::fs::File;
