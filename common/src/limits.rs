@@ -47,6 +47,12 @@ pub const MAX_QUEUED_MISSIONS: usize = 8;
 /// waypoints write 26 MB; the start record holds the scenario (at most 4 MB).
 pub const MAX_LOG_LINE_BYTES: usize = 64 << 20;
 
+/// Bytes of an MCAP mission log read back by `replay` and `export` (every record is kept in
+/// memory for the replay). A report is about 400 bytes, so a 45-minute mission of 100 vehicles
+/// reporting at 10 Hz logs about 1.1 GB; one MCAP message is one record, so it has
+/// [`MAX_LOG_LINE_BYTES`] as its own bound.
+pub const MAX_LOG_BYTES: u64 = 4 << 30;
+
 /// Bytes of a `plan.json` read back by `export`: the trajectories take about 100 bytes per
 /// waypoint, so 256 vehicles of 1,000 waypoints are 26 MB, with room for the figures.
 pub const MAX_PLAN_BYTES: u64 = 64 << 20;

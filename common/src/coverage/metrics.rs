@@ -230,7 +230,7 @@ pub fn exact_clearance(map: &TerrainMap25, x: f64, y: f64, exact_below: f64) -> 
 }
 
 /// Area swept by a path's swath over a region.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 pub struct CoverageCount {
     /// Swept area / region area.
     pub ratio: f64,

@@ -42,7 +42,7 @@ impl MissionClock {
 }
 
 /// What a vehicle is doing, as its link reports it.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(rename_all = "snake_case")]
 pub enum VehicleStatus {
     /// Powered, no trajectory loaded yet.
@@ -60,7 +60,7 @@ pub enum VehicleStatus {
 }
 
 /// A command an agent passes to its vehicle.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(rename_all = "snake_case")]
 pub enum VehicleCommand {
     /// Load a (re)planned trajectory and start it.
@@ -83,7 +83,7 @@ impl VehicleCommand {
 }
 
 /// Where a command stands, as far as the vehicle has confirmed it.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(rename_all = "snake_case")]
 pub enum CommandState {
     /// Sent; the vehicle has not answered yet.
@@ -98,7 +98,7 @@ pub enum CommandState {
 
 /// The latest command of an agent and what its vehicle made of it: carried in every
 /// telemetry report, so that a lost report does not lose a refused hold.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 pub struct CommandReport {
     /// Which command.
     pub command: VehicleCommand,
@@ -111,7 +111,7 @@ pub struct CommandReport {
 }
 
 /// One state report of a vehicle (the telemetry it sends), in the scenario frame.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 pub struct VehicleState {
     /// Mission time of the fix, seconds.
     pub t_s: f64,

@@ -75,7 +75,7 @@ pub struct Bounds {
 }
 
 /// How an obstacle affects a vehicle (Zhi & Zuo 2024, §2.1).
-#[derive(Debug, Clone, Copy, Serialize, Deserialize, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, Serialize, Deserialize, PartialEq, Eq, schemars::JsonSchema)]
 #[serde(rename_all = "lowercase")]
 pub enum ObstacleKind {
     /// Must never be entered (radius plus inflation): a plan touching one is infeasible.
@@ -85,7 +85,7 @@ pub enum ObstacleKind {
 }
 
 /// A sphere with a safety inflation margin (Zhi & Zuo 2024, Fig. 1).
-#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Obstacle {
     /// Name used in reports (e.g. `HObs#1`).

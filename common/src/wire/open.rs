@@ -21,7 +21,7 @@ use crate::execution::{CommandReport, VehicleState};
 pub const OPEN_VERSION: u16 = 1;
 
 /// One telemetry report of a vehicle.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 pub struct Telemetry {
     /// [`OPEN_VERSION`].
     pub version: u16,
@@ -87,7 +87,7 @@ pub struct FleetStatus {
 }
 
 /// A plan (or replan) as published.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 pub struct PlanNotice {
     /// [`OPEN_VERSION`].
     pub version: u16,
@@ -102,7 +102,7 @@ pub struct PlanNotice {
 }
 
 /// A decision or an observation of the coordinator, as logged and published.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 pub struct MissionEvent {
     /// [`OPEN_VERSION`].
     pub version: u16,

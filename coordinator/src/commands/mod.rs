@@ -42,7 +42,7 @@ pub enum Command {
     /// Plan a scenario and write plan.json and plan.svg.
     Plan(plan_args::PlanArgs),
     /// Write a plan for maps (GeoJSON) or QGroundControl (.plan per vehicle), on WGS-84 through
-    /// the scenario's `[origin]`.
+    /// the scenario's `[origin]`; or a mission log as MCAP (`--format mcap`).
     Export(export::ExportArgs),
     /// Compare the optimizers over several seeds (markdown table on stdout).
     Compare(compare::CompareArgs),
@@ -57,7 +57,8 @@ pub enum Command {
     Serve(serve::ServeArgs),
     /// Print the live fleet picture of the running missions (a Zenoh query).
     Status(status::StatusArgs),
-    /// Re-read a mission log (`run`'s mission.ndjson): events, figures and an SVG of the tracks.
+    /// Re-read a mission log (`run`'s mission.ndjson or mission.mcap): events, figures and an
+    /// SVG of the tracks.
     Replay(replay::ReplayArgs),
 
     // -- Network and deployment --

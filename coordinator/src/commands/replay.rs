@@ -21,7 +21,8 @@ use crate::report::svg::chart::fail;
 /// `shoal-coordinator replay`.
 #[derive(Debug, Clone, clap::Args)]
 pub struct ReplayArgs {
-    /// The mission log (`mission.ndjson` of `run`).
+    /// The mission log: `mission.ndjson` or `mission.mcap` of `run` (told apart by their
+    /// content, not their name).
     pub log: PathBuf,
     /// Where to draw the tracks (default: the log's path with `.svg`).
     #[arg(long)]
@@ -42,8 +43,8 @@ pub struct Replayed {
     pub planned: Vec<Trajectory>,
     /// The executed tracks.
     pub tracks: Vec<Trajectory>,
-    /// A last line cut short and left out (see [`log::Log::cut_short`]).
-    pub cut_short: Option<usize>,
+    /// A last record cut short and left out (see [`log::Log::cut_short`]).
+    pub cut_short: Option<log::CutShort>,
 }
 
 /// Replays the log at `path`.
@@ -165,9 +166,9 @@ pub fn command(args: &ReplayArgs) -> anyhow::Result<i32> {
         }
         None => out.push_str("the log has no end record: the run did not finish\n"),
     }
-    if let Some(n) = r.cut_short {
+    if let Some(cut) = r.cut_short {
         out.push_str(&format!(
-            "line {n}, the last, is cut short (the run stopped while writing it): left out\n"
+            "{cut}, the last, is cut short (the run stopped while writing it): left out\n"
         ));
     }
     let svg_path = args

@@ -422,7 +422,7 @@ fn quantile_of(x: &[f64], q: f64) -> Option<f64> {
 }
 
 /// One vehicle's execution figures.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 pub struct VehicleFigures {
     /// Vehicle id.
     pub vehicle: String,
@@ -471,7 +471,7 @@ pub struct VehicleFigures {
 }
 
 /// The figures of an execution (also what `replay` reports).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 pub struct ExecutionFigures {
     /// Minimum separation, metres.
     pub d_min_m: f64,

@@ -1,21 +1,26 @@
-//! The mission log: one JSON object per line (NDJSON), written as the execution goes, so a
-//! crash loses at most the line being written. `shoal-coordinator replay LOG` reads it back and
-//! recomputes the figures from the records alone.
+//! The mission log, written as the execution goes, in two files with the same records:
+//! `mission.ndjson`, one JSON object per line for scripts ([`ndjson`]), and `mission.mcap`
+//! beside it for robotics tools ([`mcap`]; its channels and schemas: `channels`). Each loses
+//! at most the record being written when the run is killed. `shoal-coordinator replay LOG`
+//! reads either back (told apart by the MCAP magic, not by the name) and recomputes the figures
+//! from the records alone.
 //!
-//! Lines: `{"record": "start", …}` first, then `plan`, `telemetry` and `event` records in the
-//! order they happened, and `{"record": "end", …}` with the figures last.
+//! Records: `start` first, then `plan`, `telemetry`, `event` and `obstacle` records in the
+//! order they happened, and `end` with the figures last.
 
-use std::fs::File;
-use std::io::{BufRead, BufReader, BufWriter, Read, Write};
+mod channels;
+pub mod mcap;
+pub mod ndjson;
+mod record;
+
+use std::io::Read as _;
 use std::path::{Path, PathBuf};
 
 use anyhow::Context as _;
-use serde::{Deserialize, Serialize};
-use shoal_common::limits::MAX_LOG_LINE_BYTES;
-use shoal_common::scenario::Obstacle;
-use shoal_common::wire::open::{MissionEvent, PlanNotice, Telemetry};
 
-use super::fleet::ExecutionFigures;
+use self::mcap::McapWriter;
+use self::ndjson::NdjsonWriter;
+pub use self::record::{CutShort, Log, Record, Start};
 
 /// The event kind of a vehicle declared lost (its `vehicles` names it).
 pub const EVENT_LOST: &str = "vehicle_lost";
@@ -31,222 +36,79 @@ pub const EVENT_IMPLAUSIBLE: &str = "implausible_report";
 /// or the rate limit).
 pub const EVENT_OBSTACLE_DROPPED: &str = "obstacle_dropped";
 
-/// What starts a log.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct Start {
-    /// Mission id.
-    pub mission: String,
-    /// The scenario as TOML (obstacles as planned; new ones come as events).
-    pub scenario_toml: String,
-    /// The fleet's arrival time, mission seconds.
-    pub common_arrival_s: f64,
-    /// Half-width of the arrival window, mission seconds.
-    pub arrival_window_s: f64,
-    /// Prediction horizon, mission seconds.
-    pub horizon_s: f64,
-    /// Mission seconds per wall second.
-    pub time_scale: f64,
-    /// Unix time of mission time 0, milliseconds.
-    pub epoch_unix_ms: u64,
-}
-
-/// One line.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(tag = "record", rename_all = "snake_case")]
-pub enum Record {
-    /// First line.
-    Start(Start),
-    /// A plan or a replan.
-    Plan(PlanNotice),
-    /// A report, with when it came.
-    Telemetry {
-        /// Unix time of receipt, microseconds.
-        received_unix_us: u64,
-        /// The report.
-        telemetry: Telemetry,
-    },
-    /// A decision or an observation.
-    Event(MissionEvent),
-    /// An obstacle published during the execution.
-    Obstacle(Obstacle),
-    /// Last line.
-    End(ExecutionFigures),
-}
-
-/// Appends records to a log file.
+/// Appends records to both logs.
 pub struct LogWriter {
-    out: BufWriter<File>,
-    path: PathBuf,
+    /// The NDJSON log (it cannot be created: the mission does not start).
+    ndjson: NdjsonWriter,
+    /// The MCAP log; `None` when it could not be created (a warning; the mission goes on).
+    mcap: Option<McapWriter>,
 }
 
 impl LogWriter {
-    /// Creates (truncates) `path`.
+    /// Creates (truncates) the NDJSON log `path` and the MCAP log at [`mcap_path`] of it.
     pub fn create(path: &Path) -> anyhow::Result<LogWriter> {
-        let file = File::create(path)
-            .with_context(|| format!("cannot create the mission log {}", path.display()))?;
-        Ok(LogWriter {
-            out: BufWriter::new(file),
-            path: path.to_path_buf(),
-        })
+        let ndjson = NdjsonWriter::create(path)?;
+        let mcap = McapWriter::create(&mcap_path(path))
+            .map_err(|e| tracing::warn!("{e:#}; the mission goes on with the NDJSON log alone"))
+            .ok();
+        Ok(LogWriter { ndjson, mcap })
     }
 
     /// Writes one record (a failure is logged, not fatal: the mission goes on).
     pub fn write(&mut self, r: &Record) {
-        let line = match serde_json::to_string(r) {
-            Ok(l) => l,
-            Err(e) => return tracing::warn!("cannot serialise a log record: {e}"),
-        };
-        if let Err(e) = writeln!(self.out, "{line}") {
-            tracing::warn!("cannot write {}: {e}", self.path.display());
+        self.ndjson.write(r);
+        if let Some(m) = &mut self.mcap {
+            m.write(r);
         }
     }
 
     /// Flushes to disk.
     pub fn flush(&mut self) {
-        if let Err(e) = self.out.flush() {
-            tracing::warn!("cannot write {}: {e}", self.path.display());
+        self.ndjson.flush();
+        if let Some(m) = &mut self.mcap {
+            m.flush();
+        }
+    }
+
+    /// Flushes, and ends the MCAP log with its summary: after the last record.
+    pub fn finish(&mut self) {
+        self.ndjson.flush();
+        if let Some(m) = &mut self.mcap {
+            m.finish();
         }
     }
 }
 
-/// A log read back.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Log {
-    /// Its records, in order.
-    pub records: Vec<Record>,
-    /// The number of a last line cut short (no newline, not a whole record), left out: the
-    /// run was stopped while writing it.
-    pub cut_short: Option<usize>,
+/// Where the MCAP log of the NDJSON log `path` goes: beside it, with the extension `.mcap`
+/// (`mission.ndjson` → `mission.mcap`; a log named `….mcap` gets `….mcap.mcap`).
+pub fn mcap_path(path: &Path) -> PathBuf {
+    let beside = path.with_extension("mcap");
+    if beside == path {
+        let mut name = path.as_os_str().to_owned();
+        name.push(".mcap");
+        PathBuf::from(name)
+    } else {
+        beside
+    }
 }
 
-/// Reads a whole log; a bad line is an error naming the file, the line and what is wrong. Only
-/// a last line without its newline that is not a whole record is left out instead (and named
-/// in [`Log::cut_short`]): that is what a run killed mid-write leaves, and the records before
-/// it still tell the mission.
-///
-/// A line longer than [`MAX_LOG_LINE_BYTES`] is an error too, found before more of it is read:
-/// no mission writes one, and a file without newlines (`/dev/zero`) would otherwise fill the
-/// memory.
+/// Reads a whole log, NDJSON ([`ndjson::read`]) or MCAP ([`mcap::read`]), told apart by the
+/// MCAP magic at its start.
 pub fn read(path: &Path) -> anyhow::Result<Log> {
-    read_with_line_limit(path, MAX_LOG_LINE_BYTES)
+    if is_mcap(path)? {
+        self::mcap::read(path)
+    } else {
+        ndjson::read(path)
+    }
 }
 
-/// [`read`] with lines of at most `max_line` bytes.
-fn read_with_line_limit(path: &Path, max_line: usize) -> anyhow::Result<Log> {
-    let file = File::open(path)
+/// Whether the file at `path` starts with the MCAP magic.
+pub fn is_mcap(path: &Path) -> anyhow::Result<bool> {
+    let file = std::fs::File::open(path)
         .with_context(|| format!("cannot open the mission log {}", path.display()))?;
-    let mut reader = BufReader::new(file);
-    let mut records = Vec::new();
-    let mut cut_short = None;
-    let mut bytes = Vec::new();
-    for n in 1.. {
-        bytes.clear();
-        let read = (&mut reader)
-            .take(max_line as u64 + 1)
-            .read_until(b'\n', &mut bytes)
-            .with_context(|| format!("{}: cannot read line {n}", path.display()))?;
-        if read == 0 {
-            break;
-        }
-        if bytes.len() > max_line {
-            anyhow::bail!(
-                "{} line {n}: longer than the limit of {max_line} bytes (limits::MAX_LOG_LINE_BYTES): not a mission log",
-                path.display()
-            );
-        }
-        let Ok(line) = std::str::from_utf8(&bytes) else {
-            anyhow::bail!(
-                "{} line {n}: not UTF-8 text: not a mission log",
-                path.display()
-            );
-        };
-        if line.trim().is_empty() {
-            continue;
-        }
-        match serde_json::from_str::<Record>(line) {
-            Ok(r) => records.push(r),
-            Err(_) if !line.ends_with('\n') => cut_short = Some(n),
-            Err(e) => anyhow::bail!("{} line {n}: not a mission-log record: {e}", path.display()),
-        }
-    }
-    match records.first() {
-        Some(Record::Start(_)) => Ok(Log { records, cut_short }),
-        _ => anyhow::bail!(
-            "{}: a mission log starts with a \"start\" record; this one does not",
-            path.display()
-        ),
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn a_log_reads_back_and_a_bad_line_is_named() -> anyhow::Result<()> {
-        let dir = std::env::temp_dir().join(format!("shoal-log-test-{}", std::process::id()));
-        std::fs::create_dir_all(&dir)?;
-        let path = dir.join("m.ndjson");
-        let start = Record::Start(Start {
-            mission: "m".into(),
-            scenario_toml: "name = \"x\"".into(),
-            common_arrival_s: 100.0,
-            arrival_window_s: 10.0,
-            horizon_s: 60.0,
-            time_scale: 50.0,
-            epoch_unix_ms: 7,
-        });
-        let event = Record::Event(MissionEvent {
-            version: 1,
-            mission: "m".into(),
-            t_s: 3.5,
-            kind: "hold".into(),
-            vehicles: vec!["auv2".into()],
-            detail: "because".into(),
-        });
-        let mut w = LogWriter::create(&path)?;
-        w.write(&start);
-        w.write(&event);
-        w.flush();
-        assert_eq!(read(&path)?.records, vec![start.clone(), event.clone()]);
-        let text = std::fs::read_to_string(&path)?;
-        assert!(text
-            .lines()
-            .next()
-            .unwrap_or("")
-            .contains("\"record\":\"start\""));
-        // Killed mid-write: the last line has no newline and is half a record.
-        let cut = text.len() - 20;
-        std::fs::write(&path, &text[..cut])?;
-        let log = read(&path)?;
-        assert_eq!((log.records, log.cut_short), (vec![start.clone()], Some(2)));
-        // A whole last record without its newline is read.
-        std::fs::write(&path, text.trim_end())?;
-        assert_eq!(read(&path)?.records, vec![start, event]);
-        // The same half record with a newline after it is no cut: an error naming the line.
-        std::fs::write(&path, format!("{}\n{}", &text[..cut], text))?;
-        let e = read(&path).err().map(|e| e.to_string()).unwrap_or_default();
-        assert!(e.contains("line 2") && e.contains("m.ndjson"), "{e}");
-        std::fs::write(&path, format!("{text}{{\"record\": \"nonsense\"}}\n"))?;
-        let e = read(&path).err().map(|e| e.to_string()).unwrap_or_default();
-        assert!(e.contains("line 3") && e.contains("m.ndjson"), "{e}");
-        // A line over the limit is named with its number before the rest of it is read.
-        let limit = text.lines().map(str::len).max().unwrap_or(0) + 1;
-        std::fs::write(&path, &text)?;
-        assert!(read_with_line_limit(&path, limit).is_ok());
-        std::fs::write(&path, format!("{text}{}\n", "x".repeat(limit + 1)))?;
-        let e = read_with_line_limit(&path, limit)
-            .err()
-            .map(|e| e.to_string())
-            .unwrap_or_default();
-        assert!(
-            e.contains("m.ndjson line 3") && e.contains(&format!("limit of {limit} bytes")),
-            "{e}"
-        );
-        std::fs::write(&path, text.lines().nth(1).unwrap_or(""))?;
-        let e = read(&path).err().map(|e| e.to_string()).unwrap_or_default();
-        assert!(e.contains("starts with a \"start\" record"), "{e}");
-        std::fs::remove_dir_all(&dir)?;
-        Ok(())
-    }
+    let mut head = Vec::with_capacity(self::mcap::MAGIC.len());
+    file.take(self::mcap::MAGIC.len() as u64)
+        .read_to_end(&mut head)
+        .with_context(|| format!("cannot read {}", path.display()))?;
+    Ok(head == self::mcap::MAGIC)
 }

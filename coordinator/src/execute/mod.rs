@@ -215,7 +215,7 @@ pub fn execute_trajectories(
         .fleet
         .figures_for(&x.scenario, common_arrival_s, options.arrival_window_s);
     x.log.write(&Record::End(figures.clone()));
-    x.log.flush();
+    x.log.finish();
     let report = ExecutionReport {
         figures,
         replans: x.replans,

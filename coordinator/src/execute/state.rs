@@ -42,7 +42,7 @@ pub struct ExecOptions {
     pub replan_budget: Duration,
     /// Half-width of the arrival window around the common arrival, mission seconds.
     pub arrival_window_s: f64,
-    /// The mission log (NDJSON).
+    /// The mission log (NDJSON; the MCAP log goes beside it, see [`super::log::mcap_path`]).
     pub log: PathBuf,
     /// Obstacles to publish at given mission times (tests and figures: an obstacle appearing
     /// on a vehicle's path mid-mission), as any client would.

@@ -260,7 +260,7 @@ pub struct ExecutionSettings {
     pub position_noise_m: f64,
     /// Obstacles published during the execution.
     pub inject: Vec<Injection>,
-    /// The mission log (`None`: `<out>/mission.ndjson`).
+    /// The mission log (`None`: `<out>/mission.ndjson`; the MCAP log goes beside it).
     pub log: Option<PathBuf>,
 }
 

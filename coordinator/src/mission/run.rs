@@ -1,6 +1,7 @@
 //! Planning a mission, then executing the plan with one agent per vehicle driving it through
 //! its vehicle link, and reporting the execution's figures (`<out>/execution.json`, the
-//! mission log `<out>/mission.ndjson`): what `run` does, and each mission `serve` takes.
+//! mission log `<out>/mission.ndjson` and its MCAP copy `mission.mcap`): what `run` does, and
+//! each mission `serve` takes.
 
 use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
@@ -248,7 +249,17 @@ pub fn run_mission(options: &RunOptions, shutdown: Arc<AtomicBool>) -> anyhow::R
     let json = serde_json::to_string_pretty(&report).context("cannot serialise the execution")?;
     std::fs::write(&path, json).with_context(|| format!("cannot write {}", path.display()))?;
     say(&execution_summary(&report));
-    say(&format!("Wrote {} and {}\n", path.display(), log.display()));
+    let mcap = execute::log::mcap_path(&log);
+    if mcap.is_file() {
+        say(&format!(
+            "Wrote {}, {} and {}\n",
+            path.display(),
+            log.display(),
+            mcap.display()
+        ));
+    } else {
+        say(&format!("Wrote {} and {}\n", path.display(), log.display()));
+    }
     Ok(execution_ok(&report))
 }
 

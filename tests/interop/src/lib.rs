@@ -1,6 +1,6 @@
 //! The Python interpreter of Shoal's interop tests, which check Shoal against implementations
-//! nobody here wrote (eclipse-zenoh, pymavlink, MAVSDK, geojson, shapely; pinned in
-//! `tests/python/requirements.txt`).
+//! nobody here wrote (eclipse-zenoh, pymavlink, MAVSDK, geojson, shapely, mcap, jsonschema;
+//! pinned in `tests/python/requirements.txt`).
 //!
 //! `$SHOAL_INTEROP_PYTHON` names it when set. Otherwise the first test to ask makes a venv
 //! under the workspace's `target/interop-venv` with the pinned packages (one test binary at a

@@ -1,6 +1,6 @@
 //! `shoal-coordinator run <SCENARIO>`: plan (as `plan` does), then execute the plan with one
 //! agent per vehicle driving it through its vehicle link, and report the execution's figures
-//! (`<out>/execution.json`, the mission log `<out>/mission.ndjson`); see
+//! (`<out>/execution.json`, the mission log `<out>/mission.ndjson` and `<out>/mission.mcap`); see
 //! [`crate::mission::run_mission`].
 
 use std::path::PathBuf;
@@ -52,7 +52,8 @@ pub struct RunArgs {
     /// 150 s of mission time after T. Repeatable.
     #[arg(long = "inject-obstacle", value_parser = parse_injection)]
     pub inject: Vec<Injection>,
-    /// The mission log (default: `<out>/mission.ndjson`).
+    /// The mission log (default: `<out>/mission.ndjson`); its MCAP copy goes beside it, with
+    /// the extension `.mcap`.
     #[arg(long, env = "SHOAL_LOG")]
     pub log: Option<PathBuf>,
 }
