@@ -5,16 +5,16 @@
 //! measures its planners against each other by, here measured against a reference nobody's
 //! swarm made.
 //!
-//! Dijkstra on a lattice of `cell` metres aligned with the start, with the moves `(i, j, k)`,
-//! `|i|, |j| ≤ 3`, `|k| ≤ 1`, `gcd = 1`, whose pitch is within the vehicle's limits (the
-//! steepest is 19.5°, so a 20° limit is nearly reached). A search state is a lattice point and
-//! the move that led there, and a move may follow another only when an arc of the turning radius
-//! of eq. (5) fits the corner ([`corner_fits`]). A move costs the work of eq. (10)–(11) summed over sub-steps of at most one cell
-//! (the same [`EnergyModel::segment_work`](super::EnergyModel::segment_work) the plan's figures
-//! use) and its length, weighed by [`measure`]; it is admissible when every sub-step point is inside the bounds, outside
-//! every hard sphere and the terrain clearance above the seabed. The lattice path is then
-//! string-pulled: a straight shortcut replaces a stretch when it is admissible, costs less and
-//! its corners at both ends fit the turning radius.
+//! Dijkstra on a lattice of `cell` metres aligned with the start, with the moves `(i, j, k)`, `|i|,
+//! |j| ≤ 3`, `|k| ≤ 1`, `gcd = 1`, whose pitch is within the vehicle's limits (the steepest is
+//! 19.5°, so a 20° limit is nearly reached). A search state is a lattice point and the move that
+//! led there, and a move may follow another only when an arc of the turning radius of eq. (5) fits
+//! the corner (`corner_fits`). A move costs the work of eq. (10)–(11) summed over sub-steps of at
+//! most one cell (the same [`EnergyModel::segment_work`](super::EnergyModel::segment_work) the
+//! plan's figures use) and its length, weighed by [`measure`]; it is admissible when every sub-step
+//! point is inside the bounds, outside every hard sphere and the terrain clearance above the
+//! seabed. The lattice path is then string-pulled: a straight shortcut replaces a stretch when it
+//! is admissible, costs less and its corners at both ends fit the turning radius.
 //!
 //! The reference is a polyline whose corners keep the radius, where the plan is a spline: its
 //! stretches follow the lattice's directions before the string pulling, which can make it

@@ -15,7 +15,7 @@
 //!
 //! Hand-written rather than taken from `argmin`: its line searches do not keep a position inside
 //! box bounds, and this search must also stop on a flag and within an evaluation budget; the
-//! method is a hundred lines of [`Run`].
+//! method is a hundred lines of `Run`.
 
 use std::sync::atomic::{AtomicBool, Ordering};
 
