@@ -16,15 +16,17 @@ use crate::queue::Cheapest;
 
 use crate::terrain::{Hazard, Terrain};
 
+/// Greatest common divisor of two non-negative integers (a lattice move's reduced form).
+pub(crate) fn gcd(a: i64, b: i64) -> i64 {
+    if b == 0 {
+        a
+    } else {
+        gcd(b, a % b)
+    }
+}
+
 /// The moves: every `(i, j)` with `|i|, |j| ≤ 3`, not both 0, `gcd(|i|, |j|) = 1`.
 fn moves() -> Vec<(i64, i64)> {
-    fn gcd(a: i64, b: i64) -> i64 {
-        if b == 0 {
-            a
-        } else {
-            gcd(b, a % b)
-        }
-    }
     let mut out = Vec::new();
     for i in -3i64..=3 {
         for j in -3i64..=3 {

@@ -24,6 +24,7 @@ use std::collections::BinaryHeap;
 
 use super::problem::{EnergyProblem, Objective};
 use crate::geometry::Vec3;
+use crate::gridsearch::gcd;
 use crate::queue::Cheapest;
 use crate::swarm::Problem;
 
@@ -146,13 +147,6 @@ pub fn measure(problem: &EnergyProblem, length_m: f64, energy_j: f64) -> f64 {
 
 /// The lattice moves within the pitch range `(lo, hi)` degrees.
 fn moves(pitch_range: (f64, f64)) -> Vec<[i64; 3]> {
-    fn gcd(a: i64, b: i64) -> i64 {
-        if b == 0 {
-            a
-        } else {
-            gcd(b, a % b)
-        }
-    }
     let mut out = Vec::new();
     for i in -3i64..=3 {
         for j in -3i64..=3 {
@@ -373,31 +367,15 @@ fn pulled(lattice: &Lattice, points: Vec<Vec3>) -> Vec<Vec3> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::fixtures::vehicle_toml;
     use crate::scenario::Scenario;
 
     fn scenario(extra: &str) -> Scenario {
         let text = format!(
-            r#"
-name = "reference"
-[bounds]
-min = [0.0, 0.0, 0.0]
-max = [100.0, 100.0, 100.0]
-[[vehicles]]
-id = "auv1"
-kind = "auv"
-start = [10.0, 50.0, 50.0]
-goal = [90.0, 50.0, 50.0]
-speed_min_mps = 0.5
-speed_max_mps = 3.0
-max_turn_deg = 30.0
-max_pitch_deg = 20.0
-[fleet]
-d_min_m = 0.0
-mission_time_s = 300.0
-[optimizer]
-algorithm = "epa-pso"
-{extra}
-"#
+            "name = \"reference\"\n[bounds]\nmin = [0.0, 0.0, 0.0]\nmax = [100.0, 100.0, 100.0]\n\
+             {}[fleet]\nd_min_m = 0.0\nmission_time_s = 300.0\n[optimizer]\n\
+             algorithm = \"epa-pso\"\n{extra}",
+            vehicle_toml("auv1", [10.0, 50.0, 50.0], [90.0, 50.0, 50.0])
         );
         match Scenario::parse(&text, std::path::Path::new("reference.toml")) {
             Ok(s) => s,
@@ -413,8 +391,8 @@ algorithm = "epa-pso"
         let Some(r) = r else { panic!("no reference") };
         assert!((r.length_m - 80.0).abs() < 1e-9, "{r:?}");
         assert_eq!(r.points.len(), 2, "{r:?}");
-        // Level flight, no current, at the ground speed (the top speed, 3 m/s, without an
-        // [energy] table) for 80/3 s: X_R(0) · 3 m/s · 80/3 s = 5.3 × 80 = 424 J.
+        // Level flight, no current, at any ground speed v for 80 / v seconds:
+        // X_R(0) · v · 80 / v = 5.3 N × 80 m = 424 J.
         assert!((r.energy_j - 424.0).abs() < 1e-9, "{r:?}");
     }
 
