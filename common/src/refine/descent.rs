@@ -180,7 +180,8 @@ impl<'a> Run<'a> {
     /// One compass sweep: each coordinate moved by `probe` of its range up, else down, kept
     /// where it lowers the cost. Whether any move was kept.
     fn compass(&mut self, x: &mut [f64], f: &mut f64, probe: f64) -> bool {
-        let (lo, hi) = (self.problem.lower().to_vec(), self.problem.upper().to_vec());
+        let problem = self.problem;
+        let (lo, hi) = (problem.lower(), problem.upper());
         let mut kept = false;
         for d in 0..x.len() {
             let here = x[d];
@@ -221,7 +222,8 @@ impl<'a> Run<'a> {
 
     /// Central differences, one-sided at a bound.
     fn gradient(&mut self, x: &[f64]) -> Vec<f64> {
-        let (lo, hi) = (self.problem.lower().to_vec(), self.problem.upper().to_vec());
+        let problem = self.problem;
+        let (lo, hi) = (problem.lower(), problem.upper());
         let mut probe = x.to_vec();
         let mut g = vec![0.0; x.len()];
         for d in 0..x.len() {
