@@ -115,6 +115,7 @@ mod tests {
             inject: Vec::new(),
             quiet: true,
             seed: 1,
+            live: None,
         };
         // (0.3 s + 0.25 s) · 500 = 275 s of lead.
         assert!((update_lead_s(o.replan_budget, o.time_scale) - 275.0).abs() < 1e-9);

@@ -15,11 +15,13 @@ mod record;
 
 use std::io::Read as _;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 use anyhow::Context as _;
 
 use self::mcap::McapWriter;
 use self::ndjson::NdjsonWriter;
+use super::live::{LiveFeed, LiveMessage};
 pub use self::record::{CutShort, Log, Record, Start};
 
 /// The event kind of a vehicle declared lost (its `vehicles` names it).
@@ -42,6 +44,8 @@ pub struct LogWriter {
     ndjson: NdjsonWriter,
     /// The MCAP log; `None` when it could not be created (a warning; the mission goes on).
     mcap: Option<McapWriter>,
+    /// Live watchers, who get every record written (see [`super::live`]).
+    live: Option<Arc<LiveFeed>>,
 }
 
 impl LogWriter {
@@ -51,7 +55,17 @@ impl LogWriter {
         let mcap = McapWriter::create(&mcap_path(path))
             .map_err(|e| tracing::warn!("{e:#}; the mission goes on with the NDJSON log alone"))
             .ok();
-        Ok(LogWriter { ndjson, mcap })
+        Ok(LogWriter {
+            ndjson,
+            mcap,
+            live: None,
+        })
+    }
+
+    /// Also hands every record written from now on to `feed`.
+    pub fn with_live(mut self, feed: Option<Arc<LiveFeed>>) -> LogWriter {
+        self.live = feed;
+        self
     }
 
     /// Writes one record (a failure is logged, not fatal: the mission goes on).
@@ -59,6 +73,9 @@ impl LogWriter {
         self.ndjson.write(r);
         if let Some(m) = &mut self.mcap {
             m.write(r);
+        }
+        if let Some(feed) = &self.live {
+            feed.publish(LiveMessage::Record(r.clone()));
         }
     }
 

@@ -12,6 +12,7 @@ pub mod fleet;
 mod ground;
 mod keep_out;
 mod lead;
+pub mod live;
 pub mod log;
 pub mod plausible;
 mod queue;
@@ -160,7 +161,7 @@ pub fn execute_trajectories(
         .map_err(|e| anyhow::anyhow!("cannot declare the queryable {status_key}: {e}"))?;
     // Built before the mission clock starts: a large map takes a moment.
     let ground = crawler_ground(scenario).map(Arc::new);
-    let log = LogWriter::create(&options.log)?;
+    let log = LogWriter::create(&options.log)?.with_live(options.live.clone());
     let epoch_unix_ms = unix_us() / 1000 + 1500;
     let mut x = Exec {
         scenario: scenario.clone(),
@@ -314,6 +315,9 @@ fn run_loop(
             }
             if let Ok(key) = topics::open_key(&x.mission, OpenKey::Status) {
                 x.put_json(&key, &status);
+            }
+            if let Some(feed) = &o.live {
+                feed.publish(live::LiveMessage::Status(status.clone()));
             }
             if !o.quiet {
                 eprintln!("{}", react::progress_line(&status, x.fleet.reports));

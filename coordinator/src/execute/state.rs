@@ -16,6 +16,7 @@ use shoal_common::wire::WireTrajectory;
 use zenoh::Wait;
 
 use super::fleet::Fleet;
+use super::live::LiveFeed;
 use super::log::{LogWriter, Record};
 use super::plausible::Guard;
 use super::queue::ReplanQueue;
@@ -51,6 +52,9 @@ pub struct ExecOptions {
     pub quiet: bool,
     /// RNG seed (simulated noise, replanning).
     pub seed: u64,
+    /// Live watchers' feed (the web view, the Foxglove server): every log record and each
+    /// published status; `None` when nobody watches.
+    pub live: Option<Arc<LiveFeed>>,
 }
 
 /// Everything the execution loop shares.

@@ -262,6 +262,8 @@ pub struct ExecutionSettings {
     pub inject: Vec<Injection>,
     /// The mission log (`None`: `<out>/mission.ndjson`; the MCAP log goes beside it).
     pub log: Option<PathBuf>,
+    /// Live watchers' feed (see [`crate::execute::live`]); `None` when nobody watches.
+    pub live: Option<std::sync::Arc<crate::execute::live::LiveFeed>>,
 }
 
 impl ExecutionSettings {
@@ -278,6 +280,7 @@ impl ExecutionSettings {
         position_noise_m: 1.0,
         inject: Vec::new(),
         log: None,
+        live: None,
     };
 }
 

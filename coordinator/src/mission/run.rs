@@ -229,6 +229,7 @@ pub fn run_mission(options: &RunOptions, shutdown: Arc<AtomicBool>) -> anyhow::R
         )?,
         quiet: m.quiet,
         seed: scenario.optimizer.seed,
+        live: e.live.clone(),
     };
     eprintln!(
         "executing mission {} at {}× real time ({} vehicles, telemetry {} Hz)",

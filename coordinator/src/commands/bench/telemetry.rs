@@ -81,6 +81,7 @@ pub fn command(args: &BenchTelemetryArgs, stop: &AtomicBool) -> anyhow::Result<i
         inject: Vec::new(),
         quiet: true,
         seed: 1,
+        live: None,
     };
     eprintln!(
         "bench-telemetry: {n} vehicles at {} Hz for about {:.0} s ({time_scale:.1}× real time)",

@@ -103,6 +103,7 @@ impl RunArgs {
                 position_noise_m: self.position_noise,
                 inject: self.inject.clone(),
                 log: self.log.clone(),
+                live: None,
             },
         })
     }
