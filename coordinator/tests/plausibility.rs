@@ -180,6 +180,7 @@ fn a_forged_far_fix_and_a_replayed_hold_leave_the_mission_met_and_are_counted() 
         inject: Vec::new(),
         quiet: true,
         seed: 1,
+        live: None,
     };
     let report = execute_trajectories(
         &s,

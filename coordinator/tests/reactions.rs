@@ -138,6 +138,7 @@ fn settings(
         inject: Vec::new(),
         quiet: true,
         seed: 1,
+        live: None,
     };
     (distributed, options)
 }
