@@ -81,10 +81,8 @@ impl FleetModel {
     /// Appends an initial chromosome for vehicle `i` to `x` (see [`Problem::sample`] above for
     /// how it is drawn); a vehicle agent samples its own chromosome alone with it.
     pub fn sample_chromosome(&self, i: usize, rng: &mut StdRng, x: &mut Vec<f64>) {
-        let s = &self.scenario;
         let m = self.layout.waypoints;
-        let v = &s.vehicles[i];
-        let (a, b) = (v.start(), v.goal());
+        let v = &self.scenario.vehicles[i];
         let span = self.straight[i].max(1.0);
         let shape: Vec<Vec3> = (1..=3)
             .map(|k| {
@@ -95,25 +93,50 @@ impl FleetModel {
                 ) / k as f64
             })
             .collect();
-        let d = b - a;
+        let d = v.goal() - v.start();
         let needed = required_horizontal_length(v);
-        let amp = if needed > (d.x * d.x + d.y * d.y).sqrt() * (1.0 + 1e-9) {
-            let target = needed * rng.random_range(1.02..=1.25);
-            bend_for_length(a, b, m, &shape, target, 2.0 * span)
+        let bend = if needed > (d.x * d.x + d.y * d.y).sqrt() * (1.0 + 1e-9) {
+            Bend::Covering(needed * rng.random_range(1.02..=1.25))
         } else {
-            rng.random_range(0.02..=0.5) * span
+            Bend::Amplitude(rng.random_range(0.02..=0.5) * span)
+        };
+        self.bent_waypoints(i, &shape, bend, x);
+        x.extend((0..m).map(|_| rng.random_range(v.speed_min_mps..=v.speed_max_mps)));
+        debug_assert_eq!(x.len() % (m * GENES_PER_WAYPOINT), 0);
+    }
+
+    /// Appends vehicle `i`'s waypoint genes (not its speeds) along its straight line bent by
+    /// the sine harmonics `shape` (see [`bent_curve`]), as big as `bend` says, each gene
+    /// clamped to its bounds.
+    pub fn bent_waypoints(&self, i: usize, shape: &[Vec3], bend: Bend, x: &mut Vec<f64>) {
+        let m = self.layout.waypoints;
+        let v = &self.scenario.vehicles[i];
+        let (a, b) = (v.start(), v.goal());
+        let amp = match bend {
+            Bend::Amplitude(amp) => amp,
+            Bend::Covering(target) => {
+                bend_for_length(a, b, m, shape, target, 2.0 * self.straight[i].max(1.0))
+            }
         };
         // The chromosome's own bounds: a crawler's z genes are pinned.
         let first = self.layout.chromosome(i).start;
-        for (j, p) in bent_curve(a, b, m, &shape, amp)[1..=m].iter().enumerate() {
+        for (j, p) in bent_curve(a, b, m, shape, amp)[1..=m].iter().enumerate() {
             for d in 0..3 {
                 let g = first + 3 * j + d;
                 x.push(p[d].clamp(self.lower[g], self.upper[g]));
             }
         }
-        x.extend((0..m).map(|_| rng.random_range(v.speed_min_mps..=v.speed_max_mps)));
-        debug_assert_eq!(x.len() % (m * GENES_PER_WAYPOINT), 0);
     }
+}
+
+/// How far a bent path strays from the straight line.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Bend {
+    /// The bend's amplitude, metres.
+    Amplitude(f64),
+    /// The horizontal distance the path covers, metres (the amplitude is solved for it, up to
+    /// twice the straight distance).
+    Covering(f64),
 }
 
 /// The straight line `a→b` at `m + 2` stations (ends included) bent by `amp · Σ shape_k sin(kπf)`,

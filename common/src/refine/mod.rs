@@ -37,6 +37,7 @@
 pub mod constraints;
 pub mod descent;
 mod objective;
+pub mod pitch_routes;
 pub mod qp;
 pub mod reroute;
 mod search;
@@ -149,6 +150,12 @@ pub fn refine(
         if search.interrupted {
             break;
         }
+        tighten_if_long(&mut search, i);
+    }
+    for &i in &swimmers {
+        if search.interrupted {
+            break;
+        }
         reroute_if_late(&mut search, i);
     }
     search.settings = &fine;
@@ -249,9 +256,55 @@ fn reroute_if_late(search: &mut Search<FleetArena>, i: usize) {
     };
     let (genes, spent) = reroute::fresh_route(model, &search.x, i, search.target, &executor);
     search.evaluations += spent;
+    let mut trial = search.x.clone();
+    trial[model.layout.chromosome(i)].copy_from_slice(&genes);
+    try_way(search, i, trial);
+}
+
+/// When vehicle `i`'s path is more than [`pitch_routes::SLACK`] longer than its pitch limit
+/// allows, [`pitch_routes::DRAWN`] fresh ways at that bound are scored by the merit and the best
+/// [`pitch_routes::TRIED`] refined ([`try_way`]).
+fn tighten_if_long(search: &mut Search<FleetArena>, i: usize) {
+    let model = search.arena.model;
+    let v = &model.scenario.vehicles[i];
+    let length = polyline_length(&search.eval.trajectories[i].points);
+    if length <= shortest_pitch_feasible_length(v) * (1.0 + pitch_routes::SLACK) {
+        return;
+    }
+    let genes = model.layout.chromosome(i);
+    let speeds = search.x[genes.start + 3 * model.layout.waypoints..genes.end].to_vec();
+    let seed = crate::swarm::population::stream_seed(
+        model.scenario.optimizer.seed,
+        9_100_001 + i as u64,
+    );
+    let mut rng = <rand::rngs::StdRng as rand::SeedableRng>::seed_from_u64(seed);
+    let mut scored: Vec<(f64, Vec<f64>)> =
+        pitch_routes::drawn_ways(model, i, &speeds, pitch_routes::DRAWN, &mut rng)
+            .into_iter()
+            .map(|way| {
+                let mut trial = search.x.clone();
+                trial[genes.clone()].copy_from_slice(&way);
+                let e = search.arena.evaluate_change(&search.eval, &trial, i);
+                (search.arena.merit(&e), trial)
+            })
+            .collect();
+    search.evaluations += scored.len() as u64;
+    scored.sort_by(|a, b| a.0.total_cmp(&b.0));
+    for (_, trial) in scored.into_iter().take(pitch_routes::TRIED) {
+        if search.interrupted {
+            return;
+        }
+        try_way(search, i, trial);
+    }
+}
+
+/// Moves to fleet position `trial` (a new way for vehicle `i` alone), refines vehicle `i` there
+/// for the settings' rounds, and goes back unless that lowered the merit.
+fn try_way(search: &mut Search<FleetArena>, i: usize, trial: Vec<f64>) {
+    let model = search.arena.model;
     let kept = (search.x.clone(), search.eval.clone(), search.steps);
-    search.x[model.layout.chromosome(i)].copy_from_slice(&genes);
-    search.eval = model.evaluate(&search.x);
+    search.eval = model.evaluate(&trial);
+    search.x = trial;
     search.evaluations += 1;
     search.steps += 1;
     for _ in 0..search.settings.rounds {
