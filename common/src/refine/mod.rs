@@ -26,8 +26,11 @@
 //!
 //! The target arrival is the mission time when every vehicle's pitch limit lets it arrive by
 //! then ([`target_arrival`]), so a fleet the swarm left late is pulled back on time where the
-//! paths allow it: a vehicle still late gets a fresh route of its own ([`reroute`]), and then a
-//! last pass with margins a tenth as wide (it may be pressed against several limits at once).
+//! paths allow it. A local search keeps the way round the obstacles the swarm chose, which can be
+//! longer than needed: a vehicle left more than 1 % over the length its pitch limit allows is
+//! offered fresh ways at that bound ([`pitch_routes`]), and one still late a fresh route of its
+//! own ([`reroute`]); each is pulled tight and kept only if it lowers the merit. Then a last pass
+//! with margins a tenth as wide (a late vehicle may be pressed against several limits at once).
 //! Crawlers (their path is a B-spline draped on the seabed) are left as they are: a gradient
 //! descent of the fleet's fitness over a crawler's genes ([`descent`], which refines energy
 //! plans and inspection legs) lowered the seabed scenarios' fitness by less than 10⁻⁵ for
@@ -273,10 +276,8 @@ fn tighten_if_long(search: &mut Search<FleetArena>, i: usize) {
     }
     let genes = model.layout.chromosome(i);
     let speeds = search.x[genes.start + 3 * model.layout.waypoints..genes.end].to_vec();
-    let seed = crate::swarm::population::stream_seed(
-        model.scenario.optimizer.seed,
-        9_100_001 + i as u64,
-    );
+    let seed =
+        crate::swarm::population::stream_seed(model.scenario.optimizer.seed, 9_100_001 + i as u64);
     let mut rng = <rand::rngs::StdRng as rand::SeedableRng>::seed_from_u64(seed);
     let mut scored: Vec<(f64, Vec<f64>)> =
         pitch_routes::drawn_ways(model, i, &speeds, pitch_routes::DRAWN, &mut rng)

@@ -52,8 +52,11 @@ pub fn drawn_ways(
         .map(|_| {
             let shape: Vec<Vec3> = (1..=3)
                 .map(|k| {
-                    Vec3::new(rng.random_range(-1.0..=1.0), rng.random_range(-1.0..=1.0), 0.0)
-                        / k as f64
+                    Vec3::new(
+                        rng.random_range(-1.0..=1.0),
+                        rng.random_range(-1.0..=1.0),
+                        0.0,
+                    ) / k as f64
                 })
                 .collect();
             let target = needed * (1.0 + SPREAD * rng.random::<f64>());
@@ -82,7 +85,8 @@ mod tests {
              [fleet]\nd_min_m = 50.0\nmission_time_s = 1000.0\n[optimizer]\nwaypoints = 10\n",
             crate::fixtures::vehicle_toml("a", [800.0, 1000.0, 600.0], [1200.0, 1000.0, 300.0])
         );
-        let s = Scenario::parse(&text, std::path::Path::new("t.toml")).map_err(|e| e.to_string())?;
+        let s =
+            Scenario::parse(&text, std::path::Path::new("t.toml")).map_err(|e| e.to_string())?;
         let model = FleetModel::new(&s);
         let v = &s.vehicles[0];
         assert!((v.max_pitch_deg - 20.0).abs() < 1e-9, "{}", v.max_pitch_deg);
