@@ -19,6 +19,7 @@ mod queue;
 mod react;
 mod repair;
 pub mod replan;
+pub mod replayed;
 mod replan_queue;
 mod standing;
 mod state;
