@@ -54,12 +54,15 @@ function apply(m) {
   switch (m.kind) {
     case "hello": S.mode = m.mode; break;
     case "reset": reset(); break;
-    case "scene":
+    case "scene": {
+      const caughtUp = S.caughtUp;   // a mission starting while the page watches
       reset();
+      S.caughtUp = caughtUp;
       S.scene = m;
       S.obstacles = (m.obstacles || []).map(o => Object.assign({ published: false }, o));
       m.vehicles.forEach(vehicle);
       break;
+    }
     case "plan":
       S.revision = m.plan.revision;
       for (const [id, samples] of m.plan.trajectories) { S.plans[id] = samples; vehicle(id); }
