@@ -29,7 +29,12 @@ fn artefacts() -> PathBuf {
     Path::new(env!("CARGO_TARGET_TMPDIR")).join("live_view")
 }
 
-fn browser_steps(fleet: &mut Fleet, url: &str, out: &Path, mode: &str) -> Result<BTreeMap<String, Value>, Box<dyn std::error::Error>> {
+fn browser_steps(
+    fleet: &mut Fleet,
+    url: &str,
+    out: &Path,
+    mode: &str,
+) -> Result<BTreeMap<String, Value>, Box<dyn std::error::Error>> {
     let python = interop_python()?;
     let chromium = shoal_interop::chromium()?;
     let mut cmd = Command::new(python);
@@ -79,12 +84,24 @@ fn check_vehicles(step: &Value, log: &[Value], vehicles: usize) {
             .unwrap_or_else(|| panic!("{id} drawn with report {seq:?}, which is not in the log"));
         let p = &logged["telemetry"]["state"]["position"];
         for (k, axis) in ["x", "y", "z"].iter().enumerate() {
-            let (shown, want) = (d[axis].as_f64().unwrap_or(f64::NAN), p[k].as_f64().unwrap_or(f64::NAN));
-            assert!((shown - want).abs() < 1e-6, "{id} {axis}: drawn {shown}, logged {want}");
+            let (shown, want) = (
+                d[axis].as_f64().unwrap_or(f64::NAN),
+                p[k].as_f64().unwrap_or(f64::NAN),
+            );
+            assert!(
+                (shown - want).abs() < 1e-6,
+                "{id} {axis}: drawn {shown}, logged {want}"
+            );
         }
         // Drawn where it says: the top view's circle at (x, -y).
-        assert!((d["cx"].as_f64().unwrap_or(f64::NAN) - p[0].as_f64().unwrap_or(0.0)).abs() < 1e-6, "{d}");
-        assert!((d["cy"].as_f64().unwrap_or(f64::NAN) + p[1].as_f64().unwrap_or(0.0)).abs() < 1e-6, "{d}");
+        assert!(
+            (d["cx"].as_f64().unwrap_or(f64::NAN) - p[0].as_f64().unwrap_or(0.0)).abs() < 1e-6,
+            "{d}"
+        );
+        assert!(
+            (d["cy"].as_f64().unwrap_or(f64::NAN) + p[1].as_f64().unwrap_or(0.0)).abs() < 1e-6,
+            "{d}"
+        );
         let drawn_at = logged["received_unix_us"].as_u64().unwrap_or(0);
         let newest = reports
             .iter()
@@ -114,9 +131,18 @@ fn check_obstacle(s: &Value, log: &[Value]) {
             .iter()
             .find(|o| o["id"] == d["id"])
             .unwrap_or_else(|| panic!("drawn {d}, not in the log"));
-        assert!((d["cx"].as_f64().unwrap_or(f64::NAN) - o["centre"][0].as_f64().unwrap_or(0.0)).abs() < 1e-6);
-        assert!((d["cy"].as_f64().unwrap_or(f64::NAN) + o["centre"][1].as_f64().unwrap_or(0.0)).abs() < 1e-6);
-        assert!((d["r"].as_f64().unwrap_or(f64::NAN) - o["radius_m"].as_f64().unwrap_or(0.0)).abs() < 1e-6);
+        assert!(
+            (d["cx"].as_f64().unwrap_or(f64::NAN) - o["centre"][0].as_f64().unwrap_or(0.0)).abs()
+                < 1e-6
+        );
+        assert!(
+            (d["cy"].as_f64().unwrap_or(f64::NAN) + o["centre"][1].as_f64().unwrap_or(0.0)).abs()
+                < 1e-6
+        );
+        assert!(
+            (d["r"].as_f64().unwrap_or(f64::NAN) - o["radius_m"].as_f64().unwrap_or(0.0)).abs()
+                < 1e-6
+        );
     }
 }
 
@@ -131,7 +157,10 @@ fn check_predicted(s: &Value, d_min: f64) {
     assert_eq!(line["vehicles"].as_array().map(Vec::len), Some(2), "{s}");
     for k in ["x1", "x2"] {
         let x = line[k].as_f64().unwrap_or(f64::NAN);
-        assert!((0.0..=2000.0).contains(&x), "{k} = {x} is outside the box: {s}");
+        assert!(
+            (0.0..=2000.0).contains(&x),
+            "{k} = {x} is outside the box: {s}"
+        );
     }
 }
 
@@ -152,25 +181,52 @@ fn the_live_view_shows_the_mission_in_a_real_browser_and_replays_it() -> TestRes
         .arg("run")
         .arg(scenario("amp-pso-3"))
         .args(["--in-process", "-q", "--time-scale", "50"])
-        .args(["--iterations", "30", "--populations", "4", "--particles", "20"])
+        .args([
+            "--iterations",
+            "30",
+            "--populations",
+            "4",
+            "--particles",
+            "20",
+        ])
         .args(["--inject-obstacle", "600:auv2,40", "--view", &addr, "--out"])
         .arg(&out);
     let run = fleet.spawn("coordinator", cmd);
-    fleet.wait_for_stderr(run, "live view: http://", Instant::now() + Duration::from_secs(60));
-    let steps = browser_steps(&mut fleet, &format!("http://{addr}/"), &shots.join("live"), "live")?;
+    fleet.wait_for_stderr(
+        run,
+        "live view: http://",
+        Instant::now() + Duration::from_secs(60),
+    );
+    let steps = browser_steps(
+        &mut fleet,
+        &format!("http://{addr}/"),
+        &shots.join("live"),
+        "live",
+    )?;
     let r = fleet.wait(run, Instant::now() + LIMIT);
     assert!(matches!(r.code(), Some(0 | 3)), "{r}");
 
     let log = read_log(&out.join("mission.ndjson"))?;
-    let step = |name: &str| steps.get(name).unwrap_or_else(|| panic!("no step {name}: {steps:?}"));
+    let step = |name: &str| {
+        steps
+            .get(name)
+            .unwrap_or_else(|| panic!("no step {name}: {steps:?}"))
+    };
     check_vehicles(step("vehicles"), &log, 5);
     check_predicted(&step("predicted")["summary"], 50.0);
     check_obstacle(&step("obstacle")["summary"], &log);
     for again in ["reconnected", "reloaded"] {
         let s = &step(again)["summary"];
         check_obstacle(s, &log);
-        assert_eq!(s["vehicles"].as_array().map(Vec::len), Some(5), "{again}: {s}");
-        assert!(s["caughtUp"] == true && s["mission"].is_string(), "{again}: {s}");
+        assert_eq!(
+            s["vehicles"].as_array().map(Vec::len),
+            Some(5),
+            "{again}: {s}"
+        );
+        assert!(
+            s["caughtUp"] == true && s["mission"].is_string(),
+            "{again}: {s}"
+        );
     }
     assert!(step("reconnected")["summary"]["connections"].as_u64() >= Some(2));
     assert_eq!(step("reloaded")["summary"]["connections"].as_u64(), Some(1));
@@ -185,8 +241,17 @@ fn the_live_view_shows_the_mission_in_a_real_browser_and_replays_it() -> TestRes
         .arg(out.join("mission.ndjson"))
         .args(["--view", &addr]);
     let replay = fleet.spawn("replay", cmd);
-    fleet.wait_for_stderr(replay, "replay view: http://", Instant::now() + Duration::from_secs(60));
-    let steps = browser_steps(&mut fleet, &format!("http://{addr}/"), &shots.join("replay"), "replay")?;
+    fleet.wait_for_stderr(
+        replay,
+        "replay view: http://",
+        Instant::now() + Duration::from_secs(60),
+    );
+    let steps = browser_steps(
+        &mut fleet,
+        &format!("http://{addr}/"),
+        &shots.join("replay"),
+        "replay",
+    )?;
     let end = &steps["replay-end"]["summary"];
     assert_eq!(end["vehicles"].as_array().map(Vec::len), Some(5), "{end}");
     check_obstacle(end, &log);
@@ -194,12 +259,23 @@ fn the_live_view_shows_the_mission_in_a_real_browser_and_replays_it() -> TestRes
     let middle = &steps["replay-middle"]["summary"];
     let t = middle["t_s"].as_f64().unwrap_or(f64::NAN);
     for d in middle["vehicles"].as_array().cloned().unwrap_or_default() {
-        assert!(d["t_s"].as_f64().is_some_and(|f| f <= t), "{d} drawn after the slider's {t}");
+        assert!(
+            d["t_s"].as_f64().is_some_and(|f| f <= t),
+            "{d} drawn after the slider's {t}"
+        );
     }
     fleet.kill(replay);
-    for shot in ["live/vehicles.png", "live/obstacle.png", "live/reloaded.png", "replay/replay-middle.png"] {
+    for shot in [
+        "live/vehicles.png",
+        "live/obstacle.png",
+        "live/reloaded.png",
+        "replay/replay-middle.png",
+    ] {
         let bytes = std::fs::read(shots.join(shot))?;
-        assert!(bytes.starts_with(b"\x89PNG\r\n\x1a\n"), "{shot} is not a PNG");
+        assert!(
+            bytes.starts_with(b"\x89PNG\r\n\x1a\n"),
+            "{shot} is not a PNG"
+        );
     }
     fleet.passed();
     Ok(())

@@ -14,9 +14,9 @@ use shoal_common::scenario::{Obstacle, ObstacleKind, Scenario};
 use shoal_common::trajectory::Trajectory;
 use shoal_common::wire::open::MissionEvent;
 
+use crate::execute;
 use crate::execute::fleet::ExecutionFigures;
 use crate::execute::log;
-use crate::execute;
 use crate::execute::verdict;
 use crate::report::svg::chart::fail;
 

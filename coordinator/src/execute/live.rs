@@ -83,10 +83,12 @@ impl CatchUp {
         match m {
             LiveMessage::Status(s) => self.status = Some(s.clone()),
             LiveMessage::Record(r) => match r {
-                Record::Start(_) => *self = CatchUp {
-                    start: Some(r.clone()),
-                    ..CatchUp::default()
-                },
+                Record::Start(_) => {
+                    *self = CatchUp {
+                        start: Some(r.clone()),
+                        ..CatchUp::default()
+                    }
+                }
                 Record::Plan(_) => self.plan = Some(r.clone()),
                 Record::Obstacle(_) => self.obstacles.push(r.clone()),
                 Record::Event(_) => {
@@ -177,14 +179,16 @@ impl LiveFeed {
         }
         let m = Arc::new(m);
         let mut cut = 0;
-        inner.subscribers.retain(|s| match s.try_send(Arc::clone(&m)) {
-            Ok(()) => true,
-            Err(TrySendError::Full(_)) => {
-                cut += 1;
-                false
-            }
-            Err(TrySendError::Disconnected(_)) => false,
-        });
+        inner
+            .subscribers
+            .retain(|s| match s.try_send(Arc::clone(&m)) {
+                Ok(()) => true,
+                Err(TrySendError::Full(_)) => {
+                    cut += 1;
+                    false
+                }
+                Err(TrySendError::Disconnected(_)) => false,
+            });
         inner.cut_off += cut;
     }
 
@@ -330,15 +334,17 @@ mod tests {
     fn a_new_start_resets_the_catch_up() {
         let feed = LiveFeed::new();
         feed.publish(report("auv1", 0));
-        feed.publish(LiveMessage::Record(Record::Start(super::super::log::Start {
-            mission: "m2".into(),
-            scenario_toml: String::new(),
-            common_arrival_s: 1.0,
-            arrival_window_s: 1.0,
-            horizon_s: 1.0,
-            time_scale: 1.0,
-            epoch_unix_ms: 0,
-        })));
+        feed.publish(LiveMessage::Record(Record::Start(
+            super::super::log::Start {
+                mission: "m2".into(),
+                scenario_toml: String::new(),
+                common_arrival_s: 1.0,
+                arrival_window_s: 1.0,
+                horizon_s: 1.0,
+                time_scale: 1.0,
+                epoch_unix_ms: 0,
+            },
+        )));
         let c = feed.subscribe().catch_up;
         assert!(c.tracks.is_empty());
         assert!(c.start.is_some());

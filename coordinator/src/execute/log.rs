@@ -21,8 +21,8 @@ use anyhow::Context as _;
 
 use self::mcap::McapWriter;
 use self::ndjson::NdjsonWriter;
-use super::live::{LiveFeed, LiveMessage};
 pub use self::record::{CutShort, Log, Record, Start};
+use super::live::{LiveFeed, LiveMessage};
 
 /// The event kind of a vehicle declared lost (its `vehicles` names it).
 pub const EVENT_LOST: &str = "vehicle_lost";

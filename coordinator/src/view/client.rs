@@ -14,7 +14,8 @@ use std::time::{Duration, Instant};
 use tungstenite::{Error, Message, WebSocket};
 
 use super::message::{push_json, Shaper, ViewMessage};
-use super::{replay::ReplayLog, Shared, Source, MAX_INCOMING_PER_S};
+use super::replay::ReplayLog;
+use super::shared::{Shared, Source, MAX_INCOMING_PER_S};
 use crate::execute::live::{LiveFeed, LiveMessage};
 
 /// How often a page gets what happened: also how long a read from it waits.
@@ -142,7 +143,12 @@ impl Incoming {
 
     /// Reads what the page sent, waiting up to [`TICK`] for the first message.
     fn poll(&mut self, ws: &mut WebSocket<TcpStream>, shared: &Shared) -> Result<(), Ended> {
-        let dropped = || shared.stats.dropped_messages.fetch_add(1, Ordering::Relaxed);
+        let dropped = || {
+            shared
+                .stats
+                .dropped_messages
+                .fetch_add(1, Ordering::Relaxed)
+        };
         loop {
             match ws.read() {
                 Ok(m) => {

@@ -11,7 +11,8 @@ use std::time::Duration;
 use tungstenite::protocol::{Role, WebSocketConfig};
 use tungstenite::WebSocket;
 
-use super::{assets, client, Shared, MAX_CLIENTS, MAX_INCOMING_BYTES, MAX_REQUEST_BYTES};
+use super::shared::{Shared, MAX_CLIENTS, MAX_INCOMING_BYTES, MAX_REQUEST_BYTES};
+use super::{assets, client};
 
 /// How long a connection may take to send its request head.
 const HEAD_TIMEOUT: Duration = Duration::from_secs(5);
@@ -91,7 +92,11 @@ pub(super) fn parse(head: &[u8]) -> Result<Request, Refusal> {
         return Err(Refusal::NotGet);
     }
     let path = req.path.ok_or(Refusal::BadRequest)?;
-    let path = path.split(['?', '#']).next().unwrap_or_default().to_string();
+    let path = path
+        .split(['?', '#'])
+        .next()
+        .unwrap_or_default()
+        .to_string();
     let headers = req
         .headers
         .iter()
@@ -108,10 +113,8 @@ pub(super) fn parse(head: &[u8]) -> Result<Request, Refusal> {
 pub(super) fn route(req: &Request) -> Result<Route, Refusal> {
     if req.path == "/ws" {
         let has = |name: &str, word: &str| {
-            req.header(name).is_some_and(|v| {
-                v.split(',')
-                    .any(|w| w.trim().eq_ignore_ascii_case(word))
-            })
+            req.header(name)
+                .is_some_and(|v| v.split(',').any(|w| w.trim().eq_ignore_ascii_case(word)))
         };
         if !(has("upgrade", "websocket")
             && has("connection", "upgrade")
@@ -204,7 +207,12 @@ fn refuse(stream: &mut TcpStream, refusal: Refusal, shared: &Shared) {
 }
 
 /// Writes a whole response and closes.
-fn answer(stream: &mut TcpStream, status: &str, content_type: &str, body: &[u8]) -> std::io::Result<()> {
+fn answer(
+    stream: &mut TcpStream,
+    status: &str,
+    content_type: &str,
+    body: &[u8],
+) -> std::io::Result<()> {
     let head = format!(
         "HTTP/1.1 {status}\r\nContent-Type: {content_type}\r\nContent-Length: {}\r\n\
          Cache-Control: no-store\r\nX-Content-Type-Options: nosniff\r\n\
@@ -304,11 +312,16 @@ mod tests {
             request("GET /etc/passwd HTTP/1.1\r\nHost: h\r\n\r\n"),
             Err(Refusal::NotFound)
         );
-        assert_eq!(request("GET /ws HTTP/1.1\r\nHost: h\r\n\r\n"), Err(Refusal::BadRequest));
+        assert_eq!(
+            request("GET /ws HTTP/1.1\r\nHost: h\r\n\r\n"),
+            Err(Refusal::BadRequest)
+        );
         assert_eq!(request("nonsense\r\n\r\n"), Err(Refusal::BadRequest));
         let foreign = format!("{UPGRADE}Origin: http://evil.example\r\n\r\n");
         assert_eq!(request(&foreign), Err(Refusal::ForeignOrigin));
-        let many: String = (0..MAX_HEADERS + 1).map(|i| format!("X-{i}: y\r\n")).collect();
+        let many: String = (0..MAX_HEADERS + 1)
+            .map(|i| format!("X-{i}: y\r\n"))
+            .collect();
         assert_eq!(
             request(&format!("GET / HTTP/1.1\r\n{many}\r\n")),
             Err(Refusal::TooLarge)

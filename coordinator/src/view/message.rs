@@ -31,7 +31,9 @@ use shoal_common::execution::VehicleStatus;
 use shoal_common::scenario::{Bounds, Obstacle, Scenario};
 use shoal_common::terrain::{Hazard, Terrain};
 use shoal_common::trajectory::Trajectory;
-use shoal_common::wire::open::{FleetStatus, MissionEvent, PlanNotice, Telemetry, VehicleStatusRow};
+use shoal_common::wire::open::{
+    FleetStatus, MissionEvent, PlanNotice, Telemetry, VehicleStatusRow,
+};
 
 use crate::execute::fleet::ExecutionFigures;
 use crate::execute::live::LiveMessage;
@@ -189,9 +191,10 @@ pub fn scene(start: &Start) -> Scene {
             .as_ref()
             .map(|s| s.vehicles.iter().map(|v| v.id.clone()).collect())
             .unwrap_or_default(),
-        seabed: s
-            .as_ref()
-            .and_then(|s| s.terrain().map(|t| seabed_view(t, &s.bounds, SEABED_SAMPLES))),
+        seabed: s.as_ref().and_then(|s| {
+            s.terrain()
+                .map(|t| seabed_view(t, &s.bounds, SEABED_SAMPLES))
+        }),
     }
 }
 
@@ -199,11 +202,18 @@ pub fn scene(start: &Start) -> Scene {
 /// seen if it stands (lost, holding, faulted, arrived, stopped); else along its plan at its
 /// current lag (a vehicle 20 s late is where its plan is 20 s earlier); along its plan on time
 /// before its first report.
-pub fn predicted_place(row: &VehicleStatusRow, plan: Option<&Trajectory>, at_s: f64) -> Option<[f64; 3]> {
+pub fn predicted_place(
+    row: &VehicleStatusRow,
+    plan: Option<&Trajectory>,
+    at_s: f64,
+) -> Option<[f64; 3]> {
     let standing = |s: VehicleStatus| {
         matches!(
             s,
-            VehicleStatus::Holding | VehicleStatus::Fault | VehicleStatus::Arrived | VehicleStatus::Stopped
+            VehicleStatus::Holding
+                | VehicleStatus::Fault
+                | VehicleStatus::Arrived
+                | VehicleStatus::Stopped
         )
     };
     match (&row.state, plan) {
@@ -219,7 +229,10 @@ pub fn predicted_place(row: &VehicleStatusRow, plan: Option<&Trajectory>, at_s: 
 }
 
 /// Where `status`'s predicted closest approach happens, given each vehicle's current plan.
-pub fn predicted_view(status: &FleetStatus, plans: &BTreeMap<String, Trajectory>) -> Option<PredictedView> {
+pub fn predicted_view(
+    status: &FleetStatus,
+    plans: &BTreeMap<String, Trajectory>,
+) -> Option<PredictedView> {
     let Conflict {
         a,
         b,
@@ -261,7 +274,8 @@ impl Shaper {
                 }
                 Record::Plan(p) => {
                     for (id, samples) in &p.trajectories {
-                        self.plans.insert(id.clone(), Trajectory::from_samples(samples));
+                        self.plans
+                            .insert(id.clone(), Trajectory::from_samples(samples));
                     }
                     ViewMessage::Plan { plan: p }
                 }

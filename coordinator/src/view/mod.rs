@@ -21,9 +21,10 @@ mod client;
 mod http;
 pub mod message;
 pub mod replay;
+mod shared;
 
 use std::net::{SocketAddr, TcpListener, TcpStream};
-use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::thread::JoinHandle;
 use std::time::Duration;
@@ -31,54 +32,11 @@ use std::time::Duration;
 use anyhow::Context as _;
 
 use crate::execute::live::LiveFeed;
-
-/// Pages connected at once; the next one is answered HTTP 503.
-pub const MAX_CLIENTS: usize = 16;
-/// Connections being served at once (pages, assets, refusals); past it a connection is closed
-/// unanswered.
-pub const MAX_CONNECTIONS: usize = 64;
-/// Largest WebSocket message (and frame) a page may send: it needs to send nothing.
-pub const MAX_INCOMING_BYTES: usize = 1024;
-/// WebSocket messages (pings included) a page may send per second before it is disconnected.
-pub const MAX_INCOMING_PER_S: u32 = 20;
-/// Largest HTTP request head read.
-pub const MAX_REQUEST_BYTES: usize = 8192;
-
-/// What the view shows.
-#[derive(Clone)]
-pub enum Source {
-    /// A running execution (`run`, `serve`): its feed.
-    Live(Arc<LiveFeed>),
-    /// A finished mission log (`replay`), already shaped into the page's messages.
-    Log(Arc<replay::ReplayLog>),
-}
-
-/// What a server has refused and served, for tests and logs.
-#[derive(Debug, Default)]
-pub struct ViewStats {
-    /// Pages connected now.
-    pub clients: AtomicUsize,
-    /// Connections open now (pages included).
-    pub connections: AtomicUsize,
-    /// Pages refused because [`MAX_CLIENTS`] were connected.
-    pub refused_clients: AtomicU64,
-    /// Bad requests: malformed, too long, not `GET`, unknown path, foreign origin.
-    pub bad_requests: AtomicU64,
-    /// Messages from pages dropped (oversized, over the rate, not expected).
-    pub dropped_messages: AtomicU64,
-    /// Catch-ups sent (one per connection, and one more each time a slow page was cut off).
-    pub catch_ups: AtomicU64,
-}
-
-/// What the connection threads share.
-struct Shared {
-    /// What to show.
-    source: Source,
-    /// Counters.
-    stats: Arc<ViewStats>,
-    /// Set when the server stops: every thread ends.
-    stop: Arc<AtomicBool>,
-}
+use shared::Shared;
+pub use shared::{
+    Source, ViewStats, MAX_CLIENTS, MAX_CONNECTIONS, MAX_INCOMING_BYTES, MAX_INCOMING_PER_S,
+    MAX_REQUEST_BYTES,
+};
 
 /// A running view server; dropping it stops it.
 pub struct ViewServer {
@@ -161,7 +119,11 @@ pub fn start_live(addr: Option<SocketAddr>) -> anyhow::Result<Option<(ViewServer
 }
 
 /// For `replay LOG --view ADDR`: serves the log at `path` until `shutdown`.
-pub fn serve_log(addr: SocketAddr, path: &std::path::Path, shutdown: &AtomicBool) -> anyhow::Result<()> {
+pub fn serve_log(
+    addr: SocketAddr,
+    path: &std::path::Path,
+    shutdown: &AtomicBool,
+) -> anyhow::Result<()> {
     let log = crate::execute::log::read(path)?;
     let shaped = replay::ReplayLog::from_records(&log.records, path)?;
     let server = ViewServer::start(addr, Source::Log(Arc::new(shaped)))?;
@@ -188,9 +150,7 @@ fn accept_loop(listener: &TcpListener, shared: &Arc<Shared>) {
     while !shared.stop.load(Ordering::Relaxed) {
         match listener.accept() {
             Ok((stream, _)) => admit(stream, shared),
-            Err(e) if e.kind() == std::io::ErrorKind::WouldBlock => {
-                std::thread::sleep(ACCEPT_TICK)
-            }
+            Err(e) if e.kind() == std::io::ErrorKind::WouldBlock => std::thread::sleep(ACCEPT_TICK),
             Err(e) => {
                 tracing::warn!("web view: accept failed: {e}");
                 std::thread::sleep(ACCEPT_TICK);

@@ -70,7 +70,10 @@ impl ReplayLog {
                 continue;
             };
             let n = seen.entry(telemetry.vehicle.as_str()).or_default();
-            let (stride, total) = strides.get(telemetry.vehicle.as_str()).copied().unwrap_or((1, 0));
+            let (stride, total) = strides
+                .get(telemetry.vehicle.as_str())
+                .copied()
+                .unwrap_or((1, 0));
             if *n % stride == 0 || *n + 1 == total {
                 messages.push(LiveMessage::Record(r.clone()));
             }
@@ -105,8 +108,9 @@ fn telemetry_span(records: &[Record]) -> (f64, f64) {
         Record::Telemetry { telemetry, .. } => Some(telemetry.state.t_s),
         _ => None,
     });
-    times.fold(None, |span: Option<(f64, f64)>, t| {
-        Some(span.map_or((t, t), |(a, b)| (a.min(t), b.max(t))))
-    })
-    .unwrap_or((0.0, 0.0))
+    times
+        .fold(None, |span: Option<(f64, f64)>, t| {
+            Some(span.map_or((t, t), |(a, b)| (a.min(t), b.max(t))))
+        })
+        .unwrap_or((0.0, 0.0))
 }

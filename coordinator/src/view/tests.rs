@@ -44,10 +44,7 @@ fn report(vehicle: &str, seq: u64) -> LiveMessage {
 }
 
 fn server(feed: &Arc<LiveFeed>) -> anyhow::Result<ViewServer> {
-    ViewServer::start(
-        "127.0.0.1:0".parse()?,
-        Source::Live(Arc::clone(feed)),
-    )
+    ViewServer::start("127.0.0.1:0".parse()?, Source::Live(Arc::clone(feed)))
 }
 
 type Socket = WebSocket<TcpStream>;
@@ -111,7 +108,10 @@ fn the_page_is_served_and_bad_requests_are_answered_and_counted() -> TestResult 
     assert!(e.starts_with("HTTP/1.1 405"), "{e}");
     let e = get(&s, "GET /../../etc/passwd HTTP/1.1\r\nHost: x\r\n\r\n")?;
     assert!(e.starts_with("HTTP/1.1 404"), "{e}");
-    let huge = format!("GET / HTTP/1.1\r\nX: {}\r\n\r\n", "a".repeat(MAX_REQUEST_BYTES));
+    let huge = format!(
+        "GET / HTTP/1.1\r\nX: {}\r\n\r\n",
+        "a".repeat(MAX_REQUEST_BYTES)
+    );
     let e = get(&s, &huge)?;
     assert!(e.starts_with("HTTP/1.1 431"), "{e}");
     assert_eq!(s.stats().bad_requests.load(Ordering::Relaxed), 3);
@@ -145,8 +145,12 @@ fn a_page_gets_the_catch_up_then_each_message() -> TestResult {
 fn past_the_client_cap_a_page_gets_503() -> TestResult {
     let feed = LiveFeed::new();
     let s = server(&feed)?;
-    let mut pages: Vec<Socket> = (0..MAX_CLIENTS).map(|_| connect(&s)).collect::<Result<_, _>>()?;
-    assert!(eventually(|| s.stats().clients.load(Ordering::SeqCst) == MAX_CLIENTS));
+    let mut pages: Vec<Socket> = (0..MAX_CLIENTS)
+        .map(|_| connect(&s))
+        .collect::<Result<_, _>>()?;
+    assert!(eventually(
+        || s.stats().clients.load(Ordering::SeqCst) == MAX_CLIENTS
+    ));
     let refused = connect(&s).err().map(|e| e.to_string()).unwrap_or_default();
     assert!(refused.contains("503"), "{refused}");
     assert_eq!(s.stats().refused_clients.load(Ordering::Relaxed), 1);
@@ -154,7 +158,9 @@ fn past_the_client_cap_a_page_gets_503() -> TestResult {
     let mut one = pages.pop().ok_or("no page")?;
     one.close(None)?;
     while one.read().is_ok() {}
-    assert!(eventually(|| s.stats().clients.load(Ordering::SeqCst) < MAX_CLIENTS));
+    assert!(eventually(
+        || s.stats().clients.load(Ordering::SeqCst) < MAX_CLIENTS
+    ));
     let _again = connect(&s)?;
     Ok(())
 }
@@ -168,7 +174,11 @@ fn an_oversized_message_ends_the_connection_and_is_counted() -> TestResult {
     ws.send(Message::text("x".repeat(MAX_INCOMING_BYTES + 1)))?;
     let closed = (0..10).any(|_| ws.read().is_err());
     assert!(closed, "the server kept the connection");
-    assert!(eventually(|| s.stats().dropped_messages.load(Ordering::Relaxed) == 1));
+    assert!(eventually(|| s
+        .stats()
+        .dropped_messages
+        .load(Ordering::Relaxed)
+        == 1));
     assert!(eventually(|| s.stats().clients.load(Ordering::SeqCst) == 0));
     Ok(())
 }
@@ -214,7 +224,10 @@ fn beyond_loopback_is_refused_with_what_to_do() -> TestResult {
             .err()
             .map(|e| e.to_string())
             .unwrap_or_default();
-        assert!(e.contains("loopback only") && e.contains("ssh -L"), "{addr}: {e}");
+        assert!(
+            e.contains("loopback only") && e.contains("ssh -L"),
+            "{addr}: {e}"
+        );
     }
     assert!(check_bind(&"[::1]:8080".parse()?).is_ok());
     Ok(())

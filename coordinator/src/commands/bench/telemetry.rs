@@ -95,16 +95,36 @@ pub fn command(args: &BenchTelemetryArgs, stop: &AtomicBool) -> anyhow::Result<i
         crate::report::out::say(&m.line);
         return Ok(crate::commands::exit::EXIT_FEASIBLE);
     };
-    let without = bench.measure(args, ("no-page", "view served, no page"), Some(Arc::clone(&feed)), stop)?;
-    let browser = super::headless::Headless::open(&args.browser, &server.url(), &args.out.join("browser"))?;
+    let without = bench.measure(
+        args,
+        ("no-page", "view served, no page"),
+        Some(Arc::clone(&feed)),
+        stop,
+    )?;
+    let browser =
+        super::headless::Headless::open(&args.browser, &server.url(), &args.out.join("browser"))?;
     browser.wait_for_page(server.stats(), Duration::from_secs(60))?;
-    let with = bench.measure(args, ("browser", "view served, headless browser connected"), Some(feed), stop)?;
-    let pages = server.stats().clients.load(std::sync::atomic::Ordering::SeqCst);
+    let with = bench.measure(
+        args,
+        ("browser", "view served, headless browser connected"),
+        Some(feed),
+        stop,
+    )?;
+    let pages = server
+        .stats()
+        .clients
+        .load(std::sync::atomic::Ordering::SeqCst);
     drop(browser);
     let share = |m: &Measured| m.cpu.map(|c| 100.0 * c / m.wall);
-    let extra = share(&with).zip(share(&without)).map_or("unknown".into(), |(a, b)| {
-        format!("{:+.1} % of one core ({:+.0} % of the coordinator's)", a - b, 100.0 * (a - b) / b)
-    });
+    let extra = share(&with)
+        .zip(share(&without))
+        .map_or("unknown".into(), |(a, b)| {
+            format!(
+                "{:+.1} % of one core ({:+.0} % of the coordinator's)",
+                a - b,
+                100.0 * (a - b) / b
+            )
+        });
     crate::report::out::say(&format!(
         "{}{}view cost: {extra}; pages connected at the end: {pages}\n",
         without.line, with.line

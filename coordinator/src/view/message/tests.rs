@@ -47,28 +47,50 @@ fn a_vehicle_on_its_way_is_predicted_along_its_plan_at_its_lag() {
     let plan = east();
     let on_time = row("a", Some([1.0, 1.0, 10.0]), VehicleStatus::Underway, 0.0);
     // At t = 30 on time: 60 m along.
-    assert_eq!(predicted_place(&on_time, Some(&plan), 30.0), Some([60.0, 0.0, 10.0]));
+    assert_eq!(
+        predicted_place(&on_time, Some(&plan), 30.0),
+        Some([60.0, 0.0, 10.0])
+    );
     // 10 s late: where the plan is at t = 20, 40 m along.
     let late = row("a", Some([1.0, 1.0, 10.0]), VehicleStatus::Underway, 10.0);
-    assert_eq!(predicted_place(&late, Some(&plan), 30.0), Some([40.0, 0.0, 10.0]));
+    assert_eq!(
+        predicted_place(&late, Some(&plan), 30.0),
+        Some([40.0, 0.0, 10.0])
+    );
     // Past the plan's end: at its end.
-    assert_eq!(predicted_place(&on_time, Some(&plan), 500.0), Some([200.0, 0.0, 10.0]));
+    assert_eq!(
+        predicted_place(&on_time, Some(&plan), 500.0),
+        Some([200.0, 0.0, 10.0])
+    );
     // Not heard yet: on its plan, on time.
     let silent = row("a", None, VehicleStatus::Underway, 0.0);
-    assert_eq!(predicted_place(&silent, Some(&plan), 50.0), Some([100.0, 0.0, 10.0]));
+    assert_eq!(
+        predicted_place(&silent, Some(&plan), 50.0),
+        Some([100.0, 0.0, 10.0])
+    );
     assert_eq!(predicted_place(&silent, None, 50.0), None);
 }
 
 #[test]
 fn a_standing_vehicle_is_predicted_where_it_was_seen() {
     let plan = east();
-    for status in [VehicleStatus::Holding, VehicleStatus::Fault, VehicleStatus::Arrived] {
+    for status in [
+        VehicleStatus::Holding,
+        VehicleStatus::Fault,
+        VehicleStatus::Arrived,
+    ] {
         let r = row("a", Some([7.0, 8.0, 9.0]), status, 0.0);
-        assert_eq!(predicted_place(&r, Some(&plan), 30.0), Some([7.0, 8.0, 9.0]));
+        assert_eq!(
+            predicted_place(&r, Some(&plan), 30.0),
+            Some([7.0, 8.0, 9.0])
+        );
     }
     let mut lost = row("a", Some([7.0, 8.0, 9.0]), VehicleStatus::Underway, 0.0);
     lost.lost = true;
-    assert_eq!(predicted_place(&lost, Some(&plan), 30.0), Some([7.0, 8.0, 9.0]));
+    assert_eq!(
+        predicted_place(&lost, Some(&plan), 30.0),
+        Some([7.0, 8.0, 9.0])
+    );
 }
 
 #[test]
@@ -111,8 +133,14 @@ fn the_predicted_closest_approach_names_both_places_and_whether_it_conflicts() {
         })
     );
     let mut far = status.clone();
-    far.predicted = far.predicted.map(|c| Conflict { min_distance_m: 60.0, ..c });
-    assert_eq!(predicted_view(&far, &plans).map(|p| p.conflict), Some(false));
+    far.predicted = far.predicted.map(|c| Conflict {
+        min_distance_m: 60.0,
+        ..c
+    });
+    assert_eq!(
+        predicted_view(&far, &plans).map(|p| p.conflict),
+        Some(false)
+    );
     let mut bad = status;
     bad.predicted = bad.predicted.map(|c| Conflict { b: 5, ..c });
     assert_eq!(predicted_view(&bad, &plans), None, "an index out of range");
