@@ -162,6 +162,8 @@ def main():
             proc.wait(timeout=10)
         except subprocess.TimeoutExpired:
             proc.kill()
+        # Only the screenshots are kept.
+        shutil.rmtree(os.path.join(outdir, "profile"), ignore_errors=True)
 
 
 if __name__ == "__main__":
