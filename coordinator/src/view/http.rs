@@ -139,9 +139,12 @@ pub(super) fn route(req: &Request) -> Result<Route, Refusal> {
         .ok_or(Refusal::NotFound)
 }
 
+/// A request head and the bytes read after it.
+type Head = (Vec<u8>, Vec<u8>);
+
 /// Reads a request head: up to the blank line, at most [`MAX_REQUEST_BYTES`]. `Ok(None)`: the
 /// connection closed or went quiet before sending anything (a browser's spare connection).
-fn read_head(stream: &mut TcpStream) -> Result<Option<(Vec<u8>, Vec<u8>)>, Refusal> {
+fn read_head(stream: &mut TcpStream) -> Result<Option<Head>, Refusal> {
     let mut buf = Vec::with_capacity(1024);
     let mut chunk = [0u8; 1024];
     loop {

@@ -74,7 +74,7 @@ impl ReplayLog {
                 .get(telemetry.vehicle.as_str())
                 .copied()
                 .unwrap_or((1, 0));
-            if *n % stride == 0 || *n + 1 == total {
+            if n.is_multiple_of(stride) || *n + 1 == total {
                 messages.push(LiveMessage::Record(r.clone()));
             }
             *n += 1;
