@@ -16,6 +16,8 @@
 //!   the comparison tables, the SVG charts and the GeoJSON/QGroundControl exports.
 //! - [`distributed`] (planning over agents on Zenoh) and [`execute`] (driving a plan, watching
 //!   the fleet, replanning).
+//! - [`view`]: the operator's live web view (`--view ADDR`): a page and a WebSocket fed from
+//!   the execution's live feed, or a finished log.
 //! - [`cpu`]: the process's CPU time, for the figures that report a step's cost.
 //! - The rule: `commands` → `mission` → `planning`, `report`, `distributed`, `execute`, never
 //!   back (`commands` may also call the lower layers directly); no cycle between files
@@ -29,6 +31,7 @@ pub mod execute;
 pub mod mission;
 pub mod planning;
 pub mod report;
+pub mod view;
 
 pub use commands::plan_args::PlanArgs;
 pub use commands::{

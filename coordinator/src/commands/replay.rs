@@ -1,9 +1,10 @@
 //! `shoal-coordinator replay LOG`: reads a mission log back, recomputes the execution's figures
-//! from its records alone (the same [`Fleet`] the live run used), lists the decisions, and
+//! from its records alone (the same fleet picture the live run used, see [`execute::replayed`]), lists the decisions, and
 //! draws the planned and executed tracks (`<LOG>.svg`: top view, over the seabed and its hazards
 //! when the scenario has them). Its verdict and exit status are `run`'s.
 
 use std::path::{Path, PathBuf};
+use std::sync::atomic::AtomicBool;
 
 use anyhow::Context as _;
 use plotters::backend::SVGBackend;
@@ -13,8 +14,9 @@ use shoal_common::scenario::{Obstacle, ObstacleKind, Scenario};
 use shoal_common::trajectory::Trajectory;
 use shoal_common::wire::open::MissionEvent;
 
-use crate::execute::fleet::{ExecutionFigures, Fleet};
-use crate::execute::log::{self, Record};
+use crate::execute;
+use crate::execute::fleet::ExecutionFigures;
+use crate::execute::log;
 use crate::execute::verdict;
 use crate::report::svg::chart::fail;
 
@@ -27,6 +29,10 @@ pub struct ReplayArgs {
     /// Where to draw the tracks (default: the log's path with `.svg`).
     #[arg(long)]
     pub svg: Option<PathBuf>,
+    /// Then serve the log in the web view here (loopback, e.g. 127.0.0.1:8080), to play it
+    /// back with a time slider, until Ctrl-C.
+    #[arg(long, env = "SHOAL_VIEW", value_name = "ADDR")]
+    pub view: Option<std::net::SocketAddr>,
 }
 
 /// What a log holds, replayed.
@@ -50,92 +56,29 @@ pub struct Replayed {
 /// Replays the log at `path`.
 pub fn replay(path: &Path) -> anyhow::Result<Replayed> {
     let log::Log { records, cut_short } = log::read(path)?;
-    let Some(Record::Start(start)) = records.first() else {
-        anyhow::bail!("{}: no start record", path.display());
-    };
-    let origin = format!("{} (start record)", path.display());
-    let mut scenario = Scenario::parse(&start.scenario_toml, Path::new(&origin))?;
-    let ids: Vec<String> = scenario.vehicles.iter().map(|v| v.id.clone()).collect();
-    let first = records.iter().find_map(|r| match r {
-        Record::Plan(p) if p.revision == 0 => Some(p.clone()),
-        _ => None,
-    });
-    let Some(first) = first else {
-        anyhow::bail!("{}: no plan record of revision 0", path.display());
-    };
-    let planned: Vec<Trajectory> = ids
-        .iter()
-        .map(|id| {
-            first
-                .trajectories
-                .iter()
-                .find(|(v, _)| v == id)
-                .map(|(_, s)| Trajectory::from_samples(s))
-                .ok_or_else(|| {
-                    anyhow::anyhow!("{}: the plan has no trajectory for {id}", path.display())
-                })
-        })
-        .collect::<anyhow::Result<_>>()?;
-    let mut fleet = Fleet::new(&ids, &planned, scenario.fleet.d_min_m, start.horizon_s);
-    let mut events = Vec::new();
-    let mut logged = None;
-    for r in &records {
-        match r {
-            Record::Plan(p) if p.revision > 0 => {
-                for (id, s) in &p.trajectories {
-                    if let Some(i) = fleet.index(id) {
-                        if p.changed.contains(id) {
-                            // As live: a new plan ends a hold.
-                            fleet.vehicles[i].plan = Trajectory::from_samples(s);
-                            fleet.vehicles[i].revision = p.revision;
-                            fleet.vehicles[i].holding = false;
-                        }
-                    }
-                }
-            }
-            Record::Telemetry {
-                received_unix_us,
-                telemetry,
-            } => {
-                fleet.report(telemetry.clone(), *received_unix_us);
-            }
-            Record::Event(e) => {
-                // The live run marks a vehicle lost or holding just before it logs the event,
-                // and a holding vehicle's distance from its plan is no tracking error.
-                for v in &e.vehicles {
-                    if let Some(i) = fleet.index(v) {
-                        match e.kind.as_str() {
-                            log::EVENT_LOST => fleet.vehicles[i].lost = true,
-                            log::EVENT_HOLD => fleet.vehicles[i].holding = true,
-                            _ => {}
-                        }
-                    }
-                }
-                events.push(e.clone());
-            }
-            Record::Obstacle(o) => {
-                scenario.obstacles.push(o.clone());
-                fleet.obstacle_published();
-            }
-            Record::End(f) => logged = Some(f.clone()),
-            Record::Start(_) | Record::Plan(_) => {}
-        }
+    let mut r = execute::replayed::Replayed::new(&records, path)?;
+    for record in &records {
+        r.apply(record);
     }
-    let figures = fleet.figures_for(&scenario, start.common_arrival_s, start.arrival_window_s);
-    let tracks = fleet.vehicles.iter().map(|v| v.track.clone()).collect();
+    let figures = r.fleet.figures_for(
+        &r.scenario,
+        r.start.common_arrival_s,
+        r.start.arrival_window_s,
+    );
+    let tracks = r.fleet.vehicles.iter().map(|v| v.track.clone()).collect();
     Ok(Replayed {
-        scenario,
+        scenario: r.scenario,
         figures,
-        logged,
-        events,
-        planned,
+        logged: r.logged,
+        events: r.events,
+        planned: r.planned,
         tracks,
         cut_short,
     })
 }
 
 /// The replay command: prints the events and the figures and writes the SVG.
-pub fn command(args: &ReplayArgs) -> anyhow::Result<i32> {
+pub fn command(args: &ReplayArgs, shutdown: &AtomicBool) -> anyhow::Result<i32> {
     let r = replay(&args.log)?;
     let mut out = String::new();
     for e in &r.events {
@@ -180,6 +123,9 @@ pub fn command(args: &ReplayArgs) -> anyhow::Result<i32> {
         .with_context(|| format!("cannot write {}", svg_path.display()))?;
     out.push_str(&format!("Wrote {}\n", svg_path.display()));
     crate::report::out::say(&out);
+    if let Some(addr) = args.view {
+        crate::view::serve_log(addr, &args.log, shutdown)?;
+    }
     // As `run`: 0 when the execution met its figures, 3 when it did not.
     Ok(if verdict::failures(f).is_empty() {
         crate::commands::exit::EXIT_FEASIBLE
@@ -293,7 +239,7 @@ fn same_figures(logged: &ExecutionFigures, replayed: &ExecutionFigures) -> bool 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::execute::log::{LogWriter, Start};
+    use crate::execute::log::{LogWriter, Record, Start};
     use shoal_common::execution::{VehicleState, VehicleStatus};
     use shoal_common::wire::open::{PlanNotice, Telemetry};
 
@@ -474,10 +420,14 @@ mod tests {
         let again = replay(&path)?;
         assert_eq!(again.logged.as_ref(), Some(&r.figures));
         let svg = dir.join("m.svg");
-        let code = command(&ReplayArgs {
-            log: path,
-            svg: Some(svg.clone()),
-        })?;
+        let code = command(
+            &ReplayArgs {
+                log: path,
+                svg: Some(svg.clone()),
+                view: None,
+            },
+            &AtomicBool::new(false),
+        )?;
         assert_eq!(code, crate::commands::exit::EXIT_VIOLATIONS);
         let drawn = std::fs::read_to_string(&svg)?;
         std::fs::remove_dir_all(&dir)?;

@@ -20,6 +20,7 @@ mod react;
 mod repair;
 pub mod replan;
 mod replan_queue;
+pub mod replayed;
 mod standing;
 mod state;
 mod track;

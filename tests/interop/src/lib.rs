@@ -1,6 +1,7 @@
 //! The Python interpreter of Shoal's interop tests, which check Shoal against implementations
-//! nobody here wrote (eclipse-zenoh, pymavlink, MAVSDK, geojson, shapely, mcap, jsonschema;
-//! pinned in `tests/python/requirements.txt`).
+//! nobody here wrote (eclipse-zenoh, pymavlink, MAVSDK, geojson, shapely, mcap, jsonschema,
+//! websockets; pinned in `tests/python/requirements.txt`), and the browser of the web view's
+//! test ([`chromium`]).
 //!
 //! `$SHOAL_INTEROP_PYTHON` names it when set. Otherwise the first test to ask makes a venv
 //! under the workspace's `target/interop-venv` with the pinned packages (one test binary at a
@@ -38,6 +39,43 @@ pub fn python() -> Result<String, String> {
         make_venv(&venv, &stamp)?;
     }
     Ok(py.display().to_string())
+}
+
+/// Debian's `chromium` for the browser tests: the one on `PATH`, else installed with
+/// `apt-get install -y chromium` (after an `apt-get update` if the package lists lack it),
+/// once, behind the same kind of lock as the venv. The tests drive it over the DevTools
+/// protocol from the venv's Python; nothing is downloaded but the Debian package.
+pub fn chromium() -> Result<String, String> {
+    if let Some(found) = on_path("chromium") {
+        return Ok(found);
+    }
+    let lock = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../target/chromium.lock");
+    let _lock = Lock::take(&lock)?;
+    if let Some(found) = on_path("chromium") {
+        return Ok(found);
+    }
+    eprintln!("interop: installing Debian's chromium (apt-get, once)");
+    let install = || {
+        run(Command::new("apt-get")
+            .args(["install", "-y", "chromium"])
+            .env("DEBIAN_FRONTEND", "noninteractive"))
+    };
+    if install().is_err() {
+        run(Command::new("apt-get").arg("update"))?;
+        install().map_err(|e| {
+            format!("{e}: the browser tests need Debian's chromium (apt-get install -y chromium, as root)")
+        })?;
+    }
+    on_path("chromium").ok_or_else(|| "apt-get installed chromium but it is not on PATH".into())
+}
+
+/// The first `name` on `PATH`.
+fn on_path(name: &str) -> Option<String> {
+    let path = std::env::var_os("PATH")?;
+    std::env::split_paths(&path)
+        .map(|dir| dir.join(name))
+        .find(|p| p.is_file())
+        .map(|p| p.display().to_string())
 }
 
 /// Makes the venv at `venv` with [`REQUIREMENTS`]; writes `stamp` last, once it works.

@@ -7,6 +7,7 @@ pub mod cages;
 pub mod coverage;
 pub mod energy;
 pub mod functions;
+pub mod headless;
 pub mod pool;
 pub mod scale;
 pub mod telemetry;

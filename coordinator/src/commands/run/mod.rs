@@ -56,6 +56,9 @@ pub struct RunArgs {
     /// the extension `.mcap`.
     #[arg(long, env = "SHOAL_LOG")]
     pub log: Option<PathBuf>,
+    /// Serve the live web view of the mission here (loopback, e.g. 127.0.0.1:8080).
+    #[arg(long, env = "SHOAL_VIEW", value_name = "ADDR")]
+    pub view: Option<std::net::SocketAddr>,
 }
 
 /// Reads `T:X,Y,Z,R` or `T:VEHICLE,R`: (time, place, radius).
@@ -112,7 +115,10 @@ impl RunArgs {
 /// Plans, then executes; exit 0 when the execution kept d_min, stayed out of every hard
 /// obstacle and every vehicle arrived in the window, 3 otherwise.
 pub fn command(args: &RunArgs, shutdown: Arc<AtomicBool>) -> anyhow::Result<i32> {
-    Ok(if run_mission(&args.options()?, shutdown)? {
+    let mut options = args.options()?;
+    let view = crate::view::start_live(args.view)?;
+    options.execution.live = view.as_ref().map(|(_, feed)| Arc::clone(feed));
+    Ok(if run_mission(&options, shutdown)? {
         EXIT_FEASIBLE
     } else {
         EXIT_VIOLATIONS

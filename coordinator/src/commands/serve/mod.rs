@@ -59,6 +59,9 @@ pub struct ServeArgs {
     /// submission is refused rather than holding the queue.
     #[arg(long, env = "SHOAL_MAX_MISSION_HOURS", default_value_t = 6.0)]
     pub max_mission_hours: f64,
+    /// Serve the live web view of the mission running now here (loopback, e.g. 127.0.0.1:8080).
+    #[arg(long, env = "SHOAL_VIEW", value_name = "ADDR")]
+    pub view: Option<std::net::SocketAddr>,
 }
 
 /// The operator's rules from the flags.
@@ -103,6 +106,10 @@ fn answer(
 /// Serves until `shutdown` (or `--missions` missions).
 pub fn command(args: &ServeArgs, shutdown: Arc<AtomicBool>) -> anyhow::Result<i32> {
     let rules = rules(args)?;
+    // One feed for every mission: each starts with its start record, which the page (and the
+    // feed's catch-up) takes as a new mission.
+    let view = crate::view::start_live(args.view)?;
+    let live = view.as_ref().map(|(_, feed)| feed);
     let listen: Vec<String> = args
         .listen
         .listen
@@ -157,7 +164,7 @@ pub fn command(args: &ServeArgs, shutdown: Arc<AtomicBool>) -> anyhow::Result<i3
         };
         served += 1;
         let ran = catch_unwind(AssertUnwindSafe(|| {
-            run_one(args, &link, &mission, &s, &shutdown)
+            run_one(args, &link, &mission, &s, live, &shutdown)
         }));
         match ran {
             Ok(Ok(code)) => eprintln!("mission {mission}: ended with status {code}"),
@@ -201,6 +208,7 @@ fn run_one(
     link: &Link,
     mission: &str,
     s: &Submission,
+    live: Option<&Arc<crate::execute::live::LiveFeed>>,
     shutdown: &Arc<AtomicBool>,
 ) -> anyhow::Result<i32> {
     let dir = args.out.join(mission);
@@ -210,7 +218,8 @@ fn run_one(
     let file = dir.join("scenario.toml");
     std::fs::write(&file, &s.scenario_toml)
         .with_context(|| format!("cannot write {}", file.display()))?;
-    let options = mission_options(link, mission, s, file, dir.clone())?;
+    let mut options = mission_options(link, mission, s, file, dir.clone())?;
+    options.execution.live = live.cloned();
     eprintln!(
         "mission {mission}: planning and executing (files in {})",
         dir.display()
