@@ -14,7 +14,7 @@ use std::sync::{Arc, Mutex};
 
 use shoal_common::wire::open::{FleetStatus, Telemetry};
 
-use super::log::Record;
+use super::log::{Record, RecordWatcher};
 
 /// One message to a watcher.
 #[derive(Debug, Clone, PartialEq)]
@@ -143,6 +143,12 @@ struct Inner {
 #[derive(Default)]
 pub struct LiveFeed {
     inner: Mutex<Inner>,
+}
+
+impl RecordWatcher for LiveFeed {
+    fn record(&self, r: &Record) {
+        self.publish(LiveMessage::Record(r.clone()));
+    }
 }
 
 /// A feed equals only itself: two options structs are equal when they hand the execution to the

@@ -22,7 +22,6 @@ use anyhow::Context as _;
 use self::mcap::McapWriter;
 use self::ndjson::NdjsonWriter;
 pub use self::record::{CutShort, Log, Record, Start};
-use super::live::{LiveFeed, LiveMessage};
 
 /// The event kind of a vehicle declared lost (its `vehicles` names it).
 pub const EVENT_LOST: &str = "vehicle_lost";
@@ -38,14 +37,22 @@ pub const EVENT_IMPLAUSIBLE: &str = "implausible_report";
 /// or the rate limit).
 pub const EVENT_OBSTACLE_DROPPED: &str = "obstacle_dropped";
 
+/// Something that is shown every record as it is written; it must not block (the execution
+/// loop writes the log).
+pub trait RecordWatcher: Send + Sync {
+    /// Takes record `r`.
+    fn record(&self, r: &Record);
+}
+
 /// Appends records to both logs.
 pub struct LogWriter {
     /// The NDJSON log (it cannot be created: the mission does not start).
     ndjson: NdjsonWriter,
     /// The MCAP log; `None` when it could not be created (a warning; the mission goes on).
     mcap: Option<McapWriter>,
-    /// Live watchers, who get every record written (see [`super::live`]).
-    live: Option<Arc<LiveFeed>>,
+    /// Who watches live: gets every record written (the live feed of the web view and the
+    /// Foxglove server).
+    watcher: Option<Arc<dyn RecordWatcher>>,
 }
 
 impl LogWriter {
@@ -58,13 +65,13 @@ impl LogWriter {
         Ok(LogWriter {
             ndjson,
             mcap,
-            live: None,
+            watcher: None,
         })
     }
 
-    /// Also hands every record written from now on to `feed`.
-    pub fn with_live(mut self, feed: Option<Arc<LiveFeed>>) -> LogWriter {
-        self.live = feed;
+    /// Also hands every record written from now on to `watcher`.
+    pub fn with_watcher(mut self, watcher: Option<Arc<dyn RecordWatcher>>) -> LogWriter {
+        self.watcher = watcher;
         self
     }
 
@@ -74,8 +81,8 @@ impl LogWriter {
         if let Some(m) = &mut self.mcap {
             m.write(r);
         }
-        if let Some(feed) = &self.live {
-            feed.publish(LiveMessage::Record(r.clone()));
+        if let Some(w) = &self.watcher {
+            w.record(r);
         }
     }
 

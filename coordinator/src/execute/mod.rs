@@ -162,7 +162,11 @@ pub fn execute_trajectories(
         .map_err(|e| anyhow::anyhow!("cannot declare the queryable {status_key}: {e}"))?;
     // Built before the mission clock starts: a large map takes a moment.
     let ground = crawler_ground(scenario).map(Arc::new);
-    let log = LogWriter::create(&options.log)?.with_live(options.live.clone());
+    let watcher = options
+        .live
+        .clone()
+        .map(|feed| feed as Arc<dyn log::RecordWatcher>);
+    let log = LogWriter::create(&options.log)?.with_watcher(watcher);
     let epoch_unix_ms = unix_us() / 1000 + 1500;
     let mut x = Exec {
         scenario: scenario.clone(),
