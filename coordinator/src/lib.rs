@@ -16,6 +16,7 @@
 //!   the comparison tables, the SVG charts and the GeoJSON/QGroundControl exports.
 //! - [`distributed`] (planning over agents on Zenoh) and [`execute`] (driving a plan, watching
 //!   the fleet, replanning).
+//! - [`foxglove`]: a Foxglove WebSocket server fed from the execution's live feed (`--foxglove`).
 //! - [`cpu`]: the process's CPU time, for the figures that report a step's cost.
 //! - The rule: `commands` → `mission` → `planning`, `report`, `distributed`, `execute`, never
 //!   back (`commands` may also call the lower layers directly); no cycle between files
@@ -26,6 +27,7 @@ pub mod commands;
 pub mod cpu;
 pub mod distributed;
 pub mod execute;
+pub mod foxglove;
 pub mod mission;
 pub mod planning;
 pub mod report;

@@ -44,7 +44,7 @@ pub struct Telemetry {
 }
 
 /// One vehicle in the live fleet picture.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 pub struct VehicleStatusRow {
     /// Vehicle id.
     pub vehicle: String,
@@ -64,7 +64,7 @@ pub struct VehicleStatusRow {
 }
 
 /// The live fleet picture.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 pub struct FleetStatus {
     /// [`OPEN_VERSION`].
     pub version: u16,

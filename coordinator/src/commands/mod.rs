@@ -107,7 +107,7 @@ pub fn run(command: Command, shutdown: Arc<AtomicBool>) -> anyhow::Result<i32> {
         Command::Run(args) => run::command(&args, shutdown),
         Command::Serve(args) => serve::command(&args, shutdown),
         Command::Status(args) => status::command(&args),
-        Command::Replay(args) => replay::command(&args),
+        Command::Replay(args) => replay::command(&args, &shutdown),
         Command::Router(args) => router::command(&args, &shutdown),
         Command::Keys(args) => keys::command(&args),
         Command::Health(args) => health::command(&args),

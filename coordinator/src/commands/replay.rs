@@ -1,9 +1,11 @@
 //! `shoal-coordinator replay LOG`: reads a mission log back, recomputes the execution's figures
 //! from its records alone (the same [`Fleet`] the live run used), lists the decisions, and
 //! draws the planned and executed tracks (`<LOG>.svg`: top view, over the seabed and its hazards
-//! when the scenario has them). Its verdict and exit status are `run`'s.
+//! when the scenario has them). Its verdict and exit status are `run`'s. With `--foxglove` it then
+//! plays the log to Foxglove at its recorded pace (`--speed` times it).
 
 use std::path::{Path, PathBuf};
+use std::sync::atomic::AtomicBool;
 
 use anyhow::Context as _;
 use plotters::backend::SVGBackend;
@@ -16,6 +18,7 @@ use shoal_common::wire::open::MissionEvent;
 use crate::execute::fleet::{ExecutionFigures, Fleet};
 use crate::execute::log::{self, Record};
 use crate::execute::verdict;
+use crate::foxglove::{self, FoxgloveArgs};
 use crate::report::svg::chart::fail;
 
 /// `shoal-coordinator replay`.
@@ -27,6 +30,16 @@ pub struct ReplayArgs {
     /// Where to draw the tracks (default: the log's path with `.svg`).
     #[arg(long)]
     pub svg: Option<PathBuf>,
+    /// Then play the log to Foxglove, as `run --foxglove` showed it live.
+    #[command(flatten)]
+    pub foxglove: FoxgloveArgs,
+    /// With --foxglove: how many times faster than it was recorded the log plays.
+    #[arg(long, default_value_t = 1.0)]
+    pub speed: f64,
+    /// With --foxglove: listen beyond loopback although anyone who reaches the port sees the
+    /// mission (a lab network nobody else reaches).
+    #[arg(long, env = "SHOAL_INSECURE")]
+    pub insecure: bool,
 }
 
 /// What a log holds, replayed.
@@ -135,7 +148,9 @@ pub fn replay(path: &Path) -> anyhow::Result<Replayed> {
 }
 
 /// The replay command: prints the events and the figures and writes the SVG.
-pub fn command(args: &ReplayArgs) -> anyhow::Result<i32> {
+pub fn command(args: &ReplayArgs, shutdown: &AtomicBool) -> anyhow::Result<i32> {
+    let foxglove = args.foxglove.settings(args.insecure)?;
+    let speed = foxglove::pace::check_speed(args.speed)?;
     let r = replay(&args.log)?;
     let mut out = String::new();
     for e in &r.events {
@@ -180,6 +195,9 @@ pub fn command(args: &ReplayArgs) -> anyhow::Result<i32> {
         .with_context(|| format!("cannot write {}", svg_path.display()))?;
     out.push_str(&format!("Wrote {}\n", svg_path.display()));
     crate::report::out::say(&out);
+    if let Some(addr) = foxglove {
+        foxglove::stream_log(addr, &args.log, speed, shutdown)?;
+    }
     // As `run`: 0 when the execution met its figures, 3 when it did not.
     Ok(if verdict::failures(f).is_empty() {
         crate::commands::exit::EXIT_FEASIBLE
@@ -474,10 +492,16 @@ mod tests {
         let again = replay(&path)?;
         assert_eq!(again.logged.as_ref(), Some(&r.figures));
         let svg = dir.join("m.svg");
-        let code = command(&ReplayArgs {
-            log: path,
-            svg: Some(svg.clone()),
-        })?;
+        let code = command(
+            &ReplayArgs {
+                log: path,
+                svg: Some(svg.clone()),
+                foxglove: FoxgloveArgs::default(),
+                speed: 1.0,
+                insecure: false,
+            },
+            &AtomicBool::new(false),
+        )?;
         assert_eq!(code, crate::commands::exit::EXIT_VIOLATIONS);
         let drawn = std::fs::read_to_string(&svg)?;
         std::fs::remove_dir_all(&dir)?;

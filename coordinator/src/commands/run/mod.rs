@@ -9,6 +9,7 @@ use std::sync::Arc;
 
 use super::exit::{EXIT_FEASIBLE, EXIT_VIOLATIONS};
 use super::plan_args::PlanArgs;
+use crate::foxglove::{self, FoxgloveArgs};
 use crate::mission::{run_mission, ExecutionSettings, Injection, Place, RunOptions};
 
 /// `shoal-coordinator run`.
@@ -56,6 +57,9 @@ pub struct RunArgs {
     /// the extension `.mcap`.
     #[arg(long, env = "SHOAL_LOG")]
     pub log: Option<PathBuf>,
+    /// Live view in Foxglove.
+    #[command(flatten)]
+    pub foxglove: FoxgloveArgs,
 }
 
 /// Reads `T:X,Y,Z,R` or `T:VEHICLE,R`: (time, place, radius).
@@ -112,11 +116,13 @@ impl RunArgs {
 /// Plans, then executes; exit 0 when the execution kept d_min, stayed out of every hard
 /// obstacle and every vehicle arrived in the window, 3 otherwise.
 pub fn command(args: &RunArgs, shutdown: Arc<AtomicBool>) -> anyhow::Result<i32> {
-    Ok(if run_mission(&args.options()?, shutdown)? {
-        EXIT_FEASIBLE
-    } else {
-        EXIT_VIOLATIONS
-    })
+    let mut options = args.options()?;
+    let foxglove = foxglove::start(&args.foxglove, args.plan.zenoh.insecure)?;
+    options.execution.live = foxglove.as_ref().map(|(_, feed)| Arc::clone(feed));
+    let kept = run_mission(&options, shutdown)?;
+    // The clients get the end of the mission before their connections close.
+    drop(foxglove);
+    Ok(if kept { EXIT_FEASIBLE } else { EXIT_VIOLATIONS })
 }
 
 #[cfg(test)]

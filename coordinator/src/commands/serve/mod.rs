@@ -24,6 +24,8 @@ use shoal_common::wire::{codec, session, topics};
 use zenoh::Wait;
 
 use crate::distributed::AgentsMode;
+use crate::execute::live::LiveFeed;
+use crate::foxglove::{self, FoxgloveArgs};
 use crate::mission::{run_mission, MissionOptions, NetworkOptions, RunOptions};
 
 mod environment;
@@ -59,6 +61,10 @@ pub struct ServeArgs {
     /// submission is refused rather than holding the queue.
     #[arg(long, env = "SHOAL_MAX_MISSION_HOURS", default_value_t = 6.0)]
     pub max_mission_hours: f64,
+    /// Show each mission live in Foxglove (one server for all missions; beyond loopback needs
+    /// --insecure).
+    #[command(flatten)]
+    pub foxglove: FoxgloveArgs,
 }
 
 /// The operator's rules from the flags.
@@ -103,6 +109,8 @@ fn answer(
 /// Serves until `shutdown` (or `--missions` missions).
 pub fn command(args: &ServeArgs, shutdown: Arc<AtomicBool>) -> anyhow::Result<i32> {
     let rules = rules(args)?;
+    let foxglove = foxglove::start(&args.foxglove, args.zenoh.insecure)?;
+    let live = foxglove.as_ref().map(|(_, feed)| feed);
     let listen: Vec<String> = args
         .listen
         .listen
@@ -157,7 +165,7 @@ pub fn command(args: &ServeArgs, shutdown: Arc<AtomicBool>) -> anyhow::Result<i3
         };
         served += 1;
         let ran = catch_unwind(AssertUnwindSafe(|| {
-            run_one(args, &link, &mission, &s, &shutdown)
+            run_one(args, &link, &mission, &s, &shutdown, live)
         }));
         match ran {
             Ok(Ok(code)) => eprintln!("mission {mission}: ended with status {code}"),
@@ -202,6 +210,7 @@ fn run_one(
     mission: &str,
     s: &Submission,
     shutdown: &Arc<AtomicBool>,
+    live: Option<&Arc<LiveFeed>>,
 ) -> anyhow::Result<i32> {
     let dir = args.out.join(mission);
     std::fs::create_dir_all(&args.out)
@@ -210,7 +219,8 @@ fn run_one(
     let file = dir.join("scenario.toml");
     std::fs::write(&file, &s.scenario_toml)
         .with_context(|| format!("cannot write {}", file.display()))?;
-    let options = mission_options(link, mission, s, file, dir.clone())?;
+    let mut options = mission_options(link, mission, s, file, dir.clone())?;
+    options.execution.live = live.cloned();
     eprintln!(
         "mission {mission}: planning and executing (files in {})",
         dir.display()
