@@ -114,7 +114,7 @@ pub fn obstacle(o: &Obstacle, published: bool, stamp: Time) -> SceneEntity {
 pub fn bounds(b: &Bounds, stamp: Time) -> SceneEntity {
     let corner = |i: usize| {
         let pick = |axis: usize| {
-            if i >> axis & 1 == 1 {
+            if (i >> axis) & 1 == 1 {
                 b.max[axis]
             } else {
                 b.min[axis]
@@ -126,7 +126,7 @@ pub fn bounds(b: &Bounds, stamp: Time) -> SceneEntity {
     let mut points = Vec::with_capacity(24);
     for i in 0..8usize {
         for axis in 0..3 {
-            let j = i | 1 << axis;
+            let j = i | (1 << axis);
             if j != i {
                 points.extend([corner(i), corner(j)]);
             }
