@@ -106,7 +106,9 @@ class Client:
         channel = self.channels.get(self.subscriptions[sub])
         need(channel is not None, f"a message on an unadvertised channel (subscription {sub})")
         message = json.loads(data[MESSAGE_DATA.size:])
-        self.validators[channel["id"]].validate(message)
+        for e in self.validators[channel["id"]].iter_errors(message):
+            path = "/".join(str(p) for p in e.absolute_path)
+            raise Failed(f"{channel['topic']}: {path}: {e.message}")
         return channel, stamp, message
 
 

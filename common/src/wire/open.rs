@@ -54,7 +54,9 @@ pub struct VehicleStatusRow {
     pub progress: Option<Progress>,
     /// Plan revision it follows.
     pub revision: u32,
-    /// Seconds (wall) since its last report.
+    /// Seconds (wall) since its last report: infinite before the first, which JSON writes as
+    /// `null` (so the schema allows it).
+    #[schemars(with = "Option<f64>")]
     pub silent_s: f64,
     /// Its latest hold, stop or upload and what the vehicle made of it, as it reported.
     #[serde(default, skip_serializing_if = "Option::is_none")]
