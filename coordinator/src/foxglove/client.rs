@@ -87,6 +87,8 @@ fn handshake(stream: TcpStream, cx: &Context) -> Option<WebSocket<TcpStream>> {
 }
 
 /// The handshake's answer: `foxglove.websocket.v1` if the client offers it, HTTP 400 otherwise.
+// The signature is tungstenite's handshake callback's.
+#[allow(clippy::result_large_err)]
 fn choose_subprotocol(req: &Request, mut response: Response) -> Result<Response, ErrorResponse> {
     let offered = req
         .headers()
