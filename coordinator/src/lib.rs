@@ -18,6 +18,7 @@
 //!   the fleet, replanning).
 //! - [`view`]: the operator's live web view (`--view ADDR`): a page and a WebSocket fed from
 //!   the execution's live feed, or a finished log.
+//! - [`foxglove`]: a Foxglove WebSocket server fed from the execution's live feed (`--foxglove`).
 //! - [`cpu`]: the process's CPU time, for the figures that report a step's cost.
 //! - The rule: `commands` → `mission` → `planning`, `report`, `distributed`, `execute`, never
 //!   back (`commands` may also call the lower layers directly); no cycle between files
@@ -28,6 +29,7 @@ pub mod commands;
 pub mod cpu;
 pub mod distributed;
 pub mod execute;
+pub mod foxglove;
 pub mod mission;
 pub mod planning;
 pub mod report;

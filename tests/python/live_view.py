@@ -1,5 +1,5 @@
 """Drives Shoal's web view in a real headless Chromium (Debian's), over the Chrome DevTools
-Protocol with the `websockets` package (15.0.1): loads the page, waits for what a person would
+Protocol with the `websockets` package (pinned in requirements.txt): loads the page, waits for what a person would
 look for, reads back what the page drew (`window.shoalView.summary()`), and takes screenshots.
 
     python live_view.py CHROMIUM URL OUTDIR live     # a running mission

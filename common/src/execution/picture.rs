@@ -17,7 +17,7 @@ use crate::separation::all_pairs;
 use crate::trajectory::Trajectory;
 
 /// Where a vehicle is relative to its plan.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 pub struct Progress {
     /// Arc length along the plan of the point nearest the vehicle, metres.
     pub along_m: f64,
@@ -35,7 +35,7 @@ pub struct Progress {
 }
 
 /// A predicted closest approach of two vehicles.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 pub struct Conflict {
     /// Index of the first vehicle (the smaller one).
     pub a: usize,

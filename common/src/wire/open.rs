@@ -44,7 +44,7 @@ pub struct Telemetry {
 }
 
 /// One vehicle in the live fleet picture.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 pub struct VehicleStatusRow {
     /// Vehicle id.
     pub vehicle: String,
@@ -54,7 +54,9 @@ pub struct VehicleStatusRow {
     pub progress: Option<Progress>,
     /// Plan revision it follows.
     pub revision: u32,
-    /// Seconds (wall) since its last report.
+    /// Seconds (wall) since its last report: infinite before the first, which JSON writes as
+    /// `null` (so the schema allows it).
+    #[schemars(with = "Option<f64>")]
     pub silent_s: f64,
     /// Its latest hold, stop or upload and what the vehicle made of it, as it reported.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -64,7 +66,7 @@ pub struct VehicleStatusRow {
 }
 
 /// The live fleet picture.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 pub struct FleetStatus {
     /// [`OPEN_VERSION`].
     pub version: u16,

@@ -1,7 +1,8 @@
 //! `shoal-coordinator replay LOG`: reads a mission log back, recomputes the execution's figures
 //! from its records alone (the same fleet picture the live run used, see [`execute::replayed`]), lists the decisions, and
 //! draws the planned and executed tracks (`<LOG>.svg`: top view, over the seabed and its hazards
-//! when the scenario has them). Its verdict and exit status are `run`'s.
+//! when the scenario has them). Its verdict and exit status are `run`'s. With `--foxglove` it then
+//! plays the log to Foxglove at its recorded pace (`--speed` times it).
 
 use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
@@ -18,6 +19,7 @@ use crate::execute;
 use crate::execute::fleet::ExecutionFigures;
 use crate::execute::log;
 use crate::execute::verdict;
+use crate::foxglove::{self, FoxgloveArgs};
 use crate::report::svg::chart::fail;
 
 /// `shoal-coordinator replay`.
@@ -33,6 +35,16 @@ pub struct ReplayArgs {
     /// back with a time slider, until Ctrl-C.
     #[arg(long, env = "SHOAL_VIEW", value_name = "ADDR")]
     pub view: Option<std::net::SocketAddr>,
+    /// Then play the log to Foxglove, as `run --foxglove` showed it live.
+    #[command(flatten)]
+    pub foxglove: FoxgloveArgs,
+    /// With --foxglove: how many times faster than it was recorded the log plays.
+    #[arg(long, default_value_t = 1.0)]
+    pub speed: f64,
+    /// With --foxglove: listen beyond loopback although anyone who reaches the port sees the
+    /// mission (a lab network nobody else reaches).
+    #[arg(long, env = "SHOAL_INSECURE")]
+    pub insecure: bool,
 }
 
 /// What a log holds, replayed.
@@ -79,6 +91,8 @@ pub fn replay(path: &Path) -> anyhow::Result<Replayed> {
 
 /// The replay command: prints the events and the figures and writes the SVG.
 pub fn command(args: &ReplayArgs, shutdown: &AtomicBool) -> anyhow::Result<i32> {
+    let foxglove = args.foxglove.settings(args.insecure)?;
+    let speed = foxglove::pace::check_speed(args.speed)?;
     let r = replay(&args.log)?;
     let mut out = String::new();
     for e in &r.events {
@@ -123,8 +137,14 @@ pub fn command(args: &ReplayArgs, shutdown: &AtomicBool) -> anyhow::Result<i32> 
         .with_context(|| format!("cannot write {}", svg_path.display()))?;
     out.push_str(&format!("Wrote {}\n", svg_path.display()));
     crate::report::out::say(&out);
+    if args.view.is_some() && foxglove.is_some() {
+        anyhow::bail!("--view and --foxglove: a log is played to one of them at a time");
+    }
     if let Some(addr) = args.view {
         crate::view::serve_log(addr, &args.log, shutdown)?;
+    }
+    if let Some(addr) = foxglove {
+        foxglove::stream_log(addr, &args.log, speed, shutdown)?;
     }
     // As `run`: 0 when the execution met its figures, 3 when it did not.
     Ok(if verdict::failures(f).is_empty() {
@@ -425,6 +445,9 @@ mod tests {
                 log: path,
                 svg: Some(svg.clone()),
                 view: None,
+                foxglove: FoxgloveArgs::default(),
+                speed: 1.0,
+                insecure: false,
             },
             &AtomicBool::new(false),
         )?;

@@ -1,6 +1,6 @@
 //! The mission log, written as the execution goes, in two files with the same records:
 //! `mission.ndjson`, one JSON object per line for scripts ([`ndjson`]), and `mission.mcap`
-//! beside it for robotics tools ([`mcap`]; its channels and schemas: `channels`). Each loses
+//! beside it for robotics tools ([`mcap`]; its channels and schemas: [`channels`]). Each loses
 //! at most the record being written when the run is killed. `shoal-coordinator replay LOG`
 //! reads either back (told apart by the MCAP magic, not by the name) and recomputes the figures
 //! from the records alone.
@@ -8,7 +8,7 @@
 //! Records: `start` first, then `plan`, `telemetry`, `event` and `obstacle` records in the
 //! order they happened, and `end` with the figures last.
 
-mod channels;
+pub mod channels;
 pub mod mcap;
 pub mod ndjson;
 mod record;

@@ -108,14 +108,16 @@ impl ViewServer {
 
 /// For a command's `--view ADDR`: a feed for the execution to write and a server showing it
 /// (`None` without the flag). The address is printed on stderr.
-pub fn start_live(addr: Option<SocketAddr>) -> anyhow::Result<Option<(ViewServer, Arc<LiveFeed>)>> {
+pub fn start_live(
+    addr: Option<SocketAddr>,
+    feed: &Arc<LiveFeed>,
+) -> anyhow::Result<Option<ViewServer>> {
     let Some(addr) = addr else {
         return Ok(None);
     };
-    let feed = LiveFeed::new();
-    let server = ViewServer::start(addr, Source::Live(Arc::clone(&feed)))?;
+    let server = ViewServer::start(addr, Source::Live(Arc::clone(feed)))?;
     eprintln!("live view: {}", server.url());
-    Ok(Some((server, feed)))
+    Ok(Some(server))
 }
 
 /// For `replay LOG --view ADDR`: serves the log at `path` until `shutdown`.

@@ -90,7 +90,8 @@ pub fn command(args: &BenchTelemetryArgs, stop: &AtomicBool) -> anyhow::Result<i
         "bench-telemetry: {n} vehicles at {} Hz for about {:.0} s ({time_scale:.1}× real time)",
         args.hz, args.seconds
     );
-    let Some((server, feed)) = crate::view::start_live(args.view)? else {
+    let feed = crate::execute::live::LiveFeed::new();
+    let Some(server) = crate::view::start_live(args.view, &feed)? else {
         let m = bench.measure(args, ("", ""), None, stop)?;
         crate::report::out::say(&m.line);
         return Ok(crate::commands::exit::EXIT_FEASIBLE);

@@ -9,6 +9,8 @@ use std::sync::Arc;
 
 use super::exit::{EXIT_FEASIBLE, EXIT_VIOLATIONS};
 use super::plan_args::PlanArgs;
+use crate::execute::live::LiveFeed;
+use crate::foxglove::{self, FoxgloveArgs};
 use crate::mission::{run_mission, ExecutionSettings, Injection, Place, RunOptions};
 
 /// `shoal-coordinator run`.
@@ -59,6 +61,9 @@ pub struct RunArgs {
     /// Serve the live web view of the mission here (loopback, e.g. 127.0.0.1:8080).
     #[arg(long, env = "SHOAL_VIEW", value_name = "ADDR")]
     pub view: Option<std::net::SocketAddr>,
+    /// Live view in Foxglove.
+    #[command(flatten)]
+    pub foxglove: FoxgloveArgs,
 }
 
 /// Reads `T:X,Y,Z,R` or `T:VEHICLE,R`: (time, place, radius).
@@ -116,13 +121,15 @@ impl RunArgs {
 /// obstacle and every vehicle arrived in the window, 3 otherwise.
 pub fn command(args: &RunArgs, shutdown: Arc<AtomicBool>) -> anyhow::Result<i32> {
     let mut options = args.options()?;
-    let view = crate::view::start_live(args.view)?;
-    options.execution.live = view.as_ref().map(|(_, feed)| Arc::clone(feed));
-    Ok(if run_mission(&options, shutdown)? {
-        EXIT_FEASIBLE
-    } else {
-        EXIT_VIOLATIONS
-    })
+    let feed = LiveFeed::new();
+    let view = crate::view::start_live(args.view, &feed)?;
+    let foxglove = foxglove::start(&args.foxglove, args.plan.zenoh.insecure, &feed)?;
+    options.execution.live = (view.is_some() || foxglove.is_some()).then(|| Arc::clone(&feed));
+    let kept = run_mission(&options, shutdown)?;
+    // The clients get the end of the mission before their connections close.
+    drop(foxglove);
+    drop(view);
+    Ok(if kept { EXIT_FEASIBLE } else { EXIT_VIOLATIONS })
 }
 
 #[cfg(test)]

@@ -24,6 +24,8 @@ use shoal_common::wire::{codec, session, topics};
 use zenoh::Wait;
 
 use crate::distributed::AgentsMode;
+use crate::execute::live::LiveFeed;
+use crate::foxglove::{self, FoxgloveArgs};
 use crate::mission::{run_mission, MissionOptions, NetworkOptions, RunOptions};
 
 mod environment;
@@ -62,6 +64,10 @@ pub struct ServeArgs {
     /// Serve the live web view of the mission running now here (loopback, e.g. 127.0.0.1:8080).
     #[arg(long, env = "SHOAL_VIEW", value_name = "ADDR")]
     pub view: Option<std::net::SocketAddr>,
+    /// Show each mission live in Foxglove (one server for all missions; beyond loopback needs
+    /// --insecure).
+    #[command(flatten)]
+    pub foxglove: FoxgloveArgs,
 }
 
 /// The operator's rules from the flags.
@@ -106,10 +112,12 @@ fn answer(
 /// Serves until `shutdown` (or `--missions` missions).
 pub fn command(args: &ServeArgs, shutdown: Arc<AtomicBool>) -> anyhow::Result<i32> {
     let rules = rules(args)?;
-    // One feed for every mission: each starts with its start record, which the page (and the
-    // feed's catch-up) takes as a new mission.
-    let view = crate::view::start_live(args.view)?;
-    let live = view.as_ref().map(|(_, feed)| feed);
+    // One feed for every mission: each starts with its start record, which the page, the
+    // Foxglove clients (and the feed's catch-up) take as a new mission.
+    let feed = LiveFeed::new();
+    let view = crate::view::start_live(args.view, &feed)?;
+    let foxglove = foxglove::start(&args.foxglove, args.zenoh.insecure, &feed)?;
+    let live = (view.is_some() || foxglove.is_some()).then_some(&feed);
     let listen: Vec<String> = args
         .listen
         .listen
@@ -164,7 +172,7 @@ pub fn command(args: &ServeArgs, shutdown: Arc<AtomicBool>) -> anyhow::Result<i3
         };
         served += 1;
         let ran = catch_unwind(AssertUnwindSafe(|| {
-            run_one(args, &link, &mission, &s, live, &shutdown)
+            run_one(args, &link, &mission, &s, &shutdown, live)
         }));
         match ran {
             Ok(Ok(code)) => eprintln!("mission {mission}: ended with status {code}"),
@@ -208,8 +216,8 @@ fn run_one(
     link: &Link,
     mission: &str,
     s: &Submission,
-    live: Option<&Arc<crate::execute::live::LiveFeed>>,
     shutdown: &Arc<AtomicBool>,
+    live: Option<&Arc<LiveFeed>>,
 ) -> anyhow::Result<i32> {
     let dir = args.out.join(mission);
     std::fs::create_dir_all(&args.out)

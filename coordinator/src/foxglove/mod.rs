@@ -1,0 +1,215 @@
+//! A Foxglove WebSocket server (protocol `foxglove.websocket.v1`) showing a mission live in
+//! Foxglove or Lichtblick, its open-source fork: `run --foxglove ADDR` (and `replay`, `serve`)
+//! serves what the execution's live feed ([`crate::execute::live`]) publishes.
+//!
+//! Channels (JSON messages, each with a JSON Schema; see `channels`):
+//!
+//! | topic | schema | what |
+//! |---|---|---|
+//! | `/shoal/pose/<vehicle>` | `foxglove.PoseInFrame` | each report, in the scenario frame `shoal` |
+//! | `/shoal/location/<vehicle>` | `foxglove.LocationFix` | each report on WGS-84 (scenarios with an `[origin]` only) |
+//! | `/shoal/scene` | `foxglove.SceneUpdate` | bounds box, obstacles (spheres), planned paths; re-sent on each plan and obstacle |
+//! | `/shoal/status` | `shoal.status` | the fleet status, once a second |
+//! | `/shoal/events` | `shoal.event` | the coordinator's decisions and observations |
+//!
+//! A client that subscribes late first gets each channel's latest message (the latest events).
+//!
+//! **Why not the `foxglove` crate.** The official SDK (`foxglove` 0.30) runs its WebSocket
+//! server on tokio-tungstenite with a process-wide context, always builds its protobuf message
+//! types (prost) and offers no cap on clients or on the rate of their messages, which Shoal
+//! needs on anything that listens. Its well-known schemas are served as protobuf, where Shoal's
+//! logs and tools are JSON. The part of the protocol a server that only publishes needs is
+//! small (`protocol`), so it is implemented here on `tungstenite` (the synchronous WebSocket
+//! crate the SDK itself builds on), on threads of its own: the execution loop never waits for
+//! a client.
+//!
+//! **Security.** The protocol has no authentication and this server no TLS: anyone who reaches
+//! the port sees the fleet. It listens on loopback unless `--insecure` says otherwise (the flag
+//! that lets a Zenoh router listen beyond loopback unauthenticated); reach it from elsewhere
+//! through an SSH tunnel.
+
+mod channels;
+mod client;
+mod fanout;
+mod hub;
+mod limits;
+pub mod pace;
+mod protocol;
+mod schemas;
+mod server;
+mod shaping;
+
+use std::net::{IpAddr, Ipv4Addr, SocketAddr};
+use std::path::Path;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+use std::time::Duration;
+
+use crate::execute::live::LiveFeed;
+use crate::execute::log;
+
+pub use limits::{Counters, MAX_CLIENTS};
+pub use server::FoxgloveServer;
+
+/// Foxglove's default port, where its "Open connection" dialog looks first.
+pub const DEFAULT_PORT: u16 = 8765;
+
+/// `--foxglove [ADDR]`, flattened into the commands that can serve a mission to Foxglove.
+#[derive(Debug, Clone, Default, PartialEq, Eq, clap::Args)]
+pub struct FoxgloveArgs {
+    /// Serve the mission live to Foxglove (or Lichtblick) over its WebSocket protocol at ADDR:
+    /// `PORT` or `IP:PORT` (loopback by default; beyond it needs --insecure). Without a value:
+    /// 127.0.0.1:8765.
+    #[arg(
+        long,
+        env = "SHOAL_FOXGLOVE",
+        value_name = "ADDR",
+        num_args = 0..=1,
+        default_missing_value = "8765",
+        value_parser = parse_address
+    )]
+    pub foxglove: Option<SocketAddr>,
+}
+
+impl FoxgloveArgs {
+    /// Where to serve, if asked: the address, refused beyond loopback unless `insecure`.
+    pub fn settings(&self, insecure: bool) -> anyhow::Result<Option<SocketAddr>> {
+        let Some(addr) = self.foxglove else {
+            return Ok(None);
+        };
+        check_exposure(addr, insecure)?;
+        Ok(Some(addr))
+    }
+}
+
+/// Starts the server `args` ask for (refused beyond loopback unless `insecure`) on a new live
+/// feed, and says on stderr where it listens; the feed is the execution's to fill.
+pub fn start(
+    args: &FoxgloveArgs,
+    insecure: bool,
+    feed: &Arc<LiveFeed>,
+) -> anyhow::Result<Option<FoxgloveServer>> {
+    let Some(addr) = args.settings(insecure)? else {
+        return Ok(None);
+    };
+    let server = FoxgloveServer::start(addr, Arc::clone(feed))?;
+    eprintln!(
+        "Foxglove WebSocket server on ws://{} (open it in Foxglove or Lichtblick)",
+        server.local_addr()
+    );
+    Ok(Some(server))
+}
+
+/// Serves the mission log at `path` on `addr`: waits for the first client, then plays the log
+/// at `speed` times its recorded pace ([`pace::play`]) and stops. False when `stop` cut it short.
+pub fn stream_log(
+    addr: SocketAddr,
+    path: &Path,
+    speed: f64,
+    stop: &AtomicBool,
+) -> anyhow::Result<bool> {
+    let records = log::read(path)?.records;
+    let feed = LiveFeed::new();
+    let server = FoxgloveServer::start(addr, Arc::clone(&feed))?;
+    eprintln!(
+        "Foxglove WebSocket server on ws://{}: the log plays at {speed} × its pace once a \
+         client connects",
+        server.local_addr()
+    );
+    while server.counters().clients_served.load(Ordering::Relaxed) == 0 {
+        if stop.load(Ordering::Relaxed) {
+            return Ok(false);
+        }
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    let played = pace::play(&records, &feed, speed, stop);
+    server.shutdown();
+    Ok(played)
+}
+
+/// Reads `PORT` (on 127.0.0.1), `IP:PORT` or `localhost:PORT`.
+pub fn parse_address(s: &str) -> Result<SocketAddr, String> {
+    let s = s.trim();
+    if let Ok(port) = s.parse::<u16>() {
+        return Ok(SocketAddr::new(IpAddr::V4(Ipv4Addr::LOCALHOST), port));
+    }
+    if let Some(port) = s.strip_prefix("localhost:") {
+        if let Ok(port) = port.parse::<u16>() {
+            return Ok(SocketAddr::new(IpAddr::V4(Ipv4Addr::LOCALHOST), port));
+        }
+    }
+    s.parse::<SocketAddr>()
+        .map_err(|_| format!("{s:?}: expected PORT, IP:PORT or localhost:PORT"))
+}
+
+/// Refuses an address beyond loopback unless `insecure`: whoever reaches it sees the fleet.
+pub fn check_exposure(addr: SocketAddr, insecure: bool) -> anyhow::Result<()> {
+    if addr.ip().is_loopback() || insecure {
+        return Ok(());
+    }
+    anyhow::bail!(
+        "--foxglove {addr}: beyond loopback anyone who reaches the port sees the fleet (the \
+         Foxglove WebSocket protocol has no authentication, and Shoal serves it without TLS); \
+         listen on 127.0.0.1 and reach it through an SSH tunnel, or pass --insecure on a network \
+         nobody else reaches"
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::Parser;
+
+    #[derive(Parser)]
+    struct Cli {
+        #[command(flatten)]
+        fox: FoxgloveArgs,
+    }
+
+    #[test]
+    fn addresses_default_to_loopback_and_foxgloves_port() -> Result<(), clap::Error> {
+        let at = |args: &[&str]| -> Result<Option<SocketAddr>, clap::Error> {
+            Ok(Cli::try_parse_from(args)?.fox.foxglove)
+        };
+        assert_eq!(at(&["x"])?, None);
+        assert_eq!(at(&["x", "--foxglove"])?, "127.0.0.1:8765".parse().ok());
+        assert_eq!(
+            at(&["x", "--foxglove", "9000"])?,
+            "127.0.0.1:9000".parse().ok()
+        );
+        assert_eq!(
+            at(&["x", "--foxglove", "localhost:9001"])?,
+            "127.0.0.1:9001".parse().ok()
+        );
+        assert_eq!(
+            at(&["x", "--foxglove", "[::1]:9002"])?,
+            "[::1]:9002".parse().ok()
+        );
+        assert!(at(&["x", "--foxglove", "example.org:80"]).is_err());
+        assert!(at(&["x", "--foxglove", "70000"]).is_err());
+        Ok(())
+    }
+
+    #[test]
+    fn beyond_loopback_is_refused_unless_insecure() {
+        let open = FoxgloveArgs {
+            foxglove: "0.0.0.0:8765".parse().ok(),
+        };
+        let e = open
+            .settings(false)
+            .err()
+            .map(|e| e.to_string())
+            .unwrap_or_default();
+        assert!(
+            e.contains("--foxglove 0.0.0.0:8765: beyond loopback"),
+            "{e}"
+        );
+        assert!(e.contains("--insecure"), "{e}");
+        assert_eq!(open.settings(true).ok().flatten(), open.foxglove);
+        let local = FoxgloveArgs {
+            foxglove: "127.0.0.1:8765".parse().ok(),
+        };
+        assert_eq!(local.settings(false).ok().flatten(), local.foxglove);
+        assert_eq!(FoxgloveArgs::default().settings(false).ok().flatten(), None);
+    }
+}

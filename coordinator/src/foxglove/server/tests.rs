@@ -1,0 +1,174 @@
+//! The server in process, with `tungstenite`'s client on loopback: the greeting, a late
+//! subscription's latest message, and the bounds (clients, refused messages).
+
+use std::net::TcpStream;
+use std::sync::atomic::Ordering;
+
+use tungstenite::client::IntoClientRequest;
+use tungstenite::stream::MaybeTlsStream;
+use tungstenite::{Message, WebSocket};
+
+use super::*;
+use crate::execute::live::LiveMessage;
+use crate::execute::log::{Record, Start};
+use crate::foxglove::limits::MAX_REFUSED_PER_CLIENT;
+use crate::foxglove::protocol;
+use shoal_common::execution::{VehicleState, VehicleStatus};
+use shoal_common::wire::open::{Telemetry, OPEN_VERSION};
+
+type Client = WebSocket<MaybeTlsStream<TcpStream>>;
+type TestResult = Result<(), Box<dyn std::error::Error>>;
+
+const SCENARIO: &str = include_str!("../../../../scenarios/amp-pso-3.toml");
+
+fn mission(feed: &LiveFeed) {
+    feed.publish(LiveMessage::Record(Record::Start(Start {
+        mission: "m".into(),
+        scenario_toml: SCENARIO.into(),
+        common_arrival_s: 2700.0,
+        arrival_window_s: 30.0,
+        horizon_s: 60.0,
+        time_scale: 200.0,
+        epoch_unix_ms: 1_700_000_000_000,
+    })));
+    feed.publish(LiveMessage::Record(Record::Telemetry {
+        received_unix_us: 0,
+        telemetry: Telemetry {
+            version: OPEN_VERSION,
+            mission: "m".into(),
+            vehicle: "auv1".into(),
+            seq: 0,
+            revision: 0,
+            sent_unix_us: 0,
+            state: VehicleState {
+                t_s: 3.5,
+                position: [10.0, 20.0, 30.0],
+                velocity: [1.0, 0.0, 0.0],
+                heading_deg: 0.0,
+                depth_m: None,
+                altitude_m: None,
+                battery: 1.0,
+                status: VehicleStatus::Underway,
+                arrived_s: None,
+            },
+            command: None,
+        },
+    }));
+}
+
+fn connect(addr: SocketAddr, subprotocol: bool) -> Result<Client, Box<dyn std::error::Error>> {
+    let mut req = format!("ws://{addr}").into_client_request()?;
+    if subprotocol {
+        req.headers_mut()
+            .insert("Sec-WebSocket-Protocol", protocol::SUBPROTOCOL.parse()?);
+    }
+    Ok(tungstenite::connect(req)?.0)
+}
+
+fn json(m: Message) -> serde_json::Value {
+    match m {
+        Message::Text(t) => serde_json::from_str(t.as_str()).unwrap_or_default(),
+        _ => serde_json::Value::Null,
+    }
+}
+
+/// The server, once its hub has taken in the sample mission.
+fn started() -> Result<(FoxgloveServer, Arc<LiveFeed>), Box<dyn std::error::Error>> {
+    let feed = LiveFeed::new();
+    mission(&feed);
+    let server = FoxgloveServer::start("127.0.0.1:0".parse()?, Arc::clone(&feed))?;
+    Ok((server, feed))
+}
+
+#[test]
+fn a_client_is_greeted_and_gets_the_latest_pose_when_it_subscribes() -> TestResult {
+    let (server, _feed) = started()?;
+    let mut c = connect(server.local_addr(), true)?;
+    assert_eq!(json(c.read()?)["op"], "serverInfo");
+    // The hub may take in the start record after this client registered: then the vehicles'
+    // channels come in an advertise of their own.
+    let mut pose = None;
+    while pose.is_none() {
+        let m = json(c.read()?);
+        assert_eq!(m["op"], "advertise", "{m}");
+        let channels = m["channels"].as_array().cloned().unwrap_or_default();
+        pose = channels
+            .iter()
+            .find(|ch| ch["topic"] == "/shoal/pose/auv1")
+            .and_then(|ch| ch["id"].as_u64());
+    }
+    let sub =
+        serde_json::json!({"op": "subscribe", "subscriptions": [{"id": 42, "channelId": pose}]});
+    c.send(Message::text(sub.to_string()))?;
+    let Message::Binary(frame) = c.read()? else {
+        return Err("no message data".into());
+    };
+    assert_eq!(frame[0], 1);
+    assert_eq!(frame[1..5], 42u32.to_le_bytes());
+    let stamp = u64::from_le_bytes(frame[5..13].try_into()?);
+    assert_eq!(stamp, 1_700_000_000_000 * 1_000_000 + 3_500_000_000);
+    let message: serde_json::Value = serde_json::from_slice(&frame[13..])?;
+    assert_eq!(message["pose"]["position"]["x"], 10.0);
+    server.shutdown();
+    Ok(())
+}
+
+#[test]
+fn clients_over_the_cap_and_without_the_subprotocol_are_turned_away() -> TestResult {
+    let (server, _feed) = started()?;
+    let addr = server.local_addr();
+    assert!(connect(addr, false).is_err(), "no subprotocol");
+    let mut clients = Vec::new();
+    for _ in 0..MAX_CLIENTS {
+        let mut c = connect(addr, true)?;
+        assert_eq!(json(c.read()?)["op"], "serverInfo");
+        clients.push(c);
+    }
+    assert!(connect(addr, true).is_err(), "one over the cap");
+    let counters = server.counters();
+    assert_eq!(counters.clients_refused.load(Ordering::Relaxed), 1);
+    assert_eq!(counters.handshakes_failed.load(Ordering::Relaxed), 1);
+    // One leaves: another gets its place.
+    drop(clients.pop());
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(10);
+    loop {
+        match connect(addr, true) {
+            Ok(_) => break,
+            Err(e) if std::time::Instant::now() > deadline => return Err(e),
+            Err(_) => std::thread::sleep(std::time::Duration::from_millis(50)),
+        }
+    }
+    server.shutdown();
+    Ok(())
+}
+
+#[test]
+fn a_client_that_keeps_sending_nonsense_is_dropped_and_counted() -> TestResult {
+    let (server, _feed) = started()?;
+    let mut c = connect(server.local_addr(), true)?;
+    for _ in 0..=MAX_REFUSED_PER_CLIENT {
+        c.send(Message::text("nonsense"))?;
+    }
+    let mut warnings = 0;
+    let closed = loop {
+        match c.read() {
+            Ok(Message::Text(t)) => {
+                let m: serde_json::Value = serde_json::from_str(t.as_str())?;
+                warnings += usize::from(m["op"] == "status" && m["level"] == 1);
+            }
+            Ok(Message::Close(frame)) => break frame.map(|f| u16::from(f.code)),
+            Ok(_) => {}
+            Err(e) => return Err(e.into()),
+        }
+    };
+    assert_eq!(warnings, MAX_REFUSED_PER_CLIENT as usize);
+    assert_eq!(closed, Some(1008), "policy violation");
+    let counters = server.counters();
+    assert_eq!(
+        counters.messages_refused.load(Ordering::Relaxed),
+        u64::from(MAX_REFUSED_PER_CLIENT) + 1
+    );
+    assert_eq!(counters.clients_dropped.load(Ordering::Relaxed), 1);
+    server.shutdown();
+    Ok(())
+}
