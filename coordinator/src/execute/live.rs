@@ -226,36 +226,43 @@ impl LiveFeed {
     }
 }
 
+/// A vehicle's report as a feed message, for tests: `seq` numbers and stamps it (microseconds),
+/// at mission time `t_s` and `position`, underway at 1 m/s east.
+#[cfg(test)]
+pub(crate) fn test_report(vehicle: &str, seq: u64, t_s: f64, position: [f64; 3]) -> LiveMessage {
+    use shoal_common::execution::{VehicleState, VehicleStatus};
+    LiveMessage::Record(Record::Telemetry {
+        received_unix_us: seq,
+        telemetry: Telemetry {
+            version: shoal_common::wire::open::OPEN_VERSION,
+            mission: "m".into(),
+            vehicle: vehicle.into(),
+            seq,
+            revision: 0,
+            sent_unix_us: seq,
+            state: VehicleState {
+                t_s,
+                position,
+                velocity: [1.0, 0.0, 0.0],
+                heading_deg: 0.0,
+                depth_m: None,
+                altitude_m: None,
+                battery: 1.0,
+                status: VehicleStatus::Underway,
+                arrived_s: None,
+            },
+            command: None,
+        },
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
-    use shoal_common::execution::{VehicleState, VehicleStatus};
     use shoal_common::wire::open::{MissionEvent, OPEN_VERSION};
 
     fn report(vehicle: &str, seq: u64) -> LiveMessage {
-        LiveMessage::Record(Record::Telemetry {
-            received_unix_us: seq,
-            telemetry: Telemetry {
-                version: OPEN_VERSION,
-                mission: "m".into(),
-                vehicle: vehicle.into(),
-                seq,
-                revision: 0,
-                sent_unix_us: seq,
-                state: VehicleState {
-                    t_s: seq as f64,
-                    position: [seq as f64, 0.0, 0.0],
-                    velocity: [1.0, 0.0, 0.0],
-                    heading_deg: 0.0,
-                    depth_m: None,
-                    altitude_m: None,
-                    battery: 1.0,
-                    status: VehicleStatus::Underway,
-                    arrived_s: None,
-                },
-                command: None,
-            },
-        })
+        test_report(vehicle, seq, seq as f64, [seq as f64, 0.0, 0.0])
     }
 
     fn event(n: usize) -> LiveMessage {

@@ -7,40 +7,15 @@ use std::sync::atomic::Ordering;
 use std::time::{Duration, Instant};
 
 use serde_json::Value;
-use shoal_common::execution::{VehicleState, VehicleStatus};
-use shoal_common::wire::open::{Telemetry, OPEN_VERSION};
 use tungstenite::{Message, WebSocket};
 
 use super::*;
 use crate::execute::live::LiveMessage;
-use crate::execute::log::Record;
 
 type TestResult = Result<(), Box<dyn std::error::Error>>;
 
 fn report(vehicle: &str, seq: u64) -> LiveMessage {
-    LiveMessage::Record(Record::Telemetry {
-        received_unix_us: seq,
-        telemetry: Telemetry {
-            version: OPEN_VERSION,
-            mission: "m".into(),
-            vehicle: vehicle.into(),
-            seq,
-            revision: 0,
-            sent_unix_us: seq,
-            state: VehicleState {
-                t_s: seq as f64,
-                position: [seq as f64, 2.0, 3.0],
-                velocity: [1.0, 0.0, 0.0],
-                heading_deg: 0.0,
-                depth_m: None,
-                altitude_m: None,
-                battery: 1.0,
-                status: VehicleStatus::Underway,
-                arrived_s: None,
-            },
-            command: None,
-        },
-    })
+    crate::execute::live::test_report(vehicle, seq, seq as f64, [seq as f64, 2.0, 3.0])
 }
 
 fn server(feed: &Arc<LiveFeed>) -> anyhow::Result<ViewServer> {

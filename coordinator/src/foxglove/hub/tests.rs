@@ -1,7 +1,6 @@
 use super::*;
-use shoal_common::execution::{VehicleState, VehicleStatus};
 use shoal_common::scenario::ObstacleKind;
-use shoal_common::wire::open::{MissionEvent, Telemetry, OPEN_VERSION};
+use shoal_common::wire::open::{MissionEvent, OPEN_VERSION};
 
 /// Five AUVs, twelve obstacles and a geodetic origin.
 const WITH_ORIGIN: &str = include_str!("../../../../scenarios/amp-pso-3.toml");
@@ -22,29 +21,7 @@ fn start(toml: &str) -> LiveMessage {
 }
 
 fn report(vehicle: &str, t_s: f64, position: [f64; 3]) -> LiveMessage {
-    LiveMessage::Record(Record::Telemetry {
-        received_unix_us: 0,
-        telemetry: Telemetry {
-            version: OPEN_VERSION,
-            mission: "m".into(),
-            vehicle: vehicle.into(),
-            seq: 0,
-            revision: 0,
-            sent_unix_us: 0,
-            state: VehicleState {
-                t_s,
-                position,
-                velocity: [1.0, 0.0, 0.0],
-                heading_deg: 0.0,
-                depth_m: None,
-                altitude_m: None,
-                battery: 1.0,
-                status: VehicleStatus::Underway,
-                arrived_s: None,
-            },
-            command: None,
-        },
-    })
+    crate::execute::live::test_report(vehicle, 0, t_s, position)
 }
 
 fn data(updates: &[Update]) -> Vec<&Data> {

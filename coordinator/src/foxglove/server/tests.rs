@@ -13,8 +13,6 @@ use crate::execute::live::LiveMessage;
 use crate::execute::log::{Record, Start};
 use crate::foxglove::limits::MAX_REFUSED_PER_CLIENT;
 use crate::foxglove::protocol;
-use shoal_common::execution::{VehicleState, VehicleStatus};
-use shoal_common::wire::open::{Telemetry, OPEN_VERSION};
 
 type Client = WebSocket<MaybeTlsStream<TcpStream>>;
 type TestResult = Result<(), Box<dyn std::error::Error>>;
@@ -31,29 +29,12 @@ fn mission(feed: &LiveFeed) {
         time_scale: 200.0,
         epoch_unix_ms: 1_700_000_000_000,
     })));
-    feed.publish(LiveMessage::Record(Record::Telemetry {
-        received_unix_us: 0,
-        telemetry: Telemetry {
-            version: OPEN_VERSION,
-            mission: "m".into(),
-            vehicle: "auv1".into(),
-            seq: 0,
-            revision: 0,
-            sent_unix_us: 0,
-            state: VehicleState {
-                t_s: 3.5,
-                position: [10.0, 20.0, 30.0],
-                velocity: [1.0, 0.0, 0.0],
-                heading_deg: 0.0,
-                depth_m: None,
-                altitude_m: None,
-                battery: 1.0,
-                status: VehicleStatus::Underway,
-                arrived_s: None,
-            },
-            command: None,
-        },
-    }));
+    feed.publish(crate::execute::live::test_report(
+        "auv1",
+        0,
+        3.5,
+        [10.0, 20.0, 30.0],
+    ));
 }
 
 fn connect(addr: SocketAddr, subprotocol: bool) -> Result<Client, Box<dyn std::error::Error>> {
