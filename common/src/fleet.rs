@@ -106,7 +106,7 @@ impl FleetModel {
     }
 
     /// Appends vehicle `i`'s waypoint genes (not its speeds) along its straight line bent by
-    /// the sine harmonics `shape` (see [`bent_curve`]), as big as `bend` says, each gene
+    /// the sine harmonics `shape` (as the initial particles are), as big as `bend` says, each gene
     /// clamped to its bounds.
     pub fn bent_waypoints(&self, i: usize, shape: &[Vec3], bend: Bend, x: &mut Vec<f64>) {
         let m = self.layout.waypoints;

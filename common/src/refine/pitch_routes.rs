@@ -38,8 +38,8 @@ fn covering(model: &FleetModel, i: usize) -> f64 {
 }
 
 /// `count` chromosomes for vehicle `i`, each its straight line bent horizontally by random sine
-/// harmonics to cover 1 to 1 + `SPREAD` times [`covering`], climbing evenly; the speed genes are
-/// `speeds` (the vehicle's present ones).
+/// harmonics to cover 1 to 1 + `SPREAD` times the horizontal distance its pitch limit requires
+/// (0.1° inside it), climbing evenly; the speed genes are `speeds` (the vehicle's present ones).
 pub fn drawn_ways(
     model: &FleetModel,
     i: usize,
