@@ -4,6 +4,7 @@ look for, reads back what the page drew (`window.shoalView.summary()`), and take
 
     python live_view.py CHROMIUM URL OUTDIR live     # a running mission
     python live_view.py CHROMIUM URL OUTDIR replay   # a replayed log
+    python live_view.py CHROMIUM URL OUTDIR conflict # a replayed log ending in a conflict
 
 Prints one JSON object per step on stdout ({"step", "before_us", "after_us", "summary"}); the
 Rust test compares them with the run's mission log. Screenshots go to OUTDIR/<step>.png.
@@ -145,6 +146,18 @@ def replay(page, url, outdir):
     step(page, outdir, "replay-middle", s)
 
 
+def conflict(page, url, outdir):
+    """A replayed log that ends with a predicted conflict: the line is drawn red."""
+    page.call("Page.navigate", url=url)
+    s = wait_for(page, "a predicted conflict",
+                 lambda s: s["mode"] == "replay" and s["caughtUp"] and s["ended"]
+                 and s["predicted"] is not None and s["predicted"]["conflict"])
+    # What the browser paints, not what the page says it drew.
+    s["predicted_stroke"] = page.evaluate(
+        "getComputedStyle(document.querySelector('#top [data-predicted]')).stroke")
+    step(page, outdir, "conflict", s)
+
+
 def main():
     chromium, url, outdir, mode = sys.argv[1:5]
     os.makedirs(outdir, exist_ok=True)
@@ -152,7 +165,7 @@ def main():
     try:
         page.call("Page.enable")
         page.call("Runtime.enable")
-        (live if mode == "live" else replay)(page, url, outdir)
+        {"live": live, "replay": replay, "conflict": conflict}[mode](page, url, outdir)
     finally:
         try:
             page.call("Browser.close")

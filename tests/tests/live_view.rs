@@ -164,6 +164,24 @@ fn check_predicted(s: &Value, d_min: f64) {
     }
 }
 
+/// Starts `replay LOG --view` on a free loopback port; returns it and the page's address.
+fn replay_view(fleet: &mut Fleet, log: &Path) -> (common::fleet::Handle, String) {
+    let addr = format!("127.0.0.1:{}", free_port());
+    let mut cmd = Command::new(coordinator());
+    without_shoal_env(&mut cmd);
+    cmd.current_dir(root())
+        .arg("replay")
+        .arg(log)
+        .args(["--view", &addr]);
+    let replay = fleet.spawn("replay", cmd);
+    fleet.wait_for_stderr(
+        replay,
+        "replay view: http://",
+        Instant::now() + Duration::from_secs(60),
+    );
+    (replay, format!("http://{addr}/"))
+}
+
 #[test]
 fn the_live_view_shows_the_mission_in_a_real_browser_and_replays_it() -> TestResult {
     let mut fleet = Fleet::new();
@@ -232,26 +250,8 @@ fn the_live_view_shows_the_mission_in_a_real_browser_and_replays_it() -> TestRes
     assert_eq!(step("reloaded")["summary"]["connections"].as_u64(), Some(1));
 
     // The finished log, played back.
-    let port = free_port();
-    let addr = format!("127.0.0.1:{port}");
-    let mut cmd = Command::new(coordinator());
-    without_shoal_env(&mut cmd);
-    cmd.current_dir(root())
-        .arg("replay")
-        .arg(out.join("mission.ndjson"))
-        .args(["--view", &addr]);
-    let replay = fleet.spawn("replay", cmd);
-    fleet.wait_for_stderr(
-        replay,
-        "replay view: http://",
-        Instant::now() + Duration::from_secs(60),
-    );
-    let steps = browser_steps(
-        &mut fleet,
-        &format!("http://{addr}/"),
-        &shots.join("replay"),
-        "replay",
-    )?;
+    let (replay, url) = replay_view(&mut fleet, &out.join("mission.ndjson"));
+    let steps = browser_steps(&mut fleet, &url, &shots.join("replay"), "replay")?;
     let end = &steps["replay-end"]["summary"];
     assert_eq!(end["vehicles"].as_array().map(Vec::len), Some(5), "{end}");
     check_obstacle(end, &log);
@@ -277,6 +277,141 @@ fn the_live_view_shows_the_mission_in_a_real_browser_and_replays_it() -> TestRes
             "{shot} is not a PNG"
         );
     }
+    fleet.passed();
+    Ok(())
+}
+
+/// Two AUVs: auv1 from (1000, 1000, 1000) 300 m south, auv2 300 m from the west to
+/// (960, 1000, 1000), 40 m from auv1's start, arriving at the mission time (300 s) when auv1 is
+/// far away (the plan keeps them at least 240 m apart).
+const CONFLICT_SCENARIO: &str = r#"
+name = "lost-beside-arrived"
+description = "auv2 arrives 40 m from where auv1 starts"
+
+[bounds]
+min = [0.0, 0.0, 0.0]
+max = [2000.0, 2000.0, 2000.0]
+
+[fleet]
+d_min_m = 50.0
+mission_time_s = 300.0
+
+[optimizer]
+algorithm = "amp-pso"
+populations = 4
+particles = 20
+leader_particles = 10
+iterations = 30
+waypoints = 10
+seed = 1
+
+[[obstacles]]
+id = "far"
+kind = "hard"
+centre = [1800.0, 1800.0, 200.0]
+radius_m = 50.0
+inflation_m = 10.0
+
+[[vehicles]]
+id = "auv1"
+kind = "auv"
+start = [1000.0, 1000.0, 1000.0]
+goal = [1000.0, 700.0, 1000.0]
+speed_min_mps = 0.5
+speed_max_mps = 1.5
+max_turn_deg = 35.0
+max_pitch_deg = 20.0
+
+[[vehicles]]
+id = "auv2"
+kind = "auv"
+start = [660.0, 1000.0, 1000.0]
+goal = [960.0, 1000.0, 1000.0]
+speed_min_mps = 0.5
+speed_max_mps = 1.5
+max_turn_deg = 35.0
+max_pitch_deg = 20.0
+"#;
+
+/// A predicted conflict, drawn red: auv1's agent never connects, so auv1 stands at its start,
+/// lost 2 + 5 wall seconds into the mission (560 mission seconds at 80×); auv2 has arrived by
+/// then (300 mission seconds: under 4 s), 40 m from it, and the mission is given up only at
+/// 930 s (the window and 600 s past it). Neither can give way, so the mission ends with the two
+/// predicted under d_min, and its last status shows it. The replayed log's page draws that
+/// closest approach as a conflict, between auv1's start and auv2's finish.
+#[test]
+fn the_view_draws_a_predicted_conflict_under_d_min_in_red() -> TestResult {
+    let mut fleet = Fleet::new();
+    let shots = artefacts().join("conflict");
+    std::fs::create_dir_all(&shots)?;
+    let file = fleet.dir().join("lost-beside-arrived.toml");
+    std::fs::write(&file, CONFLICT_SCENARIO)?;
+    let out = fleet.dir().join("run");
+    let port = free_port();
+    let mut cmd = Command::new(coordinator());
+    without_shoal_env(&mut cmd);
+    cmd.current_dir(root())
+        .arg("run")
+        .arg(&file)
+        .args([
+            "--in-process",
+            "-q",
+            "--time-scale",
+            "80",
+            "--agents",
+            "external",
+        ])
+        .args([
+            "--lost-after",
+            "2",
+            "--listen",
+            &common::fleet::endpoint(port),
+        ])
+        .arg("--out")
+        .arg(&out);
+    let run = fleet.spawn("coordinator", cmd);
+    fleet.agent(
+        "auv2",
+        &common::fleet::endpoint(port),
+        &["--idle-timeout", "5"],
+    );
+    let r = fleet.wait(run, Instant::now() + LIMIT);
+    assert_eq!(r.code(), Some(3), "{r}");
+    assert!(r.stdout.contains("auv1 never arrived"), "{r}");
+
+    let (replay, url) = replay_view(&mut fleet, &out.join("mission.ndjson"));
+    let steps = browser_steps(&mut fleet, &url, &shots, "conflict")?;
+    fleet.kill(replay);
+    let s = &steps["conflict"]["summary"];
+    check_predicted(s, 50.0);
+    let line = &s["predicted"];
+    assert_eq!(line["conflict"], true, "{s}");
+    let mut pair: Vec<&str> = (line["vehicles"].as_array().into_iter().flatten())
+        .filter_map(Value::as_str)
+        .collect();
+    pair.sort_unstable();
+    assert_eq!(pair, ["auv1", "auv2"], "{s}");
+    // Hand value: |(1000, 1000) − (960, 1000)| = 40 m, auv2 within its arrival tolerance.
+    let d = s["status_predicted"]["min_distance_m"]
+        .as_f64()
+        .unwrap_or(f64::NAN);
+    assert!((d - 40.0).abs() < 10.0, "{s}");
+    // Drawn between the two places, in the top view's (x, −y).
+    let ends = [
+        (line["x1"].as_f64(), line["y1"].as_f64()),
+        (line["x2"].as_f64(), line["y2"].as_f64()),
+    ];
+    let near = |x: f64, y: f64| {
+        ends.iter().any(|e| match e {
+            (Some(ex), Some(ey)) => (ex - x).hypot(ey - y) < 10.0,
+            _ => false,
+        })
+    };
+    assert!(near(1000.0, -1000.0) && near(960.0, -1000.0), "{s}");
+    // Painted in the conflict colour (#e0245e), not the grey of a safe approach.
+    assert_eq!(s["predicted_stroke"], "rgb(224, 36, 94)", "{s}");
+    let shot = std::fs::read(shots.join("conflict.png"))?;
+    assert!(shot.starts_with(b"\x89PNG\r\n\x1a\n"), "not a PNG");
     fleet.passed();
     Ok(())
 }

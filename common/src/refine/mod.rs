@@ -54,6 +54,7 @@ use std::sync::Arc;
 use crate::bspline::polyline_length;
 use crate::cost::{FleetEvaluation, FleetModel};
 use crate::scenario::Scenario;
+use crate::swarm::core::parallel;
 use crate::trajectory::{shortest_pitch_feasible_length, Trajectory};
 use search::{Arena, Search};
 pub use settings::RefineSettings;
@@ -261,12 +262,13 @@ fn reroute_if_late(search: &mut Search<FleetArena>, i: usize) {
     search.evaluations += spent;
     let mut trial = search.x.clone();
     trial[model.layout.chromosome(i)].copy_from_slice(&genes);
-    try_way(search, i, trial);
+    try_ways(search, i, vec![trial]);
 }
 
 /// When vehicle `i`'s path is more than [`pitch_routes::SLACK`] longer than its pitch limit
 /// allows, [`pitch_routes::DRAWN`] fresh ways at that bound are scored by the merit and the best
-/// [`pitch_routes::TRIED`] refined ([`try_way`]).
+/// [`pitch_routes::TRIED`] refined ([`try_ways`]). The scoring and the trials run on the
+/// optimizer's threads; the ways are drawn first, so the result does not depend on them.
 fn tighten_if_long(search: &mut Search<FleetArena>, i: usize) {
     let model = search.arena.model;
     let v = &model.scenario.vehicles[i];
@@ -279,40 +281,58 @@ fn tighten_if_long(search: &mut Search<FleetArena>, i: usize) {
     let seed =
         crate::swarm::population::stream_seed(model.scenario.optimizer.seed, 9_100_001 + i as u64);
     let mut rng = <rand::rngs::StdRng as rand::SeedableRng>::seed_from_u64(seed);
-    let mut scored: Vec<(f64, Vec<f64>)> =
-        pitch_routes::drawn_ways(model, i, &speeds, pitch_routes::DRAWN, &mut rng)
-            .into_iter()
-            .map(|way| {
-                let mut trial = search.x.clone();
-                trial[genes.clone()].copy_from_slice(&way);
-                let e = search.arena.evaluate_change(&search.eval, &trial, i);
-                (search.arena.merit(&e), trial)
-            })
-            .collect();
-    search.evaluations += scored.len() as u64;
-    scored.sort_by(|a, b| a.0.total_cmp(&b.0));
-    for (_, trial) in scored.into_iter().take(pitch_routes::TRIED) {
-        if search.interrupted {
-            return;
-        }
-        try_way(search, i, trial);
-    }
+    let ways = pitch_routes::drawn_ways(model, i, &speeds, pitch_routes::DRAWN, &mut rng);
+    let (x, eval, arena) = (&search.x, &search.eval, search.arena);
+    let merits = parallel::map(&ways, model.scenario.optimizer.threads, |way| {
+        let mut trial = x.clone();
+        trial[genes.clone()].copy_from_slice(way);
+        arena.merit(&arena.evaluate_change(eval, &trial, i))
+    });
+    search.evaluations += ways.len() as u64;
+    let mut order: Vec<usize> = (0..ways.len()).collect();
+    order.sort_by(|&a, &b| merits[a].total_cmp(&merits[b]));
+    let trials = (order.iter().take(pitch_routes::TRIED))
+        .map(|&k| {
+            let mut trial = search.x.clone();
+            trial[genes.clone()].copy_from_slice(&ways[k]);
+            trial
+        })
+        .collect();
+    try_ways(search, i, trials);
 }
 
-/// Moves to fleet position `trial` (a new way for vehicle `i` alone), refines vehicle `i` there
-/// for the settings' rounds, and goes back unless that lowered the merit.
-fn try_way(search: &mut Search<FleetArena>, i: usize, trial: Vec<f64>) {
-    let model = search.arena.model;
-    let kept = (search.x.clone(), search.eval.clone(), search.steps);
-    search.eval = model.evaluate(&trial);
-    search.x = trial;
-    search.evaluations += 1;
-    search.steps += 1;
-    for _ in 0..search.settings.rounds {
-        search.vehicle(i);
+/// Refines vehicle `i` for the settings' rounds from each fleet position of `trials` (a new
+/// way for vehicle `i` alone), each on its own thread, and moves to the first whose result
+/// lowers the merit most; stays put when none lowers it. The same choice as trying them one
+/// after the other, keeping each that beats the position kept so far.
+fn try_ways(search: &mut Search<FleetArena>, i: usize, trials: Vec<Vec<f64>>) {
+    if search.interrupted {
+        return;
     }
-    if search.arena.merit(&search.eval) >= search.arena.merit(&kept.1) {
-        (search.x, search.eval, search.steps) = kept;
+    let mut branches: Vec<Search<FleetArena>> =
+        trials.into_iter().map(|x| search.branch(x)).collect();
+    let threads = search.arena.model.scenario.optimizer.threads;
+    parallel::for_each_mut(&mut branches, threads, |b| {
+        for _ in 0..b.settings.rounds {
+            b.vehicle(i);
+        }
+    });
+    let mut best = search.arena.merit(&search.eval);
+    let mut chosen = None;
+    for b in branches {
+        search.evaluations += b.evaluations;
+        search.interrupted |= b.interrupted;
+        let merit = search.arena.merit(&b.eval);
+        if merit < best {
+            best = merit;
+            chosen = Some(b);
+        }
+    }
+    if let Some(b) = chosen {
+        // The move to the new way counts as a step.
+        search.steps += b.steps + 1;
+        search.x = b.x;
+        search.eval = b.eval;
     }
 }
 

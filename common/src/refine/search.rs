@@ -83,6 +83,18 @@ impl<'a, A: Arena> Search<'a, A> {
         }
     }
 
+    /// A search of the same arena and settings from `x` (its own counters, from zero).
+    pub fn branch(&self, x: Vec<f64>) -> Self {
+        Search {
+            eval: self.arena.evaluate(&x),
+            x,
+            evaluations: 1,
+            steps: 0,
+            interrupted: false,
+            ..*self
+        }
+    }
+
     /// The stop flag is raised or the deadline has passed.
     fn should_stop(&self) -> bool {
         self.stop.is_some_and(|f| f.load(Ordering::Relaxed))

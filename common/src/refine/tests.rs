@@ -98,6 +98,46 @@ fn a_descent_longer_than_its_pitch_needs_is_pulled_onto_the_pitch_bound(
     Ok(())
 }
 
+/// The fresh ways at the pitch bound are scored, and the best refined, on the optimizer's
+/// threads: the refined plan is the same, bit for bit, on one thread or several. One program
+/// leaves the 15 % longer arc of the descent above over the bound, so the ways are drawn.
+#[test]
+fn the_refinement_does_not_depend_on_the_thread_count() -> Result<(), ScenarioError> {
+    let mut s = scenario(
+        "",
+        &[vehicle("a", [300.0, 500.0, 400.0], [700.0, 500.0, 100.0])],
+    )?;
+    let radius = 200.0 / 120f64.to_radians().sin();
+    let x = chromosome(12, |u| {
+        let phi = (-150.0 - 240.0 * u).to_radians();
+        [
+            500.0 + radius * phi.cos(),
+            500.0 + radius * 0.5 + radius * phi.sin(),
+            400.0 - 300.0 * u,
+        ]
+    });
+    let settings = RefineSettings {
+        rounds: 1,
+        steps: 1,
+        ..RefineSettings::default()
+    };
+    let mut runs = Vec::new();
+    for threads in [1, 2, 3] {
+        s.optimizer.threads = threads;
+        runs.push(refine(&FleetModel::new(&s), &x, &settings, None));
+    }
+    assert!(
+        runs[0].evaluations > pitch_routes::DRAWN as u64,
+        "{:?}",
+        runs[0]
+    );
+    assert!(runs[0].total.1 < runs[0].total.0, "{:?}", runs[0]);
+    for r in &runs[1..] {
+        assert_eq!(r, &runs[0]);
+    }
+    Ok(())
+}
+
 /// Two AUVs cross at the same moment; the first bows 150 m out of the second's way. Pulling it
 /// straight would bring them together: the refinement shortens it only as far as d_min allows.
 #[test]

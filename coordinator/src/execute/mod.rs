@@ -38,6 +38,7 @@ use shoal_common::scenario::{Obstacle, Scenario};
 use shoal_common::trajectory::Trajectory;
 use shoal_common::wire::codec;
 use shoal_common::wire::coordinator_to_agent::CoordinatorToAgent;
+use shoal_common::wire::open::FleetStatus;
 use shoal_common::wire::topics::{self, OpenKey};
 use shoal_common::wire::WireTrajectory;
 use zenoh::Wait;
@@ -207,6 +208,9 @@ pub fn execute_trajectories(
     }));
     x.publish_plan(ids.clone());
     let ended = run_loop(&mut x, &rx, plans, &scenario_toml, &latest, stop);
+    // The picture as the mission ended (a vehicle lost in its last second included): the last
+    // status the status key, the web view and Foxglove show.
+    publish_status(&mut x, &latest);
     for id in &ids {
         x.send(
             id,
@@ -236,6 +240,24 @@ pub fn execute_trajectories(
     std::thread::sleep(Duration::from_millis(200)); // let the stops go out
     x.session.close();
     Ok(report)
+}
+
+/// Publishes the fleet status: the status key (and the latest kept for its queries) and the
+/// live feed; returns it.
+fn publish_status(x: &mut Exec, latest: &std::sync::Mutex<Vec<u8>>) -> FleetStatus {
+    let status = x.status();
+    if let Ok(bytes) = codec::encode_json(&status) {
+        if let Ok(mut l) = latest.lock() {
+            *l = bytes;
+        }
+    }
+    if let Ok(key) = topics::open_key(&x.mission, OpenKey::Status) {
+        x.put_json(&key, &status);
+    }
+    if let Some(feed) = &x.options.live {
+        feed.publish(live::LiveMessage::Status(status.clone()));
+    }
+    status
 }
 
 /// The loop: orders out, reports in, the picture refreshed and acted on.
@@ -312,18 +334,7 @@ fn run_loop(
         }
         if publish.elapsed() >= Duration::from_secs(1) {
             publish = Instant::now();
-            let status = x.status();
-            if let Ok(bytes) = codec::encode_json(&status) {
-                if let Ok(mut l) = latest.lock() {
-                    *l = bytes;
-                }
-            }
-            if let Ok(key) = topics::open_key(&x.mission, OpenKey::Status) {
-                x.put_json(&key, &status);
-            }
-            if let Some(feed) = &o.live {
-                feed.publish(live::LiveMessage::Status(status.clone()));
-            }
+            let status = publish_status(x, latest);
             if !o.quiet {
                 eprintln!("{}", react::progress_line(&status, x.fleet.reports));
             }

@@ -1,12 +1,12 @@
 //! A mission log folded back, record by record, into the fleet picture the live run had: what
-//! `replay` recomputes its figures from, and what the web view rebuilds a replayed mission's
-//! statuses from.
+//! `replay` recomputes its figures from, and what a replayed mission's statuses are rebuilt
+//! from ([`Statuses`], for the web view and the Foxglove server: the log holds no statuses).
 
 use std::path::Path;
 
 use shoal_common::scenario::Scenario;
 use shoal_common::trajectory::Trajectory;
-use shoal_common::wire::open::MissionEvent;
+use shoal_common::wire::open::{FleetStatus, MissionEvent};
 
 use super::fleet::{ExecutionFigures, Fleet};
 use super::log::{self, Record, Start};
@@ -111,5 +111,57 @@ impl Replayed {
             Record::End(f) => self.logged = Some(f.clone()),
             Record::Start(_) | Record::Plan(_) => {}
         }
+    }
+}
+
+/// A log's statuses, rebuilt as the live run published them: one with the first report at
+/// least `every` mission seconds after the last status, and one with the end record (the
+/// picture as the mission ended, as the run's last status).
+pub struct Statuses {
+    /// The picture so far.
+    pub replayed: Replayed,
+    /// Mission seconds between two statuses.
+    every: f64,
+    /// When the next is due, mission seconds.
+    next: f64,
+    /// The latest mission time of a report or an event so far.
+    latest: f64,
+}
+
+impl Statuses {
+    /// Statuses of `records` (see [`Replayed::new`]), `every` mission seconds apart.
+    pub fn new(records: &[Record], path: &Path, every: f64) -> anyhow::Result<Statuses> {
+        Ok(Statuses {
+            replayed: Replayed::new(records, path)?,
+            every,
+            next: f64::NEG_INFINITY,
+            latest: 0.0,
+        })
+    }
+
+    /// Applies `r` ([`Replayed::apply`]); the status it makes due, if any.
+    pub fn apply(&mut self, r: &Record) -> Option<FleetStatus> {
+        self.replayed.apply(r);
+        match r {
+            Record::Telemetry { telemetry, .. } => {
+                let t = telemetry.state.t_s;
+                self.latest = self.latest.max(t);
+                (t >= self.next).then(|| {
+                    self.next = t + self.every;
+                    self.status(t)
+                })
+            }
+            Record::Event(e) => {
+                self.latest = self.latest.max(e.t_s);
+                None
+            }
+            Record::End(_) => Some(self.status(self.latest)),
+            Record::Start(_) | Record::Plan(_) | Record::Obstacle(_) => None,
+        }
+    }
+
+    /// The status at mission time `t`.
+    fn status(&self, t: f64) -> FleetStatus {
+        self.replayed.fleet.status(&self.replayed.start.mission, t)
     }
 }

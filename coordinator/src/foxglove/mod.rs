@@ -109,6 +109,12 @@ pub fn stream_log(
     stop: &AtomicBool,
 ) -> anyhow::Result<bool> {
     let records = log::read(path)?.records;
+    // A status per wall second of the run, as it published them live.
+    let every = match records.first() {
+        Some(log::Record::Start(start)) => start.time_scale.max(1.0),
+        _ => 1.0,
+    };
+    let statuses = crate::execute::replayed::Statuses::new(&records, path, every)?;
     let feed = LiveFeed::new();
     let server = FoxgloveServer::start(addr, Arc::clone(&feed))?;
     eprintln!(
@@ -122,7 +128,7 @@ pub fn stream_log(
         }
         std::thread::sleep(Duration::from_millis(50));
     }
-    let played = pace::play(&records, &feed, speed, stop);
+    let played = pace::play(&records, Some(statuses), &feed, speed, stop);
     server.shutdown();
     Ok(played)
 }

@@ -2,8 +2,8 @@
 //! so `replay --foxglove` shows a past mission as `run --foxglove` showed it live. Each record
 //! comes when it came in the run: a report when it was received, an event at its `t_s`, and a
 //! plan, an obstacle or the end with the record before it; the mission clock runs at the log's
-//! time scale times the speed. The log has no status records, so the status channel stays
-//! empty.
+//! time scale times the speed. The log has no status records: they are rebuilt as the run
+//! published them ([`Statuses`]), one per wall second of the run and one at its end.
 
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
@@ -11,6 +11,7 @@ use std::time::{Duration, Instant};
 use crate::execute::live::{LiveFeed, LiveMessage};
 use crate::execute::log::channels::mission_s;
 use crate::execute::log::{Record, Start};
+use crate::execute::replayed::Statuses;
 
 /// Fastest and slowest `--speed`: past a million times real time a whole mission is one burst,
 /// below a thousandth one report an hour.
@@ -43,8 +44,15 @@ fn mission_time(start: &Start, r: &Record) -> Option<f64> {
 }
 
 /// Plays `records` (a log that starts with its start record) into `feed`, `speed` times the
-/// log's own pace; returns false when `stop` cut it short.
-pub fn play(records: &[Record], feed: &LiveFeed, speed: f64, stop: &AtomicBool) -> bool {
+/// log's own pace, with the statuses `statuses` rebuilds; returns false when `stop` cut it
+/// short.
+pub fn play(
+    records: &[Record],
+    mut statuses: Option<Statuses>,
+    feed: &LiveFeed,
+    speed: f64,
+    stop: &AtomicBool,
+) -> bool {
     let Some(Record::Start(start)) = records.first() else {
         return true;
     };
@@ -62,6 +70,9 @@ pub fn play(records: &[Record], feed: &LiveFeed, speed: f64, stop: &AtomicBool) 
             return false;
         }
         feed.publish(LiveMessage::Record(r.clone()));
+        if let Some(status) = statuses.as_mut().and_then(|s| s.apply(r)) {
+            feed.publish(LiveMessage::Status(status));
+        }
     }
     true
 }
@@ -118,7 +129,7 @@ mod tests {
         let sub = feed.subscribe();
         let t0 = Instant::now();
         // 40 mission seconds at 100× real time, twice as fast: 0.2 s.
-        assert!(play(&log(100.0), &feed, 2.0, &AtomicBool::new(false)));
+        assert!(play(&log(100.0), None, &feed, 2.0, &AtomicBool::new(false)));
         let took = t0.elapsed();
         assert!(took >= Duration::from_millis(195), "{took:?}");
         assert!(took < Duration::from_secs(2), "{took:?}");
@@ -130,7 +141,7 @@ mod tests {
     #[test]
     fn a_stop_cuts_the_play_short_and_speeds_are_bounded() {
         let feed = LiveFeed::new();
-        assert!(!play(&log(0.001), &feed, 1.0, &AtomicBool::new(true)));
+        assert!(!play(&log(0.001), None, &feed, 1.0, &AtomicBool::new(true)));
         assert!(check_speed(1.0).is_ok());
         for bad in [0.0, -1.0, f64::NAN, 1e7] {
             let e = check_speed(bad)

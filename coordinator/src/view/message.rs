@@ -201,7 +201,7 @@ pub fn scene(start: &Start) -> Scene {
 /// Where vehicle `row` will be at `at_s`, as the coordinator predicts it: where it was last
 /// seen if it stands (lost, holding, faulted, arrived, stopped); else along its plan at its
 /// current lag (a vehicle 20 s late is where its plan is 20 s earlier); along its plan on time
-/// before its first report.
+/// before its first report, or at its plan's start when it is lost before any.
 pub fn predicted_place(
     row: &VehicleStatusRow,
     plan: Option<&Trajectory>,
@@ -219,6 +219,7 @@ pub fn predicted_place(
     match (&row.state, plan) {
         (Some(s), _) if row.lost || standing(s.status) => Some(s.position),
         (Some(s), None) => Some(s.position),
+        (None, Some(plan)) if row.lost => plan.points.first().map(|p| [p.x, p.y, p.z]),
         (_, Some(plan)) => {
             let lag = row.progress.map_or(0.0, |p| p.lag_s);
             let p = plan.position_at(at_s - lag);

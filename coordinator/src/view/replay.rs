@@ -1,7 +1,7 @@
 //! A finished mission log for the page (`replay LOG --view ADDR`): shaped once, sent whole to
 //! every page, which plays it back with a time slider. The log holds no statuses, so they are
 //! rebuilt by folding the records into the fleet picture as the live run did
-//! ([`crate::execute::replayed`]), one per wall second of the original run. A long log is
+//! ([`Statuses`]), one per wall second of the original run and one as it ended. A long log is
 //! thinned so a page gets at most [`MAX_REPORTS_PER_VEHICLE`] reports per vehicle and
 //! [`MAX_STATUSES`] statuses.
 
@@ -10,7 +10,7 @@ use std::path::Path;
 
 use crate::execute::live::LiveMessage;
 use crate::execute::log::Record;
-use crate::execute::replayed::Replayed;
+use crate::execute::replayed::Statuses;
 
 use super::message::{push_json, Shaper, ViewMessage};
 
@@ -49,40 +49,38 @@ impl ReplayLog {
         ReplayLog { frames }
     }
 
-    /// A log's records (`path` names it in errors), thinned, with statuses rebuilt between them.
+    /// A log's records (`path` names it in errors), thinned, with statuses rebuilt between them
+    /// ([`Statuses`]).
     pub fn from_records(records: &[Record], path: &Path) -> anyhow::Result<ReplayLog> {
-        let mut replayed = Replayed::new(records, path)?;
-        let mission = replayed.start.mission.clone();
         let strides = report_strides(records);
         let (first, last) = telemetry_span(records);
-        let every = replayed
-            .start
+        let Some(Record::Start(start)) = records.first() else {
+            anyhow::bail!("{}: no start record", path.display());
+        };
+        let every = start
             .time_scale
             .max((last - first) / MAX_STATUSES as f64)
             .max(1.0);
+        let mut statuses = Statuses::new(records, path, every)?;
         let mut seen: BTreeMap<&str, usize> = BTreeMap::new();
-        let mut next_status = first;
         let mut messages = Vec::new();
         for r in records {
-            replayed.apply(r);
-            let Record::Telemetry { telemetry, .. } = r else {
-                messages.push(LiveMessage::Record(r.clone()));
-                continue;
-            };
-            let n = seen.entry(telemetry.vehicle.as_str()).or_default();
-            let (stride, total) = strides
-                .get(telemetry.vehicle.as_str())
-                .copied()
-                .unwrap_or((1, 0));
-            if n.is_multiple_of(stride) || *n + 1 == total {
-                messages.push(LiveMessage::Record(r.clone()));
+            let status = statuses.apply(r);
+            match r {
+                Record::Telemetry { telemetry, .. } => {
+                    let n = seen.entry(telemetry.vehicle.as_str()).or_default();
+                    let (stride, total) = strides
+                        .get(telemetry.vehicle.as_str())
+                        .copied()
+                        .unwrap_or((1, 0));
+                    if n.is_multiple_of(stride) || *n + 1 == total {
+                        messages.push(LiveMessage::Record(r.clone()));
+                    }
+                    *n += 1;
+                }
+                _ => messages.push(LiveMessage::Record(r.clone())),
             }
-            *n += 1;
-            let t = telemetry.state.t_s;
-            if t >= next_status {
-                messages.push(LiveMessage::Status(replayed.fleet.status(&mission, t)));
-                next_status = t + every;
-            }
+            messages.extend(status.map(LiveMessage::Status));
         }
         Ok(ReplayLog::new(&messages))
     }

@@ -91,6 +91,13 @@ fn a_standing_vehicle_is_predicted_where_it_was_seen() {
         predicted_place(&lost, Some(&plan), 30.0),
         Some([7.0, 8.0, 9.0])
     );
+    // Lost before its first report: where the coordinator has it, at its plan's start.
+    let mut never_heard = row("a", None, VehicleStatus::Underway, 0.0);
+    never_heard.lost = true;
+    assert_eq!(
+        predicted_place(&never_heard, Some(&plan), 30.0),
+        Some([0.0, 0.0, 10.0])
+    );
 }
 
 #[test]
