@@ -228,6 +228,39 @@ fn a_foxglove_client_sees_the_logged_positions_the_scene_and_the_bounds() -> Tes
         "{refusals}"
     );
     assert_eq!(refusals["oversize_close_code"], 1009, "{refusals}");
+
+    // The finished log played back, four times as fast: the same poses, and the statuses
+    // rebuilt from the records (the log has none), one per wall second of the run and the last.
+    let port = free_port();
+    let mut cmd = Command::new(coordinator());
+    without_shoal_env(&mut cmd);
+    cmd.current_dir(root())
+        .arg("replay")
+        .arg(out.join("mission.ndjson"))
+        .args(["--foxglove", &format!("127.0.0.1:{port}"), "--speed", "4"]);
+    let replay = fleet.spawn("replay", cmd);
+    let replayed = fleet.dir().join("foxglove-replay.json");
+    let mut client = Command::new(common::interop_python()?);
+    client
+        .arg(root().join("tests/python/foxglove_client.py"))
+        .arg(format!("ws://127.0.0.1:{port}"))
+        .arg(&replayed)
+        .args(["--timeout", "200"]);
+    let r = run(client, LIMIT);
+    assert_eq!(r.code(), Some(0), "{r}");
+    let played = fleet.wait(replay, Instant::now() + LIMIT);
+    assert!(matches!(played.code(), Some(0 | 3)), "{played}");
+    let got = read_json(&replayed)?;
+    let poses = matched(&got["poses"], &reports, epoch_ms, &|p| p)?;
+    for v in &vehicles {
+        let in_log = reports.get(*v).map_or(0, count);
+        let n = poses.get(*v).copied().unwrap_or(0);
+        assert!(
+            10 * n >= 9 * in_log,
+            "{v}: {n} replayed poses of {in_log} reports"
+        );
+    }
+    assert!(got["statuses"].as_u64().is_some_and(|n| n >= 3), "{got}");
     fleet.passed();
     Ok(())
 }
