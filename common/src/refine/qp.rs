@@ -110,6 +110,9 @@ impl Program<'_> {
             tol_gap_abs: 1e-7,
             tol_gap_rel: 1e-6,
             tol_feas: 1e-7,
+            // Nor a refined solve of each KKT system: it cost about a third of the solver's
+            // time on scenario 3 and changed the fitness by at most 2·10⁻⁴.
+            iterative_refinement_enable: false,
             ..DefaultSettings::default()
         };
         let cones = [SupportedConeT::NonnegativeConeT(b.len())];
