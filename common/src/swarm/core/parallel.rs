@@ -8,14 +8,19 @@
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
 
-/// Runs `work` on the calling thread and on `threads − 1` scoped helpers.
+/// Runs `work` on the calling thread and on `threads − 1` scoped helpers. A panic in a helper
+/// reaches the caller with its own payload (the scope alone would replace it with "a scoped
+/// thread panicked").
 fn on_threads(threads: usize, work: impl Fn() + Sync) {
     let work = &work;
     std::thread::scope(|scope| {
-        for _ in 1..threads {
-            scope.spawn(work);
-        }
+        let helpers: Vec<_> = (1..threads).map(|_| scope.spawn(work)).collect();
         work();
+        for h in helpers {
+            if let Err(payload) = h.join() {
+                std::panic::resume_unwind(payload);
+            }
+        }
     });
 }
 
