@@ -231,7 +231,11 @@ fn a_crawler_goes_round_a_lost_crawler_when_its_path_comes_near() -> TestResult 
         .lines()
         .filter_map(|l| serde_json::from_str::<Value>(l).ok())
         .filter(|e| e["kind"] == "replanned")
-        .filter(|e| e["detail"].as_str().is_some_and(|d| d.starts_with("crawler1 replanned")))
+        .filter(|e| {
+            e["detail"]
+                .as_str()
+                .is_some_and(|d| d.starts_with("crawler1 replanned"))
+        })
         .filter_map(|e| e["t_s"].as_f64())
         .find(|&t| t >= reacted)
         .ok_or("crawler1 was not repaired round the lost crawler2")?;
