@@ -38,7 +38,7 @@ pub struct Counters {
     /// Connections whose WebSocket handshake failed (no `foxglove.websocket.v1`, not
     /// WebSocket, too slow).
     pub handshakes_failed: AtomicU64,
-    /// TLS clients dropped: a handshake that failed or took longer than [`HANDSHAKE_TIMEOUT`]
+    /// TLS clients dropped: a handshake that failed or took longer than the handshake timeout
     /// (no certificate, one the fleet CA did not sign, plain ws to the TLS port), or a member
     /// that may not watch (a vehicle).
     pub tls_refused: AtomicU64,

@@ -18,13 +18,14 @@
 mod identity;
 mod stream;
 
-use std::net::SocketAddr;
+use std::net::{SocketAddr, TcpStream};
 use std::sync::Arc;
+use std::time::Duration;
 
 use shoal_common::wire::security::Security;
 
 pub use identity::{may_watch, server_config};
-pub use stream::{accept, Conn, Refused};
+pub use stream::{Conn, Refused};
 
 /// How one server speaks to its clients.
 #[derive(Clone)]
@@ -44,6 +45,18 @@ impl Transport {
             (Transport::Plain, false) => "ws",
             (Transport::Tls(_), false) => "wss",
         }
+    }
+}
+
+/// Makes an accepted socket a blocking connection of `transport`: as it is for plain TCP; for
+/// TLS, after a handshake of at most `deadline` with a client that may watch ([`may_watch`]).
+/// The socket's timeouts are the caller's to set afterwards.
+pub fn accept(tcp: TcpStream, transport: &Transport, deadline: Duration) -> Result<Conn, Refused> {
+    tcp.set_nonblocking(false)
+        .map_err(|e| Refused::Handshake(e.to_string()))?;
+    match transport {
+        Transport::Plain => Ok(Conn::Plain(tcp)),
+        Transport::Tls(config) => stream::handshake(tcp, config, deadline),
     }
 }
 

@@ -12,7 +12,7 @@ use std::time::{Duration, Instant};
 
 use rustls::{ServerConfig, ServerConnection, StreamOwned};
 
-use super::{may_watch, Transport};
+use super::identity::may_watch;
 
 /// One accepted connection.
 pub enum Conn {
@@ -84,19 +84,9 @@ impl Write for Conn {
     }
 }
 
-/// Makes an accepted socket a blocking connection of `transport`: as it is for plain TCP; for
-/// TLS, after a handshake of at most `deadline` with a client that may watch. The socket's
-/// timeouts are the caller's to set afterwards.
-pub fn accept(tcp: TcpStream, transport: &Transport, deadline: Duration) -> Result<Conn, Refused> {
-    let io = |e: std::io::Error| Refused::Handshake(e.to_string());
-    tcp.set_nonblocking(false).map_err(io)?;
-    match transport {
-        Transport::Plain => Ok(Conn::Plain(tcp)),
-        Transport::Tls(config) => handshake(tcp, config, deadline),
-    }
-}
-
-fn handshake(
+/// The TLS handshake on a blocking socket, within `deadline`, and the check that the client
+/// may watch.
+pub(super) fn handshake(
     mut tcp: TcpStream,
     config: &Arc<ServerConfig>,
     deadline: Duration,
