@@ -137,6 +137,47 @@ fn over_tls_an_operator_is_served_and_plain_ws_is_refused_and_counted() -> TestR
 }
 
 #[test]
+fn silent_tls_handshakes_hold_client_places_until_their_deadline() -> TestResult {
+    let dir = crate::web_tls::tests::fleet()?;
+    let server = FoxgloveServer::start(
+        "127.0.0.1:0".parse()?,
+        crate::web_tls::tests::tls(dir.path())?,
+        LiveFeed::new(),
+    )?;
+    let addr = server.local_addr();
+    let silent: Vec<TcpStream> = (0..MAX_CLIENTS)
+        .map(|_| TcpStream::connect(addr))
+        .collect::<Result<_, _>>()?;
+    let counters = server.counters();
+    let until = std::time::Instant::now() + std::time::Duration::from_secs(3);
+    while counters.clients_served.load(Ordering::SeqCst) < MAX_CLIENTS as u64
+        && std::time::Instant::now() < until
+    {
+        std::thread::sleep(std::time::Duration::from_millis(10));
+    }
+    let _one_more = TcpStream::connect(addr)?;
+    while counters.clients_refused.load(Ordering::SeqCst) == 0 && std::time::Instant::now() < until
+    {
+        std::thread::sleep(std::time::Duration::from_millis(10));
+    }
+    assert_eq!(counters.clients_refused.load(Ordering::SeqCst), 1);
+    // Past the handshake's deadline every silent client is dropped and counted.
+    let until = std::time::Instant::now() + std::time::Duration::from_secs(10);
+    while counters.tls_refused.load(Ordering::SeqCst) < MAX_CLIENTS as u64
+        && std::time::Instant::now() < until
+    {
+        std::thread::sleep(std::time::Duration::from_millis(50));
+    }
+    assert_eq!(
+        counters.tls_refused.load(Ordering::SeqCst),
+        MAX_CLIENTS as u64
+    );
+    drop(silent);
+    server.shutdown();
+    Ok(())
+}
+
+#[test]
 fn clients_over_the_cap_and_without_the_subprotocol_are_turned_away() -> TestResult {
     let (server, _feed) = started()?;
     let addr = server.local_addr();
