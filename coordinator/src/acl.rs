@@ -21,6 +21,11 @@ use serde_json::{json, Value};
 /// The coordinator's identity: the common name of its certificate.
 pub const COORDINATOR: &str = "coordinator";
 
+/// The organizational unit `keys` writes into every operator's certificate: what the web view
+/// and the Foxglove server recognise an operator by beyond loopback (the access-control rules
+/// match common names, which only list the operators known when the keys were made).
+pub const OPERATOR_UNIT: &str = "shoal-operators";
+
 /// The fleet's members other than the coordinator.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Members {

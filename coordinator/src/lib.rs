@@ -19,6 +19,8 @@
 //! - [`view`]: the operator's live web view (`--view ADDR`): a page and a WebSocket fed from
 //!   the execution's live feed, or a finished log.
 //! - [`foxglove`]: a Foxglove WebSocket server fed from the execution's live feed (`--foxglove`).
+//! - [`web_tls`]: how those two are reached beyond loopback (mutual TLS with the fleet's keys,
+//!   `--insecure`, or refused), as the fleet's Zenoh router is.
 //! - [`cpu`]: the process's CPU time, for the figures that report a step's cost.
 //! - The rule: `commands` → `mission` → `planning`, `report`, `distributed`, `execute`, never
 //!   back (`commands` may also call the lower layers directly); no cycle between files
@@ -34,6 +36,7 @@ pub mod mission;
 pub mod planning;
 pub mod report;
 pub mod view;
+pub mod web_tls;
 
 pub use commands::plan_args::PlanArgs;
 pub use commands::{

@@ -103,6 +103,35 @@ impl Security {
     }
 }
 
+impl Security {
+    /// The TLS files a server of this process presents beyond loopback (the web view, the
+    /// Foxglove server), found where the router finds its own: the configuration file's
+    /// `transport/link/tls/...` keys with the flags applied over them. The identity is the
+    /// listening one, else the connecting one; `None` without a CA or an identity.
+    pub fn server_tls(&self) -> Result<Option<TlsFiles>, SessionError> {
+        let mut config = self.base()?;
+        self.apply(&mut config, true)?;
+        let get = |key: &str| {
+            config
+                .get_json(key)
+                .ok()
+                .and_then(|v| serde_json::from_str::<Option<String>>(&v).ok().flatten())
+                .map(PathBuf::from)
+        };
+        let tls = "transport/link/tls";
+        let pair = |side: &str| {
+            get(&format!("{tls}/{side}_certificate")).zip(get(&format!("{tls}/{side}_private_key")))
+        };
+        let identity = pair("listen").or_else(|| pair("connect"));
+        Ok(get(&format!("{tls}/root_ca_certificate"))
+            .zip(identity)
+            .map(|(ca, identity)| TlsFiles {
+                ca,
+                identity: Some(identity),
+            }))
+    }
+}
+
 /// What a second router of this process needs to link to the router built from `config`: the
 /// same TLS identity and user, nothing of its listening side or access control. `serve` runs
 /// each mission on a router of its own that listens on loopback for the mission's local agents
@@ -287,6 +316,55 @@ mod tests {
             r#""/x/users.txt""#,
         )?;
         assert!(check_exposure(&users, "tcp/0.0.0.0:7447", false).is_ok());
+        Ok(())
+    }
+
+    #[test]
+    fn a_servers_tls_files_come_from_the_file_and_the_flags_override_them(
+    ) -> Result<(), Box<dyn std::error::Error>> {
+        let dir = tempfile::tempdir()?;
+        let file = dir.path().join("coordinator.json5");
+        std::fs::write(
+            &file,
+            r#"{ transport: { link: { tls: {
+                root_ca_certificate: "/k/ca.pem",
+                listen_certificate: "/k/coordinator.pem",
+                listen_private_key: "/k/coordinator.key",
+                connect_certificate: "/k/other.pem",
+                connect_private_key: "/k/other.key",
+                enable_mtls: true } } } }"#,
+        )?;
+        let from_file = Security {
+            config_file: Some(file.clone()),
+            ..Security::default()
+        };
+        let tls = from_file.server_tls()?.ok_or("no TLS from the file")?;
+        assert_eq!(tls.ca, PathBuf::from("/k/ca.pem"));
+        let pair = |c: &str, k: &str| Some((PathBuf::from(c), PathBuf::from(k)));
+        assert_eq!(
+            tls.identity,
+            pair("/k/coordinator.pem", "/k/coordinator.key")
+        );
+        let flags = Security {
+            config_file: Some(file),
+            tls: Some(TlsFiles {
+                ca: "/f/ca.pem".into(),
+                identity: pair("/f/c.pem", "/f/c.key"),
+            }),
+            ..Security::default()
+        };
+        let tls = flags.server_tls()?.ok_or("no TLS from the flags")?;
+        assert_eq!(tls.ca, PathBuf::from("/f/ca.pem"));
+        assert_eq!(tls.identity, pair("/f/c.pem", "/f/c.key"));
+        assert_eq!(Security::default().server_tls()?, None);
+        let ca_only = Security {
+            tls: Some(TlsFiles {
+                ca: "/f/ca.pem".into(),
+                identity: None,
+            }),
+            ..Security::default()
+        };
+        assert_eq!(ca_only.server_tls()?, None);
         Ok(())
     }
 

@@ -16,7 +16,7 @@ use rcgen::{
 use serde_json::json;
 use shoal_common::wire::topics;
 
-use crate::acl::{self, Members, COORDINATOR};
+use crate::acl::{self, Members, COORDINATOR, OPERATOR_UNIT};
 
 /// `shoal-coordinator keys`.
 #[derive(Debug, Clone, clap::Args)]
@@ -77,12 +77,22 @@ pub fn command(args: &KeysArgs) -> anyhow::Result<i32> {
     write(&out, "ca.pem", &ca_cert.pem(), false)?;
     write(&out, "ca.key", &ca_key.serialize_pem(), true)?;
     let issuer = Issuer::new(ca_params, ca_key);
-    let mut identities = vec![(COORDINATOR.to_string(), args.coordinator_hosts.clone())];
-    identities.extend(members.vehicles.iter().map(|v| (v.clone(), Vec::new())));
-    identities.extend(members.operators.iter().map(|o| (o.clone(), Vec::new())));
-    for (name, hosts) in &identities {
+    let mut identities = vec![(
+        COORDINATOR.to_string(),
+        args.coordinator_hosts.clone(),
+        None,
+    )];
+    identities.extend(
+        members
+            .vehicles
+            .iter()
+            .map(|v| (v.clone(), Vec::new(), None)),
+    );
+    identities
+        .extend((members.operators.iter()).map(|o| (o.clone(), Vec::new(), Some(OPERATOR_UNIT))));
+    for (name, hosts, unit) in &identities {
         let key = KeyPair::generate()?;
-        let cert = member_params(name, hosts, args.days)?.signed_by(&key, &issuer)?;
+        let cert = member_params(name, hosts, *unit, args.days)?.signed_by(&key, &issuer)?;
         write(&out, &format!("{name}.pem"), &cert.pem(), false)?;
         write(&out, &format!("{name}.key"), &key.serialize_pem(), true)?;
         let config = member_config(&in_config, name, &members);
@@ -167,11 +177,21 @@ fn ca_params(days: u32) -> anyhow::Result<CertificateParams> {
 }
 
 /// A member's certificate: its id as common name (what access control matches), usable for
-/// both ends of a TLS link (a coordinator's router also links to other routers).
-fn member_params(name: &str, hosts: &[String], days: u32) -> anyhow::Result<CertificateParams> {
+/// both ends of a TLS link (a coordinator's router also links to other routers). An operator's
+/// also names [`OPERATOR_UNIT`], by which the web view and the Foxglove server let it watch.
+fn member_params(
+    name: &str,
+    hosts: &[String],
+    unit: Option<&str>,
+    days: u32,
+) -> anyhow::Result<CertificateParams> {
     let mut p = CertificateParams::new(hosts.to_vec())
         .with_context(|| format!("a coordinator host is not a DNS name or address: {hosts:?}"))?;
     p.distinguished_name.push(DnType::CommonName, name);
+    if let Some(unit) = unit {
+        p.distinguished_name
+            .push(DnType::OrganizationalUnitName, unit);
+    }
     p.is_ca = IsCa::ExplicitNoCa;
     p.key_usages = vec![KeyUsagePurpose::DigitalSignature];
     p.extended_key_usages = vec![

@@ -13,6 +13,7 @@ use plotters::element::DashedPathElement;
 use plotters::prelude::*;
 use shoal_common::scenario::{Obstacle, ObstacleKind, Scenario};
 use shoal_common::trajectory::Trajectory;
+use shoal_common::wire::flags::ZenohSecurityArgs;
 use shoal_common::wire::open::MissionEvent;
 
 use crate::execute;
@@ -31,8 +32,8 @@ pub struct ReplayArgs {
     /// Where to draw the tracks (default: the log's path with `.svg`).
     #[arg(long)]
     pub svg: Option<PathBuf>,
-    /// Then serve the log in the web view here (loopback, e.g. 127.0.0.1:8080), to play it
-    /// back with a time slider, until Ctrl-C.
+    /// Then serve the log in the web view here (e.g. 127.0.0.1:8080), to play it back with a
+    /// time slider, until Ctrl-C.
     #[arg(long, env = "SHOAL_VIEW", value_name = "ADDR")]
     pub view: Option<std::net::SocketAddr>,
     /// Then play the log to Foxglove, as `run --foxglove` showed it live.
@@ -41,10 +42,10 @@ pub struct ReplayArgs {
     /// With --foxglove: how many times faster than it was recorded the log plays.
     #[arg(long, default_value_t = 1.0)]
     pub speed: f64,
-    /// With --foxglove: listen beyond loopback although anyone who reaches the port sees the
-    /// mission (a lab network nobody else reaches).
-    #[arg(long, env = "SHOAL_INSECURE")]
-    pub insecure: bool,
+    /// With --view or --foxglove beyond loopback: the coordinator's TLS identity (mutual TLS,
+    /// the coordinator and operators only), or --insecure (plain, anyone who reaches the port).
+    #[command(flatten)]
+    pub zenoh: ZenohSecurityArgs,
 }
 
 /// What a log holds, replayed.
@@ -91,7 +92,8 @@ pub fn replay(path: &Path) -> anyhow::Result<Replayed> {
 
 /// The replay command: prints the events and the figures and writes the SVG.
 pub fn command(args: &ReplayArgs, shutdown: &AtomicBool) -> anyhow::Result<i32> {
-    let foxglove = args.foxglove.settings(args.insecure)?;
+    let security = args.zenoh.security()?;
+    let foxglove = args.foxglove.settings(&security)?;
     let speed = foxglove::pace::check_speed(args.speed)?;
     let r = replay(&args.log)?;
     let mut out = String::new();
@@ -141,10 +143,10 @@ pub fn command(args: &ReplayArgs, shutdown: &AtomicBool) -> anyhow::Result<i32> 
         anyhow::bail!("--view and --foxglove: a log is played to one of them at a time");
     }
     if let Some(addr) = args.view {
-        crate::view::serve_log(addr, &args.log, shutdown)?;
+        crate::view::serve_log(addr, &security, &args.log, shutdown)?;
     }
-    if let Some(addr) = foxglove {
-        foxglove::stream_log(addr, &args.log, speed, shutdown)?;
+    if let Some(served) = foxglove {
+        foxglove::stream_log(served, &args.log, speed, shutdown)?;
     }
     // As `run`: 0 when the execution met its figures, 3 when it did not.
     Ok(if verdict::failures(f).is_empty() {
@@ -447,7 +449,7 @@ mod tests {
                 view: None,
                 foxglove: FoxgloveArgs::default(),
                 speed: 1.0,
-                insecure: false,
+                zenoh: ZenohSecurityArgs::default(),
             },
             &AtomicBool::new(false),
         )?;

@@ -22,6 +22,7 @@ use super::limits::{
     MAX_CLIENT_MESSAGE_BYTES, MAX_REFUSED_PER_CLIENT, MAX_SUBSCRIPTIONS, POLL, WRITE_TIMEOUT,
 };
 use super::protocol::{self, ClientMessage, Level};
+use crate::web_tls::{self, Conn, Transport};
 
 /// What every client thread shares.
 #[derive(Clone)]
@@ -34,6 +35,8 @@ pub struct Context {
     pub stop: Arc<AtomicBool>,
     /// This server's session id (`serverInfo`).
     pub session: Arc<str>,
+    /// Plain or TLS.
+    pub transport: Transport,
 }
 
 /// Serves one client until it leaves, misbehaves or the server stops.
@@ -62,12 +65,19 @@ pub fn serve(stream: TcpStream, cx: &Context) {
     }
 }
 
-/// Accepts the WebSocket if the client speaks the protocol; `None` otherwise (refused with
-/// HTTP 400, or the handshake failed or took too long).
-fn handshake(stream: TcpStream, cx: &Context) -> Option<WebSocket<TcpStream>> {
+/// Accepts the WebSocket if the client gets through TLS (when the server speaks it) and speaks
+/// the protocol; `None` otherwise (refused by TLS, refused with HTTP 400, or the handshake
+/// failed or took too long).
+fn handshake(tcp: TcpStream, cx: &Context) -> Option<WebSocket<Conn>> {
+    let stream = web_tls::accept(tcp, &cx.transport, HANDSHAKE_TIMEOUT)
+        .map_err(|refused| {
+            cx.counters.bump(&cx.counters.tls_refused);
+            tracing::debug!("Foxglove: a client refused: {refused}");
+        })
+        .ok()?;
     let ok = stream.set_read_timeout(Some(HANDSHAKE_TIMEOUT)).is_ok()
-        && stream.set_write_timeout(Some(WRITE_TIMEOUT)).is_ok()
-        && stream.set_nodelay(true).is_ok();
+        && stream.tcp().set_write_timeout(Some(WRITE_TIMEOUT)).is_ok()
+        && stream.tcp().set_nodelay(true).is_ok();
     if !ok {
         return None;
     }
@@ -152,7 +162,7 @@ enum End {
 }
 
 struct Connection {
-    ws: WebSocket<TcpStream>,
+    ws: WebSocket<Conn>,
     cx: Context,
     /// Channel → the client's id of its subscription to it (one per channel).
     subscriptions: BTreeMap<u32, u32>,

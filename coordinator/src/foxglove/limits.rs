@@ -20,7 +20,7 @@ pub const MAX_REFUSED_PER_CLIENT: u32 = 100;
 pub const MAX_SUBSCRIPTIONS: usize = 1024;
 /// Messages queued for a client before it is cut off as too slow (the hub never waits).
 pub const CLIENT_QUEUE: usize = 8192;
-/// Time a client has to finish the WebSocket handshake.
+/// Time a client has to finish the TLS handshake, and then the WebSocket handshake.
 pub const HANDSHAKE_TIMEOUT: Duration = Duration::from_secs(5);
 /// Time one write to a client may take before it is dropped as stuck.
 pub const WRITE_TIMEOUT: Duration = Duration::from_secs(5);
@@ -38,6 +38,10 @@ pub struct Counters {
     /// Connections whose WebSocket handshake failed (no `foxglove.websocket.v1`, not
     /// WebSocket, too slow).
     pub handshakes_failed: AtomicU64,
+    /// TLS clients dropped: a handshake that failed or took longer than the handshake timeout
+    /// (no certificate, one the fleet CA did not sign, plain ws to the TLS port), or a member
+    /// that may not watch (a vehicle).
+    pub tls_refused: AtomicU64,
     /// Client messages refused: over the rate, too large, malformed, unknown, binary, or a
     /// subscription that is not allowed.
     pub messages_refused: AtomicU64,
@@ -55,10 +59,11 @@ impl Counters {
     pub fn summary(&self) -> String {
         let n = |c: &AtomicU64| c.load(Ordering::Relaxed);
         format!(
-            "{} clients served, {} refused (over {MAX_CLIENTS}), {} failed handshakes, \
-             {} client messages refused, {} clients dropped",
+            "{} clients served, {} refused (over {MAX_CLIENTS}), {} refused by TLS, \
+             {} failed handshakes, {} client messages refused, {} clients dropped",
             n(&self.clients_served),
             n(&self.clients_refused),
+            n(&self.tls_refused),
             n(&self.handshakes_failed),
             n(&self.messages_refused),
             n(&self.clients_dropped),

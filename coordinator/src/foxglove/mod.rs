@@ -23,10 +23,12 @@
 //! crate the SDK itself builds on), on threads of its own: the execution loop never waits for
 //! a client.
 //!
-//! **Security.** The protocol has no authentication and this server no TLS: anyone who reaches
-//! the port sees the fleet. It listens on loopback unless `--insecure` says otherwise (the flag
-//! that lets a Zenoh router listen beyond loopback unauthenticated); reach it from elsewhere
-//! through an SSH tunnel.
+//! **Security.** The protocol has no authentication of its own. The server listens on loopback
+//! by default, plain `ws://`; beyond loopback it follows the fleet's security settings as the
+//! Zenoh router does ([`crate::web_tls`]): with the coordinator's TLS identity it serves
+//! `wss://` with mutual TLS to the coordinator and the operators only (a vehicle's certificate
+//! is refused, a refused client dropped and counted in [`Counters::tls_refused`]); with
+//! `--insecure` alone plain `ws://`, with a warning; with neither it refuses to start.
 
 mod channels;
 mod client;
@@ -47,6 +49,8 @@ use std::time::Duration;
 
 use crate::execute::live::LiveFeed;
 use crate::execute::log;
+use crate::web_tls::{self, Transport};
+use shoal_common::wire::security::Security;
 
 pub use limits::{Counters, MAX_CLIENTS};
 pub use server::FoxgloveServer;
@@ -58,8 +62,8 @@ pub const DEFAULT_PORT: u16 = 8765;
 #[derive(Debug, Clone, Default, PartialEq, Eq, clap::Args)]
 pub struct FoxgloveArgs {
     /// Serve the mission live to Foxglove (or Lichtblick) over its WebSocket protocol at ADDR:
-    /// `PORT` or `IP:PORT` (loopback by default; beyond it needs --insecure). Without a value:
-    /// 127.0.0.1:8765.
+    /// `PORT` or `IP:PORT` (loopback by default; beyond it, mutual TLS with the fleet's keys or
+    /// --insecure). Without a value: 127.0.0.1:8765.
     #[arg(
         long,
         env = "SHOAL_FOXGLOVE",
@@ -72,38 +76,41 @@ pub struct FoxgloveArgs {
 }
 
 impl FoxgloveArgs {
-    /// Where to serve, if asked: the address, refused beyond loopback unless `insecure`.
-    pub fn settings(&self, insecure: bool) -> anyhow::Result<Option<SocketAddr>> {
+    /// Where and how to serve, if asked: plain on loopback, mutual TLS beyond it with the
+    /// fleet's keys, plain with `--insecure`, refused otherwise (see [`crate::web_tls`]).
+    pub fn settings(&self, security: &Security) -> anyhow::Result<Option<(SocketAddr, Transport)>> {
         let Some(addr) = self.foxglove else {
             return Ok(None);
         };
-        check_exposure(addr, insecure)?;
-        Ok(Some(addr))
+        let transport = web_tls::choose("--foxglove", "Foxglove server", addr, security)?;
+        Ok(Some((addr, transport)))
     }
 }
 
-/// Starts the server `args` ask for (refused beyond loopback unless `insecure`) on a new live
-/// feed, and says on stderr where it listens; the feed is the execution's to fill.
+/// Starts the server `args` ask for (reached as `security` allows) on a live feed, and says on
+/// stderr where it listens; the feed is the execution's to fill.
 pub fn start(
     args: &FoxgloveArgs,
-    insecure: bool,
+    security: &Security,
     feed: &Arc<LiveFeed>,
 ) -> anyhow::Result<Option<FoxgloveServer>> {
-    let Some(addr) = args.settings(insecure)? else {
+    let Some((addr, transport)) = args.settings(security)? else {
         return Ok(None);
     };
-    let server = FoxgloveServer::start(addr, Arc::clone(feed))?;
+    let scheme = transport.scheme(false);
+    let server = FoxgloveServer::start(addr, transport, Arc::clone(feed))?;
     eprintln!(
-        "Foxglove WebSocket server on ws://{} (open it in Foxglove or Lichtblick)",
+        "Foxglove WebSocket server on {scheme}://{} (open it in Foxglove or Lichtblick)",
         server.local_addr()
     );
     Ok(Some(server))
 }
 
-/// Serves the mission log at `path` on `addr`: waits for the first client, then plays the log
-/// at `speed` times its recorded pace ([`pace::play`]) and stops. False when `stop` cut it short.
+/// Serves the mission log at `path` on `addr` over `transport`: waits for the first client,
+/// then plays the log at `speed` times its recorded pace ([`pace::play`]) and stops. False when
+/// `stop` cut it short.
 pub fn stream_log(
-    addr: SocketAddr,
+    (addr, transport): (SocketAddr, Transport),
     path: &Path,
     speed: f64,
     stop: &AtomicBool,
@@ -116,9 +123,10 @@ pub fn stream_log(
     };
     let statuses = crate::execute::replayed::Statuses::new(&records, path, every)?;
     let feed = LiveFeed::new();
-    let server = FoxgloveServer::start(addr, Arc::clone(&feed))?;
+    let scheme = transport.scheme(false);
+    let server = FoxgloveServer::start(addr, transport, Arc::clone(&feed))?;
     eprintln!(
-        "Foxglove WebSocket server on ws://{}: the log plays at {speed} × its pace once a \
+        "Foxglove WebSocket server on {scheme}://{}: the log plays at {speed} × its pace once a \
          client connects",
         server.local_addr()
     );
@@ -146,19 +154,6 @@ pub fn parse_address(s: &str) -> Result<SocketAddr, String> {
     }
     s.parse::<SocketAddr>()
         .map_err(|_| format!("{s:?}: expected PORT, IP:PORT or localhost:PORT"))
-}
-
-/// Refuses an address beyond loopback unless `insecure`: whoever reaches it sees the fleet.
-pub fn check_exposure(addr: SocketAddr, insecure: bool) -> anyhow::Result<()> {
-    if addr.ip().is_loopback() || insecure {
-        return Ok(());
-    }
-    anyhow::bail!(
-        "--foxglove {addr}: beyond loopback anyone who reaches the port sees the fleet (the \
-         Foxglove WebSocket protocol has no authentication, and Shoal serves it without TLS); \
-         listen on 127.0.0.1 and reach it through an SSH tunnel, or pass --insecure on a network \
-         nobody else reaches"
-    )
 }
 
 #[cfg(test)]
@@ -197,12 +192,12 @@ mod tests {
     }
 
     #[test]
-    fn beyond_loopback_is_refused_unless_insecure() {
+    fn beyond_loopback_is_refused_without_keys_or_insecure() {
         let open = FoxgloveArgs {
             foxglove: "0.0.0.0:8765".parse().ok(),
         };
         let e = open
-            .settings(false)
+            .settings(&Security::default())
             .err()
             .map(|e| e.to_string())
             .unwrap_or_default();
@@ -210,12 +205,25 @@ mod tests {
             e.contains("--foxglove 0.0.0.0:8765: beyond loopback"),
             "{e}"
         );
-        assert!(e.contains("--insecure"), "{e}");
-        assert_eq!(open.settings(true).ok().flatten(), open.foxglove);
+        assert!(e.contains("--insecure") && e.contains("mutual TLS"), "{e}");
+        let insecure = Security {
+            insecure: true,
+            ..Security::default()
+        };
+        let addr = |s: anyhow::Result<Option<(SocketAddr, Transport)>>| {
+            s.ok().flatten().map(|(a, t)| (a, t.scheme(false)))
+        };
+        assert_eq!(
+            addr(open.settings(&insecure)),
+            open.foxglove.map(|a| (a, "ws"))
+        );
         let local = FoxgloveArgs {
             foxglove: "127.0.0.1:8765".parse().ok(),
         };
-        assert_eq!(local.settings(false).ok().flatten(), local.foxglove);
-        assert_eq!(FoxgloveArgs::default().settings(false).ok().flatten(), None);
+        assert_eq!(
+            addr(local.settings(&Security::default())),
+            local.foxglove.map(|a| (a, "ws"))
+        );
+        assert!(addr(FoxgloveArgs::default().settings(&Security::default())).is_none());
     }
 }

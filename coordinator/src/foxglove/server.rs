@@ -17,6 +17,7 @@ use super::client::{self, Context};
 use super::fanout::{dispatch, Shared};
 use super::limits::{Counters, MAX_CLIENTS};
 use crate::execute::live::LiveFeed;
+use crate::web_tls::Transport;
 
 /// How often the listener and the hub look at the stop flags.
 const STOP_POLL: Duration = Duration::from_millis(50);
@@ -41,9 +42,13 @@ pub struct FoxgloveServer {
 }
 
 impl FoxgloveServer {
-    /// Binds `addr` and serves what `feed` publishes. The address is not checked here: see
-    /// [`super::FoxgloveArgs::settings`].
-    pub fn start(addr: SocketAddr, feed: Arc<LiveFeed>) -> anyhow::Result<FoxgloveServer> {
+    /// Binds `addr` and serves what `feed` publishes over `transport`. The address is not
+    /// checked here: see [`super::FoxgloveArgs::settings`].
+    pub fn start(
+        addr: SocketAddr,
+        transport: Transport,
+        feed: Arc<LiveFeed>,
+    ) -> anyhow::Result<FoxgloveServer> {
         let listener = TcpListener::bind(addr)
             .with_context(|| format!("cannot listen on {addr} for Foxglove"))?;
         let addr = listener.local_addr()?;
@@ -64,6 +69,7 @@ impl FoxgloveServer {
             counters: Arc::clone(&counters),
             stop: Arc::clone(&stop_clients),
             session: session_id().into(),
+            transport,
         };
         let listener = {
             let clients = Arc::clone(&clients);
@@ -168,6 +174,7 @@ fn accept(listener: &TcpListener, cx: &Context, threads: &Mutex<Vec<JoinHandle<(
                 continue;
             }
         };
+        // The TLS handshake, if any, runs on the client's thread and holds one of the places.
         if active.load(Ordering::Relaxed) >= MAX_CLIENTS || stream.set_nonblocking(false).is_err() {
             cx.counters.bump(&cx.counters.clients_refused);
             continue; // dropping the stream closes it

@@ -5,7 +5,6 @@
 //! fills, the feed cuts it off, and it gets a fresh catch-up here (a `reset` first) rather than a
 //! backlog. A write blocked for longer than the socket's write timeout drops the page.
 
-use std::net::TcpStream;
 use std::sync::atomic::Ordering;
 use std::sync::mpsc::{Receiver, TryRecvError};
 use std::sync::Arc;
@@ -17,6 +16,7 @@ use super::message::{push_json, Shaper, ViewMessage};
 use super::replay::ReplayLog;
 use super::shared::{Shared, Source, MAX_INCOMING_PER_S};
 use crate::execute::live::{LiveFeed, LiveMessage};
+use crate::web_tls::Conn;
 
 /// How often a page gets what happened: also how long a read from it waits.
 pub(super) const TICK: Duration = Duration::from_millis(100);
@@ -28,7 +28,7 @@ const MAX_BATCH: usize = 4096;
 pub(super) struct Ended;
 
 /// Serves the page on `ws` until it leaves, breaks a rule, or the server stops.
-pub(super) fn serve(ws: &mut WebSocket<TcpStream>, shared: &Shared) {
+pub(super) fn serve(ws: &mut WebSocket<Conn>, shared: &Shared) {
     let mut incoming = Incoming::default();
     let _ = match &shared.source {
         Source::Live(feed) => live(ws, feed, shared, &mut incoming),
@@ -38,14 +38,14 @@ pub(super) fn serve(ws: &mut WebSocket<TcpStream>, shared: &Shared) {
     let _ = ws.flush();
 }
 
-fn send(ws: &mut WebSocket<TcpStream>, text: String) -> Result<(), Ended> {
+fn send(ws: &mut WebSocket<Conn>, text: String) -> Result<(), Ended> {
     ws.send(Message::text(text)).map_err(|_| Ended)
 }
 
 /// A live execution: a subscription, its catch-up, then its messages; a new subscription after
 /// being cut off.
 fn live(
-    ws: &mut WebSocket<TcpStream>,
+    ws: &mut WebSocket<Conn>,
     feed: &LiveFeed,
     shared: &Shared,
     incoming: &mut Incoming,
@@ -99,7 +99,7 @@ fn drain(rx: &Receiver<Arc<LiveMessage>>) -> (Vec<Arc<LiveMessage>>, bool) {
 
 /// A finished log: all of it, then nothing but the page's own messages until it leaves.
 fn replay(
-    ws: &mut WebSocket<TcpStream>,
+    ws: &mut WebSocket<Conn>,
     log: &ReplayLog,
     shared: &Shared,
     incoming: &mut Incoming,
@@ -142,7 +142,7 @@ impl Incoming {
     }
 
     /// Reads what the page sent, waiting up to [`TICK`] for the first message.
-    fn poll(&mut self, ws: &mut WebSocket<TcpStream>, shared: &Shared) -> Result<(), Ended> {
+    fn poll(&mut self, ws: &mut WebSocket<Conn>, shared: &Shared) -> Result<(), Ended> {
         let dropped = || {
             shared
                 .stats

@@ -13,6 +13,7 @@ use tungstenite::WebSocket;
 
 use super::shared::{Shared, MAX_CLIENTS, MAX_INCOMING_BYTES, MAX_REQUEST_BYTES};
 use super::{assets, client};
+use crate::web_tls::{self, Conn};
 
 /// How long a connection may take to send its request head.
 const HEAD_TIMEOUT: Duration = Duration::from_secs(5);
@@ -144,7 +145,7 @@ type Head = (Vec<u8>, Vec<u8>);
 
 /// Reads a request head: up to the blank line, at most [`MAX_REQUEST_BYTES`]. `Ok(None)`: the
 /// connection closed or went quiet before sending anything (a browser's spare connection).
-fn read_head(stream: &mut TcpStream) -> Result<Option<Head>, Refusal> {
+fn read_head(stream: &mut Conn) -> Result<Option<Head>, Refusal> {
     let mut buf = Vec::with_capacity(1024);
     let mut chunk = [0u8; 1024];
     loop {
@@ -179,11 +180,19 @@ fn read_head(stream: &mut TcpStream) -> Result<Option<Head>, Refusal> {
     }
 }
 
-/// Serves one connection: one request, then the WebSocket if it asked for one.
-pub(super) fn serve_connection(mut stream: TcpStream, shared: &Shared) {
-    let _ = stream.set_nonblocking(false);
+/// Serves one connection: the TLS handshake if the view speaks TLS (a client refused there is
+/// counted and dropped), one request, then the WebSocket if it asked for one.
+pub(super) fn serve_connection(tcp: TcpStream, shared: &Shared) {
+    let mut stream = match web_tls::accept(tcp, &shared.transport, HEAD_TIMEOUT) {
+        Ok(s) => s,
+        Err(refused) => {
+            shared.stats.refused_tls.fetch_add(1, Ordering::Relaxed);
+            tracing::debug!("web view: a client refused: {refused}");
+            return;
+        }
+    };
     let _ = stream.set_read_timeout(Some(HEAD_TIMEOUT));
-    let _ = stream.set_write_timeout(Some(WRITE_TIMEOUT));
+    let _ = stream.tcp().set_write_timeout(Some(WRITE_TIMEOUT));
     let routed = match read_head(&mut stream) {
         Ok(None) => return,
         Ok(Some((head, rest))) => parse(&head).and_then(|r| route(&r)).map(|r| (r, rest)),
@@ -199,7 +208,7 @@ pub(super) fn serve_connection(mut stream: TcpStream, shared: &Shared) {
 }
 
 /// Answers an error and counts it.
-fn refuse(stream: &mut TcpStream, refusal: Refusal, shared: &Shared) {
+fn refuse(stream: &mut Conn, refusal: Refusal, shared: &Shared) {
     let counter = match refusal {
         Refusal::Full => &shared.stats.refused_clients,
         _ => &shared.stats.bad_requests,
@@ -210,12 +219,7 @@ fn refuse(stream: &mut TcpStream, refusal: Refusal, shared: &Shared) {
 }
 
 /// Writes a whole response and closes.
-fn answer(
-    stream: &mut TcpStream,
-    status: &str,
-    content_type: &str,
-    body: &[u8],
-) -> std::io::Result<()> {
+fn answer(stream: &mut Conn, status: &str, content_type: &str, body: &[u8]) -> std::io::Result<()> {
     let head = format!(
         "HTTP/1.1 {status}\r\nContent-Type: {content_type}\r\nContent-Length: {}\r\n\
          Cache-Control: no-store\r\nX-Content-Type-Options: nosniff\r\n\
@@ -256,7 +260,7 @@ fn config() -> WebSocketConfig {
 }
 
 /// Completes the handshake (RFC 6455 §4.2.2) and hands the socket to `client`.
-fn upgrade(mut stream: TcpStream, key: &str, rest: Vec<u8>, shared: &Shared) {
+fn upgrade(mut stream: Conn, key: &str, rest: Vec<u8>, shared: &Shared) {
     let Some(_place) = Place::take(shared) else {
         refuse(&mut stream, Refusal::Full, shared);
         return;

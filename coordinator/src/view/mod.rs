@@ -12,9 +12,14 @@
 //! [`MAX_INCOMING_PER_S`] a second; what breaks a rule is answered with an error, counted in
 //! [`ViewStats`] and dropped.
 //!
-//! Reach: the view serves plain HTTP, so it binds to loopback only ([`check_bind`]); an operator
-//! elsewhere reaches it through an SSH tunnel, which authenticates and encrypts as the fleet's
-//! links do.
+//! Reach ([`check_bind`], rules in [`crate::web_tls`]): bound to loopback by default, where it
+//! serves plain HTTP to this machine; beyond loopback it follows the fleet's security settings
+//! as the Zenoh router does. With the coordinator's TLS identity (`--zenoh-config
+//! keys/coordinator.json5` or `--tls-*`) it serves HTTPS and WSS to the coordinator and the
+//! operators only, who present their certificate from the fleet CA (a vehicle's is refused); with
+//! `--insecure` alone it serves plain HTTP, with a warning; with neither it refuses to start. A
+//! refused TLS client is dropped and counted ([`ViewStats::refused_tls`]); its handshake holds
+//! one of the [`MAX_CONNECTIONS`] places and has the request head's deadline.
 
 mod assets;
 mod client;
@@ -32,16 +37,20 @@ use std::time::Duration;
 use anyhow::Context as _;
 
 use crate::execute::live::LiveFeed;
+use crate::web_tls::{self, Transport};
 use shared::Shared;
 pub use shared::{
     Source, ViewStats, MAX_CLIENTS, MAX_CONNECTIONS, MAX_INCOMING_BYTES, MAX_INCOMING_PER_S,
     MAX_REQUEST_BYTES,
 };
+use shoal_common::wire::security::Security;
 
 /// A running view server; dropping it stops it.
 pub struct ViewServer {
     /// Where it listens (the port resolved when 0 was asked).
     addr: SocketAddr,
+    /// `http` or `https`.
+    scheme: &'static str,
     /// Counters.
     stats: Arc<ViewStats>,
     /// Tells its threads to end.
@@ -50,23 +59,19 @@ pub struct ViewServer {
     accept: Option<JoinHandle<()>>,
 }
 
-/// Refuses an address beyond loopback: the view is plain HTTP and its page shows the whole
-/// mission to whoever reaches it.
-pub fn check_bind(addr: &SocketAddr) -> anyhow::Result<()> {
-    if addr.ip().is_loopback() {
-        return Ok(());
-    }
-    anyhow::bail!(
-        "--view {addr}: the web view serves plain HTTP without authentication, so it binds to \
-         loopback only (e.g. --view 127.0.0.1:8080); to watch from another machine, tunnel it \
-         over SSH (ssh -L 8080:127.0.0.1:8080 HOST), which authenticates and encrypts"
-    )
+/// How the view is served at `addr` under the fleet's `security`: plain on loopback, mutual
+/// TLS beyond it with the coordinator's keys, plain with `--insecure`, refused otherwise.
+pub fn check_bind(addr: &SocketAddr, security: &Security) -> anyhow::Result<Transport> {
+    web_tls::choose("--view", "web view", *addr, security)
 }
 
 impl ViewServer {
-    /// Binds `addr` (loopback only, see [`check_bind`]) and serves `source` until dropped.
-    pub fn start(addr: SocketAddr, source: Source) -> anyhow::Result<ViewServer> {
-        check_bind(&addr)?;
+    /// Binds `addr` and serves `source` over `transport` (see [`check_bind`]) until dropped.
+    pub fn start(
+        addr: SocketAddr,
+        transport: Transport,
+        source: Source,
+    ) -> anyhow::Result<ViewServer> {
         let listener =
             TcpListener::bind(addr).with_context(|| format!("--view {addr}: cannot listen"))?;
         let addr = listener.local_addr()?;
@@ -74,8 +79,10 @@ impl ViewServer {
         listener.set_nonblocking(true)?;
         let stats = Arc::new(ViewStats::default());
         let stop = Arc::new(AtomicBool::new(false));
+        let scheme = transport.scheme(true);
         let shared = Arc::new(Shared {
             source,
+            transport,
             stats: Arc::clone(&stats),
             stop: Arc::clone(&stop),
         });
@@ -84,6 +91,7 @@ impl ViewServer {
             .spawn(move || accept_loop(&listener, &shared))?;
         Ok(ViewServer {
             addr,
+            scheme,
             stats,
             stop,
             accept: Some(accept),
@@ -97,7 +105,7 @@ impl ViewServer {
 
     /// The page's address.
     pub fn url(&self) -> String {
-        format!("http://{}/", self.addr)
+        format!("{}://{}/", self.scheme, self.addr)
     }
 
     /// Its counters.
@@ -106,29 +114,34 @@ impl ViewServer {
     }
 }
 
-/// For a command's `--view ADDR`: a feed for the execution to write and a server showing it
-/// (`None` without the flag). The address is printed on stderr.
+/// For a command's `--view ADDR`: a server showing the execution's feed, reached as `security`
+/// allows (see [`check_bind`]); `None` without the flag. The address is printed on stderr.
 pub fn start_live(
     addr: Option<SocketAddr>,
+    security: &Security,
     feed: &Arc<LiveFeed>,
 ) -> anyhow::Result<Option<ViewServer>> {
     let Some(addr) = addr else {
         return Ok(None);
     };
-    let server = ViewServer::start(addr, Source::Live(Arc::clone(feed)))?;
+    let transport = check_bind(&addr, security)?;
+    let server = ViewServer::start(addr, transport, Source::Live(Arc::clone(feed)))?;
     eprintln!("live view: {}", server.url());
     Ok(Some(server))
 }
 
-/// For `replay LOG --view ADDR`: serves the log at `path` until `shutdown`.
+/// For `replay LOG --view ADDR`: serves the log at `path` until `shutdown`, reached as
+/// `security` allows (see [`check_bind`]).
 pub fn serve_log(
     addr: SocketAddr,
+    security: &Security,
     path: &std::path::Path,
     shutdown: &AtomicBool,
 ) -> anyhow::Result<()> {
+    let transport = check_bind(&addr, security)?;
     let log = crate::execute::log::read(path)?;
     let shaped = replay::ReplayLog::from_records(&log.records, path)?;
-    let server = ViewServer::start(addr, Source::Log(Arc::new(shaped)))?;
+    let server = ViewServer::start(addr, transport, Source::Log(Arc::new(shaped)))?;
     eprintln!("replay view: {} (Ctrl-C to stop)", server.url());
     while !shutdown.load(Ordering::Relaxed) {
         std::thread::sleep(ACCEPT_TICK);

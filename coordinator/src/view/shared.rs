@@ -5,6 +5,7 @@ use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize};
 use std::sync::Arc;
 
 use crate::execute::live::LiveFeed;
+use crate::web_tls::Transport;
 
 use super::replay::ReplayLog;
 
@@ -42,6 +43,9 @@ pub struct ViewStats {
     pub bad_requests: AtomicU64,
     /// Messages from pages dropped (oversized, over the rate, not expected).
     pub dropped_messages: AtomicU64,
+    /// TLS clients dropped: a handshake that failed or took too long (no certificate, one the
+    /// fleet CA did not sign, plain HTTP to the TLS port), or a member that may not watch.
+    pub refused_tls: AtomicU64,
     /// Catch-ups sent (one per connection, and one more each time a slow page was cut off).
     pub catch_ups: AtomicU64,
 }
@@ -50,6 +54,8 @@ pub struct ViewStats {
 pub(super) struct Shared {
     /// What to show.
     pub source: Source,
+    /// Plain or TLS.
+    pub transport: Transport,
     /// Counters.
     pub stats: Arc<ViewStats>,
     /// Set when the server stops: every thread ends.

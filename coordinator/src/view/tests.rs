@@ -1,5 +1,6 @@
 //! The server on a real loopback socket: the page, the WebSocket's catch-up and updates, and
-//! its bounds (client cap, oversized and too many messages, loopback only).
+//! its bounds (client cap, oversized and too many messages, refused beyond loopback without
+//! the fleet's keys or --insecure).
 
 use std::io::{Read, Write};
 use std::net::TcpStream;
@@ -19,7 +20,11 @@ fn report(vehicle: &str, seq: u64) -> LiveMessage {
 }
 
 fn server(feed: &Arc<LiveFeed>) -> anyhow::Result<ViewServer> {
-    ViewServer::start("127.0.0.1:0".parse()?, Source::Live(Arc::clone(feed)))
+    ViewServer::start(
+        "127.0.0.1:0".parse()?,
+        Transport::Plain,
+        Source::Live(Arc::clone(feed)),
+    )
 }
 
 type Socket = WebSocket<TcpStream>;
@@ -192,18 +197,49 @@ fn a_page_of_another_site_cannot_open_the_socket() -> TestResult {
 }
 
 #[test]
-fn beyond_loopback_is_refused_with_what_to_do() -> TestResult {
-    let feed = LiveFeed::new();
+fn beyond_loopback_without_keys_is_refused_with_what_to_do() -> TestResult {
+    let plain = Security::default();
     for addr in ["0.0.0.0:8080", "192.168.1.10:8080", "[::]:8080"] {
-        let e = ViewServer::start(addr.parse()?, Source::Live(Arc::clone(&feed)))
+        let e = start_live(addr.parse().ok(), &plain, &LiveFeed::new())
             .err()
             .map(|e| e.to_string())
             .unwrap_or_default();
         assert!(
-            e.contains("loopback only") && e.contains("ssh -L"),
+            e.contains("--view") && e.contains("mutual TLS") && e.contains("ssh -L"),
             "{addr}: {e}"
         );
     }
-    assert!(check_bind(&"[::1]:8080".parse()?).is_ok());
+    assert!(check_bind(&"[::1]:8080".parse()?, &plain).is_ok());
+    let insecure = Security {
+        insecure: true,
+        ..Security::default()
+    };
+    let open = start_live("0.0.0.0:0".parse().ok(), &insecure, &LiveFeed::new())?;
+    assert!(open.is_some_and(|s| s.url().starts_with("http://")));
+    Ok(())
+}
+
+#[test]
+fn a_refused_tls_client_is_counted_and_frees_its_place() -> TestResult {
+    let dir = crate::web_tls::tests::fleet()?;
+    let tls = crate::web_tls::tests::tls(dir.path())?;
+    let s = ViewServer::start("127.0.0.1:0".parse()?, tls, Source::Live(LiveFeed::new()))?;
+    assert!(s.url().starts_with("https://"), "{}", s.url());
+    let mut plain = TcpStream::connect(s.addr())?;
+    plain.write_all(b"GET / HTTP/1.1\r\nHost: x\r\n\r\n")?;
+    let _silent = TcpStream::connect(s.addr())?;
+    let until = Instant::now() + Duration::from_secs(10);
+    let settled = |s: &ViewServer| {
+        s.stats().refused_tls.load(Ordering::SeqCst) == 2
+            && s.stats().connections.load(Ordering::SeqCst) == 0
+    };
+    while !settled(&s) && Instant::now() < until {
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    assert_eq!(s.stats().refused_tls.load(Ordering::SeqCst), 2);
+    assert_eq!(s.stats().connections.load(Ordering::SeqCst), 0);
+    let mut answer = Vec::new();
+    let _ = plain.read_to_end(&mut answer);
+    assert!(!answer.starts_with(b"HTTP"), "plain HTTP was answered");
     Ok(())
 }

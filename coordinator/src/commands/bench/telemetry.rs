@@ -91,7 +91,12 @@ pub fn command(args: &BenchTelemetryArgs, stop: &AtomicBool) -> anyhow::Result<i
         args.hz, args.seconds
     );
     let feed = crate::execute::live::LiveFeed::new();
-    let Some(server) = crate::view::start_live(args.view, &feed)? else {
+    let Some(server) = crate::view::start_live(
+        args.view,
+        &shoal_common::wire::security::Security::default(),
+        &feed,
+    )?
+    else {
         let m = bench.measure(args, ("", ""), None, stop)?;
         crate::report::out::say(&m.line);
         return Ok(crate::commands::exit::EXIT_FEASIBLE);

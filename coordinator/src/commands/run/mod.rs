@@ -58,7 +58,8 @@ pub struct RunArgs {
     /// the extension `.mcap`.
     #[arg(long, env = "SHOAL_LOG")]
     pub log: Option<PathBuf>,
-    /// Serve the live web view of the mission here (loopback, e.g. 127.0.0.1:8080).
+    /// Serve the live web view of the mission here (e.g. 127.0.0.1:8080; beyond loopback,
+    /// HTTPS with the fleet's keys, or plain with --insecure).
     #[arg(long, env = "SHOAL_VIEW", value_name = "ADDR")]
     pub view: Option<std::net::SocketAddr>,
     /// Live view in Foxglove.
@@ -122,8 +123,9 @@ impl RunArgs {
 pub fn command(args: &RunArgs, shutdown: Arc<AtomicBool>) -> anyhow::Result<i32> {
     let mut options = args.options()?;
     let feed = LiveFeed::new();
-    let view = crate::view::start_live(args.view, &feed)?;
-    let foxglove = foxglove::start(&args.foxglove, args.plan.zenoh.insecure, &feed)?;
+    let security = args.plan.zenoh.security()?;
+    let view = crate::view::start_live(args.view, &security, &feed)?;
+    let foxglove = foxglove::start(&args.foxglove, &security, &feed)?;
     options.execution.live = (view.is_some() || foxglove.is_some()).then(|| Arc::clone(&feed));
     let kept = run_mission(&options, shutdown)?;
     // The clients get the end of the mission before their connections close.

@@ -61,11 +61,12 @@ pub struct ServeArgs {
     /// submission is refused rather than holding the queue.
     #[arg(long, env = "SHOAL_MAX_MISSION_HOURS", default_value_t = 6.0)]
     pub max_mission_hours: f64,
-    /// Serve the live web view of the mission running now here (loopback, e.g. 127.0.0.1:8080).
+    /// Serve the live web view of the mission running now here (e.g. 127.0.0.1:8080; beyond
+    /// loopback, HTTPS with the fleet's keys, or plain with --insecure).
     #[arg(long, env = "SHOAL_VIEW", value_name = "ADDR")]
     pub view: Option<std::net::SocketAddr>,
-    /// Show each mission live in Foxglove (one server for all missions; beyond loopback needs
-    /// --insecure).
+    /// Show each mission live in Foxglove (one server for all missions; beyond loopback, WSS
+    /// with the fleet's keys, or plain with --insecure).
     #[command(flatten)]
     pub foxglove: FoxgloveArgs,
 }
@@ -115,8 +116,9 @@ pub fn command(args: &ServeArgs, shutdown: Arc<AtomicBool>) -> anyhow::Result<i3
     // One feed for every mission: each starts with its start record, which the page, the
     // Foxglove clients (and the feed's catch-up) take as a new mission.
     let feed = LiveFeed::new();
-    let view = crate::view::start_live(args.view, &feed)?;
-    let foxglove = foxglove::start(&args.foxglove, args.zenoh.insecure, &feed)?;
+    let security = args.zenoh.security()?;
+    let view = crate::view::start_live(args.view, &security, &feed)?;
+    let foxglove = foxglove::start(&args.foxglove, &security, &feed)?;
     let live = (view.is_some() || foxglove.is_some()).then_some(&feed);
     let listen: Vec<String> = args
         .listen
@@ -124,7 +126,7 @@ pub fn command(args: &ServeArgs, shutdown: Arc<AtomicBool>) -> anyhow::Result<i3
         .iter()
         .map(|e| crate::distributed::network::resolve_port_zero(e))
         .collect::<anyhow::Result<_>>()?;
-    let config = session::router_config(&listen, &[], &args.zenoh.security()?)?;
+    let config = session::router_config(&listen, &[], &security)?;
     // Each mission's router links to this one with this router's own identity.
     let link_security = shoal_common::wire::security::link_identity(&config);
     let router = zenoh::open(config)

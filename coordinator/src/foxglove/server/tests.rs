@@ -1,5 +1,5 @@
 //! The server in process, with `tungstenite`'s client on loopback: the greeting, a late
-//! subscription's latest message, and the bounds (clients, refused messages).
+//! subscription's latest message, the bounds (clients, refused messages), and TLS.
 
 use std::net::TcpStream;
 use std::sync::atomic::Ordering;
@@ -57,14 +57,19 @@ fn json(m: Message) -> serde_json::Value {
 fn started() -> Result<(FoxgloveServer, Arc<LiveFeed>), Box<dyn std::error::Error>> {
     let feed = LiveFeed::new();
     mission(&feed);
-    let server = FoxgloveServer::start("127.0.0.1:0".parse()?, Arc::clone(&feed))?;
+    let server = FoxgloveServer::start(
+        "127.0.0.1:0".parse()?,
+        crate::web_tls::Transport::Plain,
+        Arc::clone(&feed),
+    )?;
     Ok((server, feed))
 }
 
-#[test]
-fn a_client_is_greeted_and_gets_the_latest_pose_when_it_subscribes() -> TestResult {
-    let (server, _feed) = started()?;
-    let mut c = connect(server.local_addr(), true)?;
+/// Reads the greeting, subscribes to auv1's pose as subscription 42 and returns the first
+/// message data frame.
+fn first_pose<S: std::io::Read + std::io::Write>(
+    c: &mut WebSocket<S>,
+) -> Result<tungstenite::Bytes, Box<dyn std::error::Error>> {
     assert_eq!(json(c.read()?)["op"], "serverInfo");
     // The hub may take in the start record after this client registered: then the vehicles'
     // channels come in an advertise of their own.
@@ -84,12 +89,90 @@ fn a_client_is_greeted_and_gets_the_latest_pose_when_it_subscribes() -> TestResu
     let Message::Binary(frame) = c.read()? else {
         return Err("no message data".into());
     };
+    Ok(frame)
+}
+
+#[test]
+fn a_client_is_greeted_and_gets_the_latest_pose_when_it_subscribes() -> TestResult {
+    let (server, _feed) = started()?;
+    let mut c = connect(server.local_addr(), true)?;
+    let frame = first_pose(&mut c)?;
     assert_eq!(frame[0], 1);
     assert_eq!(frame[1..5], 42u32.to_le_bytes());
     let stamp = u64::from_le_bytes(frame[5..13].try_into()?);
     assert_eq!(stamp, 1_700_000_000_000 * 1_000_000 + 3_500_000_000);
     let message: serde_json::Value = serde_json::from_slice(&frame[13..])?;
     assert_eq!(message["pose"]["position"]["x"], 10.0);
+    server.shutdown();
+    Ok(())
+}
+
+#[test]
+fn over_tls_an_operator_is_served_and_plain_ws_is_refused_and_counted() -> TestResult {
+    use crate::web_tls::tests as keys;
+    let dir = keys::fleet()?;
+    let feed = LiveFeed::new();
+    mission(&feed);
+    let server = FoxgloveServer::start(
+        "127.0.0.1:0".parse()?,
+        keys::tls(dir.path())?,
+        Arc::clone(&feed),
+    )?;
+    let addr = server.local_addr();
+    assert!(connect(addr, true).is_err(), "plain ws was served");
+    let config = Arc::new(keys::client(dir.path(), Some("operator"))?);
+    let tls = rustls::ClientConnection::new(config, "localhost".try_into()?)?;
+    let stream = rustls::StreamOwned::new(tls, TcpStream::connect(addr)?);
+    let mut req = format!("wss://{addr}").into_client_request()?;
+    req.headers_mut()
+        .insert("Sec-WebSocket-Protocol", protocol::SUBPROTOCOL.parse()?);
+    let (mut c, _) = tungstenite::client(req, stream)?;
+    // The server's 20 ms read polls time out through TLS many times while the client waits.
+    std::thread::sleep(std::time::Duration::from_millis(300));
+    let frame = first_pose(&mut c)?;
+    assert_eq!(frame[1..5], 42u32.to_le_bytes());
+    assert_eq!(server.counters().tls_refused.load(Ordering::SeqCst), 1);
+    server.shutdown();
+    Ok(())
+}
+
+#[test]
+fn silent_tls_handshakes_hold_client_places_until_their_deadline() -> TestResult {
+    let dir = crate::web_tls::tests::fleet()?;
+    let server = FoxgloveServer::start(
+        "127.0.0.1:0".parse()?,
+        crate::web_tls::tests::tls(dir.path())?,
+        LiveFeed::new(),
+    )?;
+    let addr = server.local_addr();
+    let silent: Vec<TcpStream> = (0..MAX_CLIENTS)
+        .map(|_| TcpStream::connect(addr))
+        .collect::<Result<_, _>>()?;
+    let counters = server.counters();
+    let until = std::time::Instant::now() + std::time::Duration::from_secs(3);
+    while counters.clients_served.load(Ordering::SeqCst) < MAX_CLIENTS as u64
+        && std::time::Instant::now() < until
+    {
+        std::thread::sleep(std::time::Duration::from_millis(10));
+    }
+    let _one_more = TcpStream::connect(addr)?;
+    while counters.clients_refused.load(Ordering::SeqCst) == 0 && std::time::Instant::now() < until
+    {
+        std::thread::sleep(std::time::Duration::from_millis(10));
+    }
+    assert_eq!(counters.clients_refused.load(Ordering::SeqCst), 1);
+    // Past the handshake's deadline every silent client is dropped and counted.
+    let until = std::time::Instant::now() + std::time::Duration::from_secs(10);
+    while counters.tls_refused.load(Ordering::SeqCst) < MAX_CLIENTS as u64
+        && std::time::Instant::now() < until
+    {
+        std::thread::sleep(std::time::Duration::from_millis(50));
+    }
+    assert_eq!(
+        counters.tls_refused.load(Ordering::SeqCst),
+        MAX_CLIENTS as u64
+    );
+    drop(silent);
     server.shutdown();
     Ok(())
 }
