@@ -114,9 +114,9 @@ impl Replayed {
     }
 }
 
-/// A log's statuses, rebuilt as the live run published them: one with the first report at
-/// least `every` mission seconds after the last status, and one with the end record (the
-/// picture as the mission ended, as the run's last status).
+/// A log's statuses, rebuilt as the live run published them: one per wall second of the run
+/// (with the first report at least that many mission seconds after the last status), and one
+/// with the end record (the picture as the mission ended, as the run's last status).
 pub struct Statuses {
     /// The picture so far.
     pub replayed: Replayed,
@@ -129,11 +129,14 @@ pub struct Statuses {
 }
 
 impl Statuses {
-    /// Statuses of `records` (see [`Replayed::new`]), `every` mission seconds apart.
-    pub fn new(records: &[Record], path: &Path, every: f64) -> anyhow::Result<Statuses> {
+    /// Statuses of `records` (see [`Replayed::new`]), a wall second of the run apart (the log's
+    /// time scale in mission seconds, at least one), or `at_least` mission seconds when that is
+    /// longer (a reader that thins them).
+    pub fn new(records: &[Record], path: &Path, at_least: f64) -> anyhow::Result<Statuses> {
+        let replayed = Replayed::new(records, path)?;
         Ok(Statuses {
-            replayed: Replayed::new(records, path)?,
-            every,
+            every: replayed.start.time_scale.max(at_least).max(1.0),
+            replayed,
             next: f64::NEG_INFINITY,
             latest: 0.0,
         })

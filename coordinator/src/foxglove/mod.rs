@@ -117,11 +117,7 @@ pub fn stream_log(
 ) -> anyhow::Result<bool> {
     let records = log::read(path)?.records;
     // A status per wall second of the run, as it published them live.
-    let every = match records.first() {
-        Some(log::Record::Start(start)) => start.time_scale.max(1.0),
-        _ => 1.0,
-    };
-    let statuses = crate::execute::replayed::Statuses::new(&records, path, every)?;
+    let statuses = crate::execute::replayed::Statuses::new(&records, path, 0.0)?;
     let feed = LiveFeed::new();
     let scheme = transport.scheme(false);
     let server = FoxgloveServer::start(addr, transport, Arc::clone(&feed))?;

@@ -54,14 +54,7 @@ impl ReplayLog {
     pub fn from_records(records: &[Record], path: &Path) -> anyhow::Result<ReplayLog> {
         let strides = report_strides(records);
         let (first, last) = telemetry_span(records);
-        let Some(Record::Start(start)) = records.first() else {
-            anyhow::bail!("{}: no start record", path.display());
-        };
-        let every = start
-            .time_scale
-            .max((last - first) / MAX_STATUSES as f64)
-            .max(1.0);
-        let mut statuses = Statuses::new(records, path, every)?;
+        let mut statuses = Statuses::new(records, path, (last - first) / MAX_STATUSES as f64)?;
         let mut seen: BTreeMap<&str, usize> = BTreeMap::new();
         let mut messages = Vec::new();
         for r in records {
