@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use shoal_common::scenario::Scenario;
 
 use super::exit::EXIT_FEASIBLE;
-use crate::planning::generated::scenario_text;
+use crate::planning::generated::{scenario_text, Layout};
 use crate::report::out::say;
 
 /// `shoal-coordinator generate`.
@@ -18,6 +18,10 @@ pub struct GenerateArgs {
     /// Hard and soft spheres, each (default: one of each per two vehicles, at least 2).
     #[arg(long, env = "SHOAL_SPHERES")]
     pub spheres: Option<u32>,
+    /// Layout: `crossing` (goals shuffled along the whole east side, paths cross everywhere) or
+    /// `lanes` (a 4 km strip, goals shuffled within groups of four neighbouring lanes).
+    #[arg(long, env = "SHOAL_LAYOUT", value_enum, default_value_t = Layout::Crossing)]
+    pub layout: Layout,
     /// Random seed of the layout.
     #[arg(long, env = "SHOAL_SEED", default_value_t = 1)]
     pub seed: u64,
@@ -29,7 +33,7 @@ pub struct GenerateArgs {
 /// Writes the scenario, after checking it loads.
 pub fn command(args: &GenerateArgs) -> anyhow::Result<i32> {
     let spheres = args.spheres.unwrap_or((args.vehicles / 2).max(2));
-    let text = scenario_text(args.vehicles, spheres, args.seed);
+    let text = scenario_text(args.vehicles, spheres, args.seed, args.layout);
     Scenario::parse(&text, &args.out)?;
     std::fs::write(&args.out, text)
         .map_err(|e| anyhow::anyhow!("cannot write {}: {e}", args.out.display()))?;

@@ -12,10 +12,12 @@ use std::time::Instant;
 
 use shoal_common::plan::Plan;
 use shoal_common::scenario::Scenario;
+use shoal_common::separation::all_pairs;
+use shoal_common::trajectory::Trajectory;
 
 use crate::cpu::cpu_time;
 use crate::mission::NetworkOptions;
-use crate::planning::generated::scenario_text;
+use crate::planning::generated::{scenario_text, Layout};
 use crate::planning::planner::plan_in_process;
 use crate::report::out::say;
 
@@ -28,6 +30,9 @@ pub struct BenchScaleArgs {
     /// Fleet sizes, comma-separated.
     #[arg(long, value_delimiter = ',', default_values_t = vec![4, 8, 16, 32, 64])]
     pub vehicles: Vec<u32>,
+    /// Fleet layout (see `generate --layout`).
+    #[arg(long, value_enum, default_value_t = Layout::Crossing)]
+    pub layout: Layout,
     /// Layout and optimizer seed.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
@@ -61,6 +66,14 @@ pub struct ScaleRow {
 }
 
 impl ScaleRow {
+    /// [`close_pairs_per_vehicle`] of the plan.
+    pub fn close_pairs_per_vehicle(&self) -> f64 {
+        let tracks: Vec<Trajectory> = (self.plan.vehicles.iter())
+            .map(|v| Trajectory::from_samples(&v.trajectory))
+            .collect();
+        close_pairs_per_vehicle(&tracks, self.plan.d_min_m)
+    }
+
     /// CPU microseconds per fitness evaluation of this process.
     pub fn cpu_per_evaluation_us(&self) -> f64 {
         1e6 * self.cpu_s / self.plan.evaluations.max(1) as f64
@@ -90,7 +103,7 @@ pub fn command(args: &BenchScaleArgs, stop: &Arc<AtomicBool>) -> anyhow::Result<
     }
     std::fs::create_dir_all(&args.out)?;
     let mut rows = Vec::new();
-    say("vehicles | mode | wall (s) | evaluations | evaluations/s | CPU µs/evaluation | fitness | feasible\n");
+    say("vehicles | mode | wall (s) | evaluations | evaluations/s | CPU µs/evaluation | fitness | feasible | close pairs per vehicle\n");
     for &n in &args.vehicles {
         let scenario = scenario_of(n, args)?;
         for distributed in [false, true] {
@@ -129,8 +142,12 @@ pub fn command(args: &BenchScaleArgs, stop: &Arc<AtomicBool>) -> anyhow::Result<
 /// The generated scenario of `n` vehicles with the benchmark's settings.
 fn scenario_of(n: u32, args: &BenchScaleArgs) -> anyhow::Result<Scenario> {
     let spheres = (n / 2).max(2);
-    let text = scenario_text(n, spheres, args.seed);
-    let path = args.out.join(format!("generated-{n}.toml"));
+    let text = scenario_text(n, spheres, args.seed, args.layout);
+    let name = match args.layout {
+        Layout::Crossing => "generated",
+        Layout::Lanes => "generated-lanes",
+    };
+    let path = args.out.join(format!("{name}-{n}.toml"));
     std::fs::write(&path, &text)?;
     let mut s = Scenario::parse(&text, &path)?;
     s.optimizer.seed = args.seed;
@@ -191,7 +208,7 @@ fn line(r: &ScaleRow) -> String {
         None => String::new(),
     };
     format!(
-        "{} | {} | {:.2} | {} | {:.0} | {:.1} | {:.4} | {}{rounds}",
+        "{} | {} | {:.2} | {} | {:.0} | {:.1} | {:.4} | {} | {:.2}{rounds}",
         r.vehicles,
         r.mode,
         r.wall_s,
@@ -200,7 +217,20 @@ fn line(r: &ScaleRow) -> String {
         r.cpu_per_evaluation_us(),
         r.plan.fitness,
         if r.plan.feasible { "yes" } else { "no" },
+        r.close_pairs_per_vehicle(),
     )
+}
+
+/// Pairs that come within two d_min of each other at the same instant, per vehicle (each pair
+/// counted for both): the interactions the fitness must measure exactly. A fleet in which it
+/// grows does more work per vehicle whatever the planner.
+pub fn close_pairs_per_vehicle(tracks: &[Trajectory], d_min: f64) -> f64 {
+    let reach = 2.0 * d_min;
+    let close = all_pairs(tracks, reach)
+        .iter()
+        .filter(|(_, s)| s.min_distance < reach)
+        .count();
+    2.0 * close as f64 / tracks.len().max(1) as f64
 }
 
 /// The slope `b` of the least-squares line through `(ln x, ln y)`: `y ∝ x^b`. `None` with
@@ -224,6 +254,37 @@ pub fn fitted_exponent(points: &[(f64, f64)]) -> Option<f64> {
 mod tests {
     use super::*;
     use approx::assert_abs_diff_eq;
+
+    #[test]
+    fn close_pairs_are_counted_for_both_vehicles_by_hand() {
+        // Two AUVs side by side 80 m apart (under 2 × 50 m), a third 500 m away, all heading
+        // east at 1 m/s for 1000 s: one close pair, 2 / 3 per vehicle.
+        let east =
+            |y: f64| Trajectory::from_samples(&[[0.0, 0.0, y, 100.0], [1000.0, 1000.0, y, 100.0]]);
+        let fleet = [east(0.0), east(80.0), east(580.0)];
+        assert_abs_diff_eq!(
+            close_pairs_per_vehicle(&fleet, 50.0),
+            2.0 / 3.0,
+            epsilon = 1e-12
+        );
+        // 120 m apart is not close.
+        assert_abs_diff_eq!(
+            close_pairs_per_vehicle(&fleet[1..], 50.0),
+            0.0,
+            epsilon = 1e-12
+        );
+        // Crossing paths meet only if they are there at the same time: the second starts
+        // 1000 s after the first has passed the crossing.
+        let north = Trajectory::from_samples(&[
+            [1500.0, 500.0, -500.0, 100.0],
+            [2500.0, 500.0, 500.0, 100.0],
+        ]);
+        assert_abs_diff_eq!(
+            close_pairs_per_vehicle(&[east(0.0), north], 50.0),
+            0.0,
+            epsilon = 1e-12
+        );
+    }
 
     #[test]
     fn the_fitted_exponent_of_a_power_law_is_its_power() {

@@ -20,7 +20,7 @@ use shoal_common::trajectory::Trajectory;
 use crate::cpu::cpu_time;
 use crate::execute::{self, ExecOptions};
 use crate::mission::NetworkOptions;
-use crate::planning::generated::scenario_text;
+use crate::planning::generated::{scenario_text, Layout};
 
 /// `shoal-coordinator bench-telemetry`.
 #[derive(Debug, Clone, clap::Args)]
@@ -61,7 +61,7 @@ pub fn command(args: &BenchTelemetryArgs, stop: &AtomicBool) -> anyhow::Result<i
     if !(args.hz.is_finite() && args.hz > 0.0 && args.seconds.is_finite() && args.seconds > 5.0) {
         anyhow::bail!("--hz must be positive and --seconds over 5");
     }
-    let text = scenario_text(args.vehicles, 0, 1);
+    let text = scenario_text(args.vehicles, 0, 1, Layout::Crossing);
     let mut scenario = Scenario::parse(&text, std::path::Path::new("<bench-telemetry scenario>"))?;
     scenario.name = "bench-telemetry".into();
     let n = scenario.vehicles.len();
