@@ -248,6 +248,26 @@ impl SlabBoxes {
     }
 }
 
+/// The box of every position a trajectory through `points` takes (it is piecewise linear and
+/// holds at its ends, so the box of its samples): every slab box of it lies inside. A
+/// trajectory without samples is nowhere, a box at infinity no other box comes near.
+pub fn extent(points: &[Vec3]) -> (Vec3, Vec3) {
+    let Some(first) = points.first() else {
+        let far = Vec3::repeat(f64::INFINITY);
+        return (far, far);
+    };
+    points
+        .iter()
+        .fold((*first, *first), |(lo, hi), p| (lo.inf(p), hi.sup(p)))
+}
+
+/// Whether boxes `a` and `b` (lower, upper corner) are closer than `reach`, by the test the
+/// slab boxes use: false for two [`extent`]s proves that no slab box of the one comes within
+/// `reach` of one of the other.
+pub fn boxes_within(a: &(Vec3, Vec3), b: &(Vec3, Vec3), reach: f64) -> bool {
+    gap2(&a.0, &a.1, &b.0, &b.1) < guarded2(reach)
+}
+
 /// How much farther than asked the broad phase looks, metres: the narrow phase computes
 /// positions with other roundings, so a pair whose closest approach is `reach` to the last
 /// bit is kept rather than pruned.

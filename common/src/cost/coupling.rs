@@ -5,7 +5,7 @@
 
 use std::cell::RefCell;
 
-use crate::broad_phase::{PairSet, SlabBoxes, SlabMask};
+use crate::broad_phase::{boxes_within, extent, PairSet, SlabBoxes, SlabMask};
 use crate::geometry::Vec3;
 use crate::separation::{closest_within, motion_separation, Motion};
 use crate::trajectory::Trajectory;
@@ -23,6 +23,8 @@ struct Scratch {
     velocities: Velocities,
     /// One pair's near windows.
     windows: Vec<(f64, f64)>,
+    /// The vehicles whose boxes were built, in the order of `boxes` (one change's).
+    built: Vec<usize>,
 }
 
 thread_local! {
@@ -109,6 +111,7 @@ pub(super) fn pair_terms_into(trajectories: &[Trajectory], d_min: f64, out: &mut
             pairs,
             velocities,
             windows,
+            ..
         } = scratch;
         boxes.close_pairs(d_min, pairs);
         let kept = pairs.iter().map(|(i, j)| (i, j, pairs.slabs(i, j)));
@@ -125,6 +128,11 @@ pub(super) fn pair_terms_into(trajectories: &[Trajectory], d_min: f64, out: &mut
 /// (the terms of an evaluation of the same fleet with `changed` elsewhere); only the pairs with
 /// it are found and measured again. Pairs the broad phase keeps but that never come within
 /// d_min have terms of exactly zero, so which of them are listed changes no sum.
+///
+/// The cost follows the vehicles near the changed one, not the fleet: slab boxes are built
+/// only for the others whose whole trajectory's box ([`extent`]) comes within d_min of the
+/// changed one's, since no slab box of the rest can. The slabs span the same time as the whole
+/// fleet's, so every kept pair gets the slabs [`pair_terms_into`] would find.
 pub(super) fn pair_terms_changed(
     trajectories: &[Trajectory],
     d_min: f64,
@@ -132,25 +140,41 @@ pub(super) fn pair_terms_changed(
     base: &[PairTerms],
     out: &mut Vec<PairTerms>,
 ) {
-    with_boxes(trajectories, d_min, out, |scratch, out| {
+    out.clear();
+    with_scratch(|scratch| {
+        scratch.velocities.reset(trajectories.len());
+        if trajectories.len() <= SMALL_FLEET || changed >= trajectories.len() {
+            return all_pair_terms_into(trajectories, d_min, &mut scratch.velocities, out);
+        }
         let Scratch {
             boxes,
             velocities,
             windows,
+            built,
             ..
         } = scratch;
         out.extend(
             base.iter()
                 .filter(|p| p.i as usize != changed && p.j as usize != changed),
         );
+        let mine = extent(&trajectories[changed].points);
+        built.clear();
+        built.push(changed);
+        built.extend((0..trajectories.len()).filter(|&j| {
+            j != changed && boxes_within(&mine, &extent(&trajectories[j].points), d_min)
+        }));
+        boxes.reset(horizon_of(trajectories));
+        for &j in built.iter() {
+            boxes.push(&trajectories[j].times, &trajectories[j].points);
+        }
         let fleet = Fleet {
             trajectories,
             d_min,
             boxes,
         };
-        let with_changed = (0..trajectories.len()).filter(|&j| j != changed).map(|j| {
+        let with_changed = built.iter().enumerate().skip(1).map(|(k, &j)| {
             let (a, b) = (changed.min(j), changed.max(j));
-            (a, b, boxes.near_slabs(a, b, d_min))
+            (a, b, fleet.boxes.near_slabs(0, k, d_min))
         });
         fleet.narrow(with_changed, velocities, windows, out);
         out.sort_unstable_by_key(|p| (p.i, p.j));
@@ -184,13 +208,17 @@ fn with_scratch<T>(f: impl FnOnce(&mut Scratch) -> T) -> T {
     })
 }
 
-/// Every trajectory's slab boxes, over the time to the last arrival.
-fn boxes_of(trajectories: &[Trajectory], boxes: &mut SlabBoxes) {
-    let horizon = trajectories
+/// The time to the last arrival: what the slabs span.
+fn horizon_of(trajectories: &[Trajectory]) -> f64 {
+    trajectories
         .iter()
         .filter_map(|t| t.times.last())
-        .fold(0.0f64, |a, b| a.max(*b));
-    boxes.reset(horizon);
+        .fold(0.0f64, |a, b| a.max(*b))
+}
+
+/// Every trajectory's slab boxes, over the time to the last arrival.
+fn boxes_of(trajectories: &[Trajectory], boxes: &mut SlabBoxes) {
+    boxes.reset(horizon_of(trajectories));
     for t in trajectories {
         boxes.push(&t.times, &t.points);
     }

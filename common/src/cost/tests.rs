@@ -302,6 +302,28 @@ fn the_fleet_fitness_adds_the_weighted_terms_by_hand() -> Result<(), crate::scen
     Ok(())
 }
 
+/// `x` with vehicle `i`'s chromosome taken from `other`, scored as a change of `base` (the
+/// evaluation of `x`) and as a whole: asserts both agree to the last bit and returns the whole.
+fn change_scores_as_a_whole(
+    model: &FleetModel,
+    base: &FleetEvaluation,
+    x: &[f64],
+    other: &[f64],
+    i: usize,
+) -> FleetEvaluation {
+    let mut y = x.to_vec();
+    let r = model.layout.chromosome(i);
+    y[r.clone()].copy_from_slice(&other[r]);
+    let whole = model.evaluate(&y);
+    let changed = model.evaluate_change(base, &y, i);
+    assert_eq!(changed.total.to_bits(), whole.total.to_bits());
+    assert_eq!(changed.vehicles, whole.vehicles);
+    assert_eq!(changed.trajectories, whole.trajectories);
+    assert_eq!(changed.pairs, whole.pairs);
+    assert_eq!(changed.penalty.to_bits(), whole.penalty.to_bits());
+    whole
+}
+
 #[test]
 fn changing_one_vehicle_scores_as_a_whole_evaluation_to_the_last_bit(
 ) -> Result<(), crate::scenario::ScenarioError> {
@@ -314,23 +336,59 @@ fn changing_one_vehicle_scores_as_a_whole_evaluation_to_the_last_bit(
         let x = model.sample(&mut rng);
         let base = model.evaluate(&x);
         for i in 0..model.layout.vehicles {
-            let other = model.sample(&mut rng);
-            let mut y = x.clone();
-            let r = model.layout.chromosome(i);
-            y[r.clone()].copy_from_slice(&other[r]);
-            let whole = model.evaluate(&y);
-            let changed = model.evaluate_change(&base, &y, i);
-            assert_eq!(changed.total.to_bits(), whole.total.to_bits());
-            assert_eq!(changed.vehicles, whole.vehicles);
-            assert_eq!(changed.trajectories, whole.trajectories);
-            assert_eq!(changed.pairs, whole.pairs);
-            assert_eq!(changed.penalty.to_bits(), whole.penalty.to_bits());
+            let whole = change_scores_as_a_whole(&model, &base, &x, &model.sample(&mut rng), i);
             incremental += usize::from(whole.common_arrival == base.common_arrival);
             breaches += usize::from(whole.separation_penalty > 0.0);
         }
     }
     // Both ways through evaluate_change were taken, and pairs did breach.
     assert!(incremental > 20 && incremental < 320, "{incremental}");
+    assert!(breaches > 20, "{breaches}");
+    Ok(())
+}
+
+/// Eight AUVs in lanes 90 m apart, each on its straight line with every waypoint moved up to
+/// 40 m: neighbours can come closer than d_min, lanes farther apart never can, so a change
+/// measures only the vehicles whose whole trajectories come near.
+#[test]
+fn changing_one_vehicle_among_far_lanes_scores_as_a_whole_evaluation_to_the_last_bit(
+) -> Result<(), crate::scenario::ScenarioError> {
+    use crate::fixtures::{scenario, straight_particle, vehicle_toml};
+    use rand::{Rng, SeedableRng};
+    let lanes: Vec<String> = (0..8)
+        .map(|k| {
+            let y = 80.0 + 90.0 * k as f64;
+            vehicle_toml(&format!("v{k}"), [50.0, y, 250.0], [950.0, y, 250.0])
+        })
+        .collect();
+    let model = FleetModel::new(&scenario(900.0, "", &lanes)?);
+    let straight = straight_particle(&model);
+    let mut rng = rand::rngs::StdRng::seed_from_u64(11);
+    // Coordinates moved by up to 40 m, speeds anywhere in their range.
+    let moved = |rng: &mut rand::rngs::StdRng| -> Vec<f64> {
+        let (m, len) = (model.layout.waypoints, model.layout.chromosome_len());
+        (straight
+            .iter()
+            .zip(model.lower.iter().zip(&model.upper))
+            .enumerate())
+        .map(|(g, (x, (lo, hi)))| {
+            if g % len >= 3 * m {
+                rng.random_range(*lo..=*hi)
+            } else {
+                (x + rng.random_range(-40.0..40.0)).clamp(*lo, *hi)
+            }
+        })
+        .collect()
+    };
+    let mut breaches = 0;
+    for _ in 0..30 {
+        let x = moved(&mut rng);
+        let base = model.evaluate(&x);
+        for i in 0..model.layout.vehicles {
+            let whole = change_scores_as_a_whole(&model, &base, &x, &moved(&mut rng), i);
+            breaches += usize::from(whole.separation_penalty > 0.0);
+        }
+    }
     assert!(breaches > 20, "{breaches}");
     Ok(())
 }
