@@ -105,7 +105,8 @@ pub struct PairTerms {
 /// The terms of every pair the broad phase cannot rule out, in row order, into `out` (cleared
 /// first).
 pub(super) fn pair_terms_into(trajectories: &[Trajectory], d_min: f64, out: &mut Vec<PairTerms>) {
-    with_boxes(trajectories, d_min, out, |scratch, out| {
+    with_measure(trajectories, d_min, out, |scratch, out| {
+        boxes_of(trajectories, &mut scratch.boxes);
         let Scratch {
             boxes,
             pairs,
@@ -140,12 +141,7 @@ pub(super) fn pair_terms_changed(
     base: &[PairTerms],
     out: &mut Vec<PairTerms>,
 ) {
-    out.clear();
-    with_scratch(|scratch| {
-        scratch.velocities.reset(trajectories.len());
-        if trajectories.len() <= SMALL_FLEET || changed >= trajectories.len() {
-            return all_pair_terms_into(trajectories, d_min, &mut scratch.velocities, out);
-        }
+    with_measure(trajectories, d_min, out, |scratch, out| {
         let Scratch {
             boxes,
             velocities,
@@ -157,7 +153,10 @@ pub(super) fn pair_terms_changed(
             base.iter()
                 .filter(|p| p.i as usize != changed && p.j as usize != changed),
         );
-        let mine = extent(&trajectories[changed].points);
+        let Some(moved) = trajectories.get(changed) else {
+            return;
+        };
+        let mine = extent(&moved.points);
         built.clear();
         built.push(changed);
         built.extend((0..trajectories.len()).filter(|&j| {
@@ -181,9 +180,9 @@ pub(super) fn pair_terms_changed(
     });
 }
 
-/// Clears `out`, then runs `measure` on this thread's buffers with the fleet's slab boxes
-/// built; a small fleet ([`SMALL_FLEET`]) gets every pair measured instead.
-fn with_boxes(
+/// Clears `out`, then runs `measure` on this thread's buffers (prepared for the fleet's
+/// vehicles); a small fleet ([`SMALL_FLEET`]) gets every pair measured instead.
+fn with_measure(
     trajectories: &[Trajectory],
     d_min: f64,
     out: &mut Vec<PairTerms>,
@@ -195,7 +194,6 @@ fn with_boxes(
         if trajectories.len() <= SMALL_FLEET {
             return all_pair_terms_into(trajectories, d_min, &mut scratch.velocities, out);
         }
-        boxes_of(trajectories, &mut scratch.boxes);
         measure(scratch, out);
     });
 }

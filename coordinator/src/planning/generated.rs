@@ -33,6 +33,17 @@ pub enum Layout {
     Lanes,
 }
 
+impl Layout {
+    /// The start of a generated scenario's name and file name: `generated-N` or
+    /// `generated-lanes-N`.
+    pub fn stem(self) -> &'static str {
+        match self {
+            Layout::Crossing => "generated",
+            Layout::Lanes => "generated-lanes",
+        }
+    }
+}
+
 /// Lanes whose goals are shuffled among themselves in the lanes layout.
 const LANE_GROUP: usize = 4;
 
@@ -46,11 +57,11 @@ const INFLATION: f64 = 50.0;
 /// along a side less 200 m at each end, are at least 3 d_min apart (a 100-vehicle fleet packed
 /// into 4 km would start 36 m apart, closer than d_min, and no plan could separate them).
 pub fn side(n: usize) -> f64 {
-    SMALL_SIDE.max(400.0 + 3.0 * D_MIN * n as f64)
+    SMALL_SIDE.max(lanes_width(n))
 }
 
 /// Width of the lanes layout's strip for `n` vehicles, metres: lanes three d_min apart and
-/// 200 m to spare at each side, as the crossing layout's starts beyond 24 vehicles.
+/// 200 m to spare at each side (the crossing layout's side beyond 24 vehicles too).
 pub fn lanes_width(n: usize) -> f64 {
     400.0 + 3.0 * D_MIN * n as f64
 }
@@ -144,11 +155,11 @@ pub fn scenario_text(vehicles: u32, spheres: u32, seed: u64, layout: Layout) -> 
 fn header(vehicles: u32, spheres: u32, seed: u64, layout: Layout, size: [f64; 2]) -> String {
     let [length, width] = size;
     let (km_x, km_y) = (length / 1000.0, width / 1000.0);
-    let (flag, name, goals) = match layout {
-        Layout::Crossing => ("", "generated", "in a\n# shuffled order"),
+    let name = layout.stem();
+    let (flag, goals) = match layout {
+        Layout::Crossing => ("", "in a\n# shuffled order"),
         Layout::Lanes => (
             " --layout lanes",
-            "generated-lanes",
             "shuffled\n# within groups of four neighbouring lanes",
         ),
     };

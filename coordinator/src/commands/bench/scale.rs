@@ -143,11 +143,7 @@ pub fn command(args: &BenchScaleArgs, stop: &Arc<AtomicBool>) -> anyhow::Result<
 fn scenario_of(n: u32, args: &BenchScaleArgs) -> anyhow::Result<Scenario> {
     let spheres = (n / 2).max(2);
     let text = scenario_text(n, spheres, args.seed, args.layout);
-    let name = match args.layout {
-        Layout::Crossing => "generated",
-        Layout::Lanes => "generated-lanes",
-    };
-    let path = args.out.join(format!("{name}-{n}.toml"));
+    let path = args.out.join(format!("{}-{n}.toml", args.layout.stem()));
     std::fs::write(&path, &text)?;
     let mut s = Scenario::parse(&text, &path)?;
     s.optimizer.seed = args.seed;
