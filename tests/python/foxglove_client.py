@@ -214,6 +214,11 @@ def main():
     ap.add_argument("url")
     ap.add_argument("out")
     ap.add_argument("--timeout", type=float, default=180.0)
+    ap.add_argument(
+        "--watch-only",
+        action="store_true",
+        help="only watch: no late client and no refusal checks (a fast replay may end first)",
+    )
     args = ap.parse_args()
     deadline = time.monotonic() + args.timeout
     mission = Mission()
@@ -233,7 +238,8 @@ def main():
                 main_client.on_text(frame)
                 continue
             mission.take(*main_client.on_binary(frame))
-            if not checks and sum(len(p) for p in mission.poses.values()) >= 20:
+            seen = sum(len(p) for p in mission.poses.values())
+            if not args.watch_only and not checks and seen >= 20:
                 checks["late"] = late_client(args.url)
                 checks["refusals"] = refusals(args.url)
     need(main_client.info is not None, "no serverInfo")

@@ -245,7 +245,7 @@ fn a_foxglove_client_sees_the_logged_positions_the_scene_and_the_bounds() -> Tes
         .arg(root().join("tests/python/foxglove_client.py"))
         .arg(format!("ws://127.0.0.1:{port}"))
         .arg(&replayed)
-        .args(["--timeout", "200"]);
+        .args(["--timeout", "200", "--watch-only"]);
     let r = run(client, LIMIT);
     assert_eq!(r.code(), Some(0), "{r}");
     let played = fleet.wait(replay, Instant::now() + LIMIT);
