@@ -37,6 +37,7 @@
 //! 5 000 fleet evaluations per crawler, the swarm's crawler paths being at a local optimum of
 //! their cost already.
 
+mod concurrent;
 pub mod constraints;
 pub mod descent;
 mod objective;
@@ -131,6 +132,11 @@ pub fn refine(
     let swimmers: Vec<usize> = (0..model.layout.vehicles)
         .filter(|i| model.crawlers[*i].is_none())
         .collect();
+    // Vehicles whose trajectories are this far apart are refined side by side: neither's
+    // separation rows (taken within 2 d_min + margin + 4 trust radii) can see the other.
+    let apart =
+        2.0 * model.scenario.fleet.d_min_m + settings.distance_margin_m + 4.0 * settings.radius_m;
+    let threads = model.scenario.optimizer.threads;
     for _ in 0..settings.rounds {
         let kept = search.steps;
         // The latest vehicles first: they hold the fleet's arrival.
@@ -140,8 +146,9 @@ pub fn refine(
                 / model.scenario.vehicles[i].speed_max_mps
         };
         order.sort_by(|a, b| lateness(*b).total_cmp(&lateness(*a)));
-        for i in order {
-            search.vehicle(i);
+        let extents = concurrent::trajectory_extents(&search, model.layout.vehicles);
+        for batch in concurrent::far_apart_batches(&order, &extents, apart) {
+            concurrent::refine_batch(&mut search, &batch, threads);
             if search.interrupted {
                 break;
             }

@@ -11,7 +11,7 @@ use super::constraints::{self, Limits, Row};
 use super::objective::{model_hessian, objective_gradient};
 use super::qp::Program;
 use super::settings::RefineSettings;
-use crate::broad_phase::SlabBoxes;
+use crate::broad_phase::{boxes_within, extent, SlabBoxes};
 use crate::cost::FleetModel;
 use crate::geometry::Vec3;
 use crate::trajectory::Trajectory;
@@ -89,6 +89,18 @@ impl<'a, A: Arena> Search<'a, A> {
             eval: self.arena.evaluate(&x),
             x,
             evaluations: 1,
+            steps: 0,
+            interrupted: false,
+            ..*self
+        }
+    }
+
+    /// A copy of this search at its fleet position, with counts of its own.
+    pub fn fork(&self) -> Self {
+        Search {
+            x: self.x.clone(),
+            eval: self.eval.clone(),
+            evaluations: 0,
             steps: 0,
             interrupted: false,
             ..*self
@@ -253,7 +265,12 @@ fn coming_near<'e>(
     let (mut own, mut other_boxes) = (SlabBoxes::new(), SlabBoxes::new());
     own.reset(horizon);
     own.push(&mine.times, &mine.points);
+    let whole = extent(&mine.points);
     others.into_iter().filter(move |t| {
+        // Whole trajectories apart prove every slab apart, for a box test instead of a slab pass.
+        if !boxes_within(&whole, &extent(&t.points), reach) {
+            return false;
+        }
         other_boxes.reset(horizon);
         other_boxes.push(&t.times, &t.points);
         own.near_other(0, &other_boxes, 0, reach)

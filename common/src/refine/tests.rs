@@ -317,3 +317,75 @@ fn a_detour_round_a_costly_soft_sphere_is_pulled_tight_without_entering_it(
     assert_eq!(soft, 0.0);
     Ok(())
 }
+
+/// Boxes of points along x at 0, 100, 200, 300 and 1000 m, 150 m apart at least within a batch:
+/// the first batch takes 0, skips 1 (100 m from 0), takes 2, skips 3 (100 m from 2), takes 4;
+/// the second takes 1 and 3 (200 m apart). Six vehicles 1 km apart fill a batch of four first.
+#[test]
+fn batches_hold_vehicles_pairwise_apart_in_order_and_at_most_four() {
+    let at = |x: f64| (Vec3::new(x, 0.0, 0.0), Vec3::new(x, 0.0, 0.0));
+    let extents: Vec<_> = [0.0, 100.0, 200.0, 300.0, 1000.0].map(at).into();
+    assert_eq!(
+        concurrent::far_apart_batches(&[0, 1, 2, 3, 4], &extents, 150.0),
+        vec![vec![0, 2, 4], vec![1, 3]]
+    );
+    // Another order: 3 opens, 0 and 1 join (300 and 200 m from 3, 100 m apart from each other:
+    // only 0 joins), then 4 (700 m from 3).
+    assert_eq!(
+        concurrent::far_apart_batches(&[3, 0, 1, 4, 2], &extents, 150.0),
+        vec![vec![3, 0, 4], vec![1], vec![2]]
+    );
+    let spread: Vec<_> = (0..6).map(|k| at(1000.0 * k as f64)).collect();
+    assert_eq!(
+        concurrent::far_apart_batches(&[0, 1, 2, 3, 4, 5], &spread, 150.0),
+        vec![vec![0, 1, 2, 3], vec![4, 5]]
+    );
+}
+
+/// Two AUVs 700 m apart, each bowed 100 m out of its straight line: refined side by side they
+/// end where refining one after the other puts them, each pulled tighter.
+#[test]
+fn far_apart_vehicles_refined_side_by_side_end_where_one_after_the_other_does(
+) -> Result<(), ScenarioError> {
+    let s = scenario(
+        "",
+        &[
+            vehicle("a", [100.0, 150.0, 250.0], [900.0, 150.0, 250.0]),
+            vehicle("b", [100.0, 850.0, 250.0], [900.0, 850.0, 250.0]),
+        ],
+    )?;
+    let model = FleetModel::new(&s);
+    let bowed = |y: f64| {
+        chromosome(12, move |u| {
+            [100.0 + 800.0 * u, y + 100.0 * (PI * u).sin(), 250.0]
+        })
+    };
+    let mut x = bowed(150.0);
+    x.extend(bowed(850.0));
+    let settings = RefineSettings::default();
+    let arena = FleetArena {
+        model: &model,
+        target: target_arrival(&s),
+    };
+    let start = search::Search::new(&arena, &x, arena.target, &settings, None);
+    let extents = concurrent::trajectory_extents(&start, 2);
+    assert_eq!(
+        concurrent::far_apart_batches(&[0, 1], &extents, 180.5),
+        vec![vec![0, 1]]
+    );
+    let mut side_by_side = start.fork();
+    concurrent::refine_batch(&mut side_by_side, &[0, 1], 2);
+    let mut in_turn = start.fork();
+    in_turn.vehicle(0);
+    in_turn.vehicle(1);
+    for i in 0..2 {
+        assert!(length(&model, &side_by_side.x, i) < length(&model, &x, i) - 10.0);
+    }
+    assert_eq!(side_by_side.steps, in_turn.steps);
+    for (a, b) in side_by_side.x.iter().zip(&in_turn.x) {
+        assert!((a - b).abs() < 1e-9, "{a} vs {b}");
+    }
+    let (m_side, m_turn) = (arena.merit(&side_by_side.eval), arena.merit(&in_turn.eval));
+    assert!((m_side - m_turn).abs() < 1e-12, "{m_side} vs {m_turn}");
+    Ok(())
+}
