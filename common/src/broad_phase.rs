@@ -103,6 +103,8 @@ impl SlabBoxes {
         let slab = self.horizon / SLABS as f64;
         let mut seg = 0usize;
         let mut start = position(times, points, &mut seg, 0.0);
+        self.lo.reserve(SLABS);
+        self.hi.reserve(SLABS);
         for k in 0..SLABS {
             let t1 = if k + 1 == SLABS {
                 f64::INFINITY
@@ -123,7 +125,8 @@ impl SlabBoxes {
                 lo = lo.inf(&points[seg]);
                 hi = hi.sup(&points[seg]);
             }
-            let end = position(times, points, &mut seg, t1);
+            // `seg` is now the last sample at or before t1.
+            let end = position_on_leg(times, points, seg, t1);
             self.lo.push(lo.inf(&end));
             self.hi.push(hi.sup(&end));
             start = end;
@@ -317,7 +320,14 @@ fn position(times: &[f64], points: &[Vec3], seg: &mut usize, t: f64) -> Vec3 {
     while *seg + 1 < n && times[*seg + 1] <= t {
         *seg += 1;
     }
-    let i = *seg;
+    position_on_leg(times, points, *seg, t)
+}
+
+/// Position at `t` on the leg from sample `i`, the last at or before `t` (held at the last
+/// sample, and at sample `i` before its time).
+#[inline]
+fn position_on_leg(times: &[f64], points: &[Vec3], i: usize, t: f64) -> Vec3 {
+    let n = times.len().min(points.len());
     if i + 1 >= n || t <= times[i] {
         return points[i];
     }

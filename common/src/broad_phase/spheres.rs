@@ -99,12 +99,14 @@ impl SphereGrid {
     /// The cell ranges (x and y, inclusive) the box covers, clamped to the grid: cells past the
     /// edge hold nothing beyond what the edge cell holds.
     fn span(&self, lo: &Vec3, hi: &Vec3) -> ((usize, usize), (usize, usize)) {
+        // Truncation is the floor for the non-negative quotients it is used on, without
+        // `floor`'s library call (x86-64 has no rounding instruction before SSE4.1).
         let index = |v: f64, d: usize| {
-            let i = ((v - self.origin[d]) / self.cell).floor();
-            if i.is_nan() || i < 0.0 {
-                0
+            let q = (v - self.origin[d]) / self.cell;
+            if q >= 0.0 {
+                (q as usize).min(self.size[d] - 1)
             } else {
-                (i as usize).min(self.size[d] - 1)
+                0
             }
         };
         (
