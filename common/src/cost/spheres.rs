@@ -1,8 +1,9 @@
 //! The legs of a path against the obstacle spheres: the hard-obstacle penalty and the metres
 //! inside soft spheres (F_i(O) of Zhi & Zuo 2024, eq. (9)), in one pass. A model's spheres are
-//! indexed once ([`SphereIndex`]); a path is then tested only against the spheres near its
-//! chunks of legs, in the same order as against all of them, so the sums are the same to the
-//! last bit.
+//! indexed once ([`SphereIndex`]); a path is then tested only against the spheres the grid
+//! lists near its box (one lookup per path: a lookup per chunk of legs cost more than the
+//! chunk tests it spared), chunk by chunk, in the same order as against all of them, so the
+//! sums are the same to the last bit.
 
 use std::cell::RefCell;
 
@@ -85,8 +86,11 @@ impl SphereIndex {
         chunk_boxes(points, boxes);
         marks.clear();
         marks.resize(self.grid.words(), 0);
-        for (lo, hi) in boxes.iter() {
-            self.grid.mark_near(lo, hi, marks);
+        if let Some(first) = boxes.first() {
+            let (lo, hi) = boxes
+                .iter()
+                .fold(*first, |(lo, hi), (l, h)| (lo.inf(l), hi.sup(h)));
+            self.grid.mark_near(&lo, &hi, marks);
         }
         let mut out = SphereTerms::default();
         for (w, &word) in marks.iter().enumerate() {

@@ -163,9 +163,11 @@ proptest::proptest! {
     #[test]
     fn sphere_terms_match_the_brute_force(
         pts in proptest::collection::vec((0.0f64..1000.0, 0.0f64..1000.0, 0.0f64..1000.0), 2..30),
-        spheres in proptest::collection::vec((0.0f64..1000.0, 0.0f64..1000.0, 0.0f64..1000.0, 1.0f64..300.0, proptest::bool::ANY), 1..12),
+        spheres in proptest::collection::vec((0.0f64..1000.0, 0.0f64..1000.0, 0.0f64..1000.0, 1.0f64..300.0, proptest::bool::ANY), 1..40),
+        spread in 0.05f64..1.0,
     ) {
-        let pts: Vec<Vec3> = pts.iter().map(|p| v(p.0, p.1, p.2)).collect();
+        // Paths over a part of the box too, so the grid of more than a dozen spheres culls.
+        let pts: Vec<Vec3> = pts.iter().map(|p| v(p.0 * spread, p.1 * spread, p.2)).collect();
         let (mut hard, mut soft) = (Vec::new(), Vec::new());
         for s in &spheres {
             let sp = Sphere { centre: v(s.0, s.1, s.2), radius: s.3 };
