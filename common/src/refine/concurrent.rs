@@ -42,10 +42,13 @@ pub(super) fn far_apart_batches(
                 break;
             }
             let candidate = order[next];
+            if placed[next] {
+                continue;
+            }
             let apart = batch
                 .iter()
                 .all(|&b| !boxes_within(&extents[b], &extents[candidate], reach));
-            if !placed[next] && apart {
+            if apart {
                 placed[next] = true;
                 batch.push(candidate);
             }
@@ -88,11 +91,8 @@ where
 }
 
 /// The box of every vehicle's trajectory, indexed by vehicle.
-pub(super) fn trajectory_extents<A: Arena>(
-    search: &Search<A>,
-    vehicles: usize,
-) -> Vec<(Vec3, Vec3)> {
-    (0..vehicles)
+pub(super) fn trajectory_extents<A: Arena>(search: &Search<A>) -> Vec<(Vec3, Vec3)> {
+    (0..search.arena.model().layout.vehicles)
         .map(|i| extent(&search.arena.mine(&search.eval, i).points))
         .collect()
 }

@@ -146,7 +146,7 @@ pub fn refine(
                 / model.scenario.vehicles[i].speed_max_mps
         };
         order.sort_by(|a, b| lateness(*b).total_cmp(&lateness(*a)));
-        let extents = concurrent::trajectory_extents(&search, model.layout.vehicles);
+        let extents = concurrent::trajectory_extents(&search);
         for batch in concurrent::far_apart_batches(&order, &extents, apart) {
             concurrent::refine_batch(&mut search, &batch, threads);
             if search.interrupted {

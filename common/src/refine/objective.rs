@@ -2,7 +2,7 @@
 //! eq. (12), with a central-difference gradient and the path length's exact Hessian as the
 //! quadratic program's model.
 
-use crate::broad_phase::extent;
+use crate::broad_phase::{boxes_within, extent};
 use crate::bspline::polyline_length;
 use crate::cost::{depth_term, soft_threat_term, time_term, FleetModel, Sphere};
 use crate::geometry::Vec3;
@@ -48,17 +48,13 @@ pub(super) fn objective_gradient(model: &FleetModel, i: usize, points: &[Vec3]) 
 
 /// The spheres of `soft`, in order, that reach the box of `points` grown by `grow` metres on
 /// every side: a sphere that does not cannot contain a point of a leg whose ends move by up to
-/// `grow` (each coordinate), since such a leg stays inside that box. A micrometre more is
-/// kept, so no rounding of a leg's closest point makes a skipped sphere count.
+/// `grow` (each coordinate), since such a leg stays inside that box. The box test is the
+/// broad phase's ([`boxes_within`], with its guard), the centre a box of its own.
 fn soft_spheres_reaching(soft: &[Sphere], points: &[Vec3], grow: f64) -> Vec<Sphere> {
-    const GUARD_M: f64 = 1e-6;
     let (lo, hi) = extent(points);
-    let (lo, hi) = (lo.add_scalar(-grow), hi.add_scalar(grow));
+    let grown = (lo.add_scalar(-grow), hi.add_scalar(grow));
     soft.iter()
-        .filter(|s| {
-            let gap = (lo - s.centre).sup(&(s.centre - hi)).sup(&Vec3::zeros());
-            gap.norm() < s.radius + GUARD_M
-        })
+        .filter(|s| boxes_within(&grown, &(s.centre, s.centre), s.radius))
         .copied()
         .collect()
 }

@@ -368,7 +368,7 @@ fn far_apart_vehicles_refined_side_by_side_end_where_one_after_the_other_does(
         target: target_arrival(&s),
     };
     let start = search::Search::new(&arena, &x, arena.target, &settings, None);
-    let extents = concurrent::trajectory_extents(&start, 2);
+    let extents = concurrent::trajectory_extents(&start);
     assert_eq!(
         concurrent::far_apart_batches(&[0, 1], &extents, 180.5),
         vec![vec![0, 1]]
