@@ -142,10 +142,7 @@ impl SlabBoxes {
     /// The slabs in which vehicles `a` and `b` have boxes closer than `reach`, as a mask (bit
     /// `k` for slab `k`).
     pub fn near_slabs(&self, a: usize, b: usize, reach: f64) -> SlabMask {
-        let r2 = guarded2(reach);
-        (0..SLABS)
-            .filter(|&k| self.box_gap2(a * SLABS + k, b * SLABS + k) < r2)
-            .fold(0, |m, k| m | 1 << k)
+        self.near_slabs_other(a, self, b, reach)
     }
 
     /// The time windows `(from, to)` of the slabs in `mask`, adjacent ones merged, into `out`
@@ -172,11 +169,20 @@ impl SlabBoxes {
     /// Whether vehicle `a` of `self` and vehicle `b` of `other` (with the same horizon) have
     /// boxes of some slab closer than `reach`.
     pub fn near_other(&self, a: usize, other: &SlabBoxes, b: usize, reach: f64) -> bool {
+        self.near_slabs_other(a, other, b, reach) != 0
+    }
+
+    /// The slabs in which vehicle `a` of `self` and vehicle `b` of `other` (with the same
+    /// horizon) have boxes closer than `reach`, as a mask: outside them the two are at least
+    /// `reach` apart.
+    pub fn near_slabs_other(&self, a: usize, other: &SlabBoxes, b: usize, reach: f64) -> SlabMask {
         let r2 = guarded2(reach);
-        (0..SLABS).any(|k| {
-            let (i, j) = (a * SLABS + k, b * SLABS + k);
-            gap2(&self.lo[i], &self.hi[i], &other.lo[j], &other.hi[j]) < r2
-        })
+        (0..SLABS)
+            .filter(|&k| {
+                let (i, j) = (a * SLABS + k, b * SLABS + k);
+                gap2(&self.lo[i], &self.hi[i], &other.lo[j], &other.hi[j]) < r2
+            })
+            .fold(0, |m, k| m | 1 << k)
     }
 
     /// Every pair `(i, j)`, `i < j`, whose boxes of some slab are closer than `reach`, marked
@@ -242,12 +248,6 @@ impl SlabBoxes {
             return 0;
         }
         spread.imax()
-    }
-
-    /// Squared distance between boxes `i` and `j` of this set.
-    #[inline]
-    fn box_gap2(&self, i: usize, j: usize) -> f64 {
-        gap2(&self.lo[i], &self.hi[i], &self.lo[j], &self.hi[j])
     }
 }
 

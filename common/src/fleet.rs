@@ -142,24 +142,7 @@ pub enum Bend {
 /// The straight line `a→b` at `m + 2` stations (ends included) bent by `amp · Σ shape_k sin(kπf)`,
 /// with depth following the horizontal distance travelled, so the climb is spread evenly.
 fn bent_curve(a: Vec3, b: Vec3, m: usize, shape: &[Vec3], amp: f64) -> Vec<Vec3> {
-    let mut pts: Vec<Vec3> = (0..=m + 1)
-        .map(|j| {
-            let f = j as f64 / (m + 1) as f64;
-            let mut p = a + (b - a) * f;
-            for (k, h) in shape.iter().enumerate() {
-                p += h * (amp * ((k + 1) as f64 * std::f64::consts::PI * f).sin());
-            }
-            p
-        })
-        .collect();
-    let along = horizontal_progress(&pts);
-    let total = along[m + 1].max(1e-9);
-    for j in 1..=m {
-        let f = j as f64 / (m + 1) as f64;
-        let bend_z = pts[j].z - (a.z + (b.z - a.z) * f);
-        pts[j].z = a.z + (b.z - a.z) * along[j] / total + bend_z;
-    }
-    pts
+    BentLine::new(a, b, m, shape).curve(amp)
 }
 
 /// Cumulative horizontal distance along `pts`.
@@ -172,10 +155,82 @@ fn horizontal_progress(pts: &[Vec3]) -> Vec<f64> {
     along
 }
 
+/// The straight line `a→b` at its stations with the sines of its bend at each, computed once
+/// for the many amplitudes a bisection tries (the sines cost more than the rest of a curve).
+/// Every amplitude's points come out to the last bit as a curve computed afresh.
+struct BentLine<'s> {
+    a: Vec3,
+    b: Vec3,
+    shape: &'s [Vec3],
+    /// The unbent stations `a + (b − a) f`, `f = j / (m + 1)`.
+    stations: Vec<Vec3>,
+    /// `sin(kπf)` of harmonic `k` at station `j`, at `j · shape.len() + k − 1`.
+    sines: Vec<f64>,
+}
+
+impl<'s> BentLine<'s> {
+    fn new(a: Vec3, b: Vec3, m: usize, shape: &'s [Vec3]) -> BentLine<'s> {
+        let fraction = |j: usize| j as f64 / (m + 1) as f64;
+        BentLine {
+            a,
+            b,
+            shape,
+            stations: (0..=m + 1).map(|j| a + (b - a) * fraction(j)).collect(),
+            sines: (0..=m + 1)
+                .flat_map(|j| {
+                    (1..=shape.len())
+                        .map(move |k| (k as f64 * std::f64::consts::PI * fraction(j)).sin())
+                })
+                .collect(),
+        }
+    }
+
+    /// Station `j` bent by `amp`, before its depth is respread.
+    fn point(&self, j: usize, amp: f64) -> Vec3 {
+        let waves = &self.sines[j * self.shape.len()..(j + 1) * self.shape.len()];
+        let mut p = self.stations[j];
+        for (h, sine) in self.shape.iter().zip(waves) {
+            p += h * (amp * sine);
+        }
+        p
+    }
+
+    /// The horizontal distance the line bent by `amp` covers.
+    fn horizontal_length(&self, amp: f64) -> f64 {
+        let mut previous = self.point(0, amp);
+        let mut along = 0.0;
+        for j in 1..self.stations.len() {
+            let p = self.point(j, amp);
+            let d = p - previous;
+            along += (d.x * d.x + d.y * d.y).sqrt();
+            previous = p;
+        }
+        along
+    }
+
+    /// The line bent by `amp`, its depth following the horizontal distance travelled.
+    fn curve(&self, amp: f64) -> Vec<Vec3> {
+        let (a, b) = (self.a, self.b);
+        let mut pts: Vec<Vec3> = (0..self.stations.len())
+            .map(|j| self.point(j, amp))
+            .collect();
+        let along = horizontal_progress(&pts);
+        let last = pts.len() - 1;
+        let total = along[last].max(1e-9);
+        for j in 1..last {
+            let f = j as f64 / last as f64;
+            let bend_z = pts[j].z - (a.z + (b.z - a.z) * f);
+            pts[j].z = a.z + (b.z - a.z) * along[j] / total + bend_z;
+        }
+        pts
+    }
+}
+
 /// The bend amplitude (in `[0, max_amp]`) whose curve covers `target` metres horizontally, by
 /// bisection (the length grows with the amplitude); `max_amp` if even that falls short.
 fn bend_for_length(a: Vec3, b: Vec3, m: usize, shape: &[Vec3], target: f64, max_amp: f64) -> f64 {
-    let length = |amp: f64| horizontal_progress(&bent_curve(a, b, m, shape, amp))[m + 1];
+    let line = BentLine::new(a, b, m, shape);
+    let length = |amp: f64| line.horizontal_length(amp);
     if length(max_amp) <= target {
         return max_amp;
     }

@@ -239,12 +239,18 @@ pub fn soft_rows(points: &[Vec3], soft: &[Sphere], reach: f64, rows: &mut Vec<Ro
 /// `p(t)` is this vehicle's position on its leg at the fraction its timing gives; the fraction
 /// is held fixed in the gradient (a path change also retimes the vehicle; the refinement's
 /// acceptance test on the true fitness answers for that).
+///
+/// Only the samples within `windows` (ascending, apart; `(0, ∞)` for the whole mission) are
+/// looked at, each tested against its neighbours as in a sweep of the whole mission: windows
+/// outside which the two are known to stay farther than `separation + reach` apart (the
+/// broad phase's near slabs) give the same rows.
 pub fn separation_rows(
     mine: &Trajectory,
     other: &Trajectory,
     limits: &Limits,
     step: f64,
     reach: f64,
+    windows: &[(f64, f64)],
     rows: &mut Vec<Row>,
 ) {
     let inner = mine.points.len().saturating_sub(2);
@@ -259,28 +265,46 @@ pub fn separation_rows(
         let p = mine.points[k] + (mine.points[k + 1] - mine.points[k]) * u;
         (k, u, p - other.position_at(t))
     };
-    let mut previous = f64::INFINITY;
-    let mut current = at(0);
-    for s in 0..=samples {
-        let next = if s < samples { Some(at(s + 1)) } else { None };
-        let (k, u, away) = current;
-        let distance = away.norm();
-        let following = next.map_or(f64::INFINITY, |n| n.2.norm());
-        let closest = distance <= previous && distance <= following;
-        if closest && distance <= limits.separation + reach && distance > 1e-9 {
-            let mut row = Row::new((limits.separation - distance) / limits.d_min);
-            let g = -away / (distance * limits.d_min);
-            row.add(k, inner, g * (1.0 - u));
-            row.add(k + 1, inner, g * u);
-            rows.push(row);
+    let mut unvisited = 0;
+    for &(from, to) in windows {
+        // A sample either side to spare: the window's edges are rounded to samples.
+        let first = ((from / step).floor().max(0.0) as usize)
+            .saturating_sub(1)
+            .max(unvisited);
+        let last = ((to / step).ceil().min(samples as f64) as usize + 1).min(samples);
+        if first > last {
+            continue;
         }
-        previous = distance;
-        match next {
-            Some(n) => current = n,
-            None => break,
+        unvisited = last + 1;
+        let mut previous = match first {
+            0 => f64::INFINITY,
+            s => at(s - 1).2.norm(),
+        };
+        let mut current = at(first);
+        for s in first..=last {
+            let next = if s < samples { Some(at(s + 1)) } else { None };
+            let (k, u, away) = current;
+            let distance = away.norm();
+            let following = next.map_or(f64::INFINITY, |n| n.2.norm());
+            let closest = distance <= previous && distance <= following;
+            if closest && distance <= limits.separation + reach && distance > 1e-9 {
+                let mut row = Row::new((limits.separation - distance) / limits.d_min);
+                let g = -away / (distance * limits.d_min);
+                row.add(k, inner, g * (1.0 - u));
+                row.add(k + 1, inner, g * u);
+                rows.push(row);
+            }
+            previous = distance;
+            match next {
+                Some(n) => current = n,
+                None => break,
+            }
         }
     }
 }
+
+/// The whole mission, as [`separation_rows`]' windows.
+pub const WHOLE_MISSION: [(f64, f64); 1] = [(0.0, f64::INFINITY)];
 
 /// The leg a trajectory is on at time `t` and the fraction of it done (the last leg, complete,
 /// after the arrival).

@@ -236,8 +236,8 @@ impl<'a, A: Arena> Search<'a, A> {
         let mine = self.arena.mine(&self.eval, i);
         let step = self.settings.sample_step_s;
         let others = self.arena.others(&self.eval, i);
-        for other in coming_near(mine, others, limits.separation + reach) {
-            constraints::separation_rows(mine, other, limits, step, reach, &mut rows);
+        for (other, windows) in coming_near(mine, others, limits.separation + reach) {
+            constraints::separation_rows(mine, other, limits, step, reach, &windows, &mut rows);
         }
         let latest = v.speed_max_mps * self.target;
         rows.extend(constraints::length_row(points, latest, 1.0));
@@ -250,14 +250,14 @@ impl<'a, A: Arena> Search<'a, A> {
 }
 
 /// The trajectories of `others` whose slab boxes ([`SlabBoxes`]) come within `reach` of
-/// `mine`'s at some instant: only those can come within `reach` of it, so only they can add a
-/// separation row (which sampling every one over the whole mission would find out far more
-/// slowly).
+/// `mine`'s at some instant, each with the time windows of the slabs where they do: only those
+/// can come within `reach` of it, and only then, so only they add a separation row (which
+/// sampling every one over the whole mission would find out far more slowly).
 fn coming_near<'e>(
     mine: &Trajectory,
     others: Vec<&'e Trajectory>,
     reach: f64,
-) -> impl Iterator<Item = &'e Trajectory> {
+) -> impl Iterator<Item = (&'e Trajectory, Vec<(f64, f64)>)> {
     let horizon = others
         .iter()
         .map(|t| t.arrival())
@@ -266,14 +266,20 @@ fn coming_near<'e>(
     own.reset(horizon);
     own.push(&mine.times, &mine.points);
     let whole = extent(&mine.points);
-    others.into_iter().filter(move |t| {
+    others.into_iter().filter_map(move |t| {
         // Whole trajectories apart prove every slab apart, for a box test instead of a slab pass.
         if !boxes_within(&whole, &extent(&t.points), reach) {
-            return false;
+            return None;
         }
         other_boxes.reset(horizon);
         other_boxes.push(&t.times, &t.points);
-        own.near_other(0, &other_boxes, 0, reach)
+        let slabs = own.near_slabs_other(0, &other_boxes, 0, reach);
+        if slabs == 0 {
+            return None;
+        }
+        let mut windows = Vec::new();
+        own.windows(slabs, &mut windows);
+        Some((t, windows))
     })
 }
 
@@ -305,20 +311,22 @@ mod tests {
             d_min: 50.0,
         };
         let reach = 60.0;
-        let kept: Vec<&Trajectory> = coming_near(
+        let kept: Vec<(&Trajectory, Vec<(f64, f64)>)> = coming_near(
             &mine,
             vec![&near, &parallel, &late],
             limits.separation + reach,
         )
         .collect();
-        assert_eq!(kept, vec![&near]);
+        assert_eq!(kept.len(), 1);
+        assert_eq!(kept[0].0, &near);
+        let whole = constraints::WHOLE_MISSION;
         for other in [&parallel, &late] {
             let mut rows = Vec::new();
-            constraints::separation_rows(&mine, other, &limits, 2.0, reach, &mut rows);
+            constraints::separation_rows(&mine, other, &limits, 2.0, reach, &whole, &mut rows);
             assert!(rows.is_empty());
         }
         let mut rows = Vec::new();
-        constraints::separation_rows(&mine, &near, &limits, 2.0, reach, &mut rows);
+        constraints::separation_rows(&mine, &near, &limits, 2.0, reach, &whole, &mut rows);
         assert!(!rows.is_empty());
     }
 }

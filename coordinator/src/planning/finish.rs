@@ -10,6 +10,7 @@
 
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
+use std::time::Instant;
 
 use shoal_common::cost::{FleetEvaluation, FleetModel};
 use shoal_common::refine::{merit, refine, target_arrival, RefineSettings, Refinement};
@@ -101,16 +102,26 @@ fn finish_one(
     stop: Option<&Arc<AtomicBool>>,
 ) -> Finished {
     let stopped = || stop.is_some_and(|s| s.load(Ordering::Relaxed));
+    let started = Instant::now();
     let touched = (o.touch_up && !stopped())
         .then(|| {
             let settings = TouchUpSettings::new(o.seed, o.velocity_cap(AMP_PSO_VELOCITY_CAP));
             touch_up(model, x, settings, stop)
         })
         .flatten();
+    tracing::debug!(
+        seconds = started.elapsed().as_secs_f64(),
+        "touch-up finished"
+    );
     let swarm_x = touched.as_ref().map_or(x, |t| &t.x);
+    let started = Instant::now();
     let refined = (o.refine && !stopped())
         .then(|| refine(model, swarm_x, &RefineSettings::default(), stop))
         .filter(shows);
+    tracing::debug!(
+        seconds = started.elapsed().as_secs_f64(),
+        "refinement finished"
+    );
     let evaluations = touched.as_ref().map_or(0, |t| t.evaluations)
         + refined.as_ref().map_or(0, |r| r.evaluations);
     Finished {

@@ -129,7 +129,15 @@ fn two_vehicles_crossing_8_m_apart_breach_a_10_m_separation_by_a_fifth() {
         points: vec![Vec3::new(5.0, 8.0, 0.0), Vec3::new(5.0, 8.0, 0.0)],
     };
     let mut rows = Vec::new();
-    separation_rows(&mine, &other, &limits(20.0, 35.0), 5.0, 0.0, &mut rows);
+    separation_rows(
+        &mine,
+        &other,
+        &limits(20.0, 35.0),
+        5.0,
+        0.0,
+        &WHOLE_MISSION,
+        &mut rows,
+    );
     // Samples at 0, 5, 10 s: only t = 5 s comes within 10 m (8 m: (10 − 8) / 10; the ends
     // are √(10² + 8²) = 12.8 m away).
     assert_eq!(rows.len(), 1);
@@ -237,4 +245,57 @@ fn a_leg_3_m_from_a_2_m_soft_sphere_is_half_a_radius_clear_and_one_inside_has_no
     soft_rows(&inside, &[sphere], 5.0, &mut rows);
     assert_eq!(rows.len(), 1);
     assert_abs_diff_eq!(rows[0].value, (2.0 - 10f64.sqrt()) / 2.0, epsilon = 1e-12);
+}
+
+/// A vehicle crossing a 1 km box in 2–5 straight legs at 0.5–2.5 m/s, from t = 0.
+fn crossing() -> impl proptest::strategy::Strategy<Value = Trajectory> {
+    use proptest::prelude::*;
+    prop::collection::vec(
+        ((0.0..1000.0f64, 0.0..1000.0f64, 0.0..300.0f64), 0.5..2.5f64),
+        3..7,
+    )
+    .prop_map(|samples| {
+        let (mut times, mut points) = (Vec::new(), Vec::<Vec3>::new());
+        let mut t = 0.0;
+        for ((x, y, z), speed) in samples {
+            let p = Vec3::new(x, y, z);
+            if let Some(q) = points.last() {
+                t += (p - q).norm() / speed;
+            }
+            times.push(t);
+            points.push(p);
+        }
+        Trajectory { times, points }
+    })
+}
+
+proptest::proptest! {
+    #![proptest_config(proptest::prelude::ProptestConfig::with_cases(200))]
+
+    /// Sampling only the windows of the slabs where the two vehicles' boxes come within
+    /// `separation + reach` finds the rows of a sweep over the whole mission, in the same
+    /// order, to the last bit.
+    #[test]
+    fn rows_within_the_near_windows_are_the_whole_missions(
+        mine in crossing(),
+        other in crossing(),
+        separation in 20.0..200.0f64,
+        reach in 0.0..100.0f64,
+        step in 0.5..20.0f64,
+    ) {
+        use crate::broad_phase::SlabBoxes;
+        let limits = Limits { separation, d_min: separation, ..limits(20.0, 35.0) };
+        let horizon = mine.arrival().max(other.arrival());
+        let (mut a, mut b) = (SlabBoxes::new(), SlabBoxes::new());
+        a.reset(horizon);
+        a.push(&mine.times, &mine.points);
+        b.reset(horizon);
+        b.push(&other.times, &other.points);
+        let mut windows = Vec::new();
+        a.windows(a.near_slabs_other(0, &b, 0, separation + reach), &mut windows);
+        let (mut near, mut whole) = (Vec::new(), Vec::new());
+        separation_rows(&mine, &other, &limits, step, reach, &windows, &mut near);
+        separation_rows(&mine, &other, &limits, step, reach, &WHOLE_MISSION, &mut whole);
+        proptest::prop_assert_eq!(near, whole);
+    }
 }
