@@ -20,10 +20,14 @@ fn line(t0: f64, from: [f64; 3], t1: f64, to: [f64; 3]) -> Trajectory {
     }
 }
 
+/// A horizon of 10 s slabs.
+const TEN_SECOND_SLABS: f64 = 10.0 * SLABS as f64;
+
 #[test]
 fn a_straight_run_has_one_box_per_slab_by_hand() {
-    // 1 m/s along x for 320 s: slab k (10 s) spans x = 10k … 10k + 10.
-    let b = boxes_of(320.0, &[line(0.0, [0., 5., 7.], 320.0, [320., 5., 7.])]);
+    // 1 m/s along x to the horizon: slab k (10 s) spans x = 10k … 10k + 10.
+    let h = TEN_SECOND_SLABS;
+    let b = boxes_of(h, &[line(0.0, [0., 5., 7.], h, [h, 5., 7.])]);
     assert_eq!(b.len(), 1);
     for k in 0..SLABS {
         assert_abs_diff_eq!(b.lo[k], Vec3::new(10.0 * k as f64, 5., 7.), epsilon = 1e-9);
@@ -37,12 +41,15 @@ fn a_straight_run_has_one_box_per_slab_by_hand() {
 
 #[test]
 fn a_vehicle_holds_before_its_first_and_after_its_last_sample() {
-    // Starts moving at 100 s and stops at 150 s, in a 320 s horizon of 10 s slabs.
-    let b = boxes_of(320.0, &[line(100.0, [0., 0., 0.], 150.0, [50., 0., 0.])]);
+    // Starts moving at 100 s and stops at 150 s, in a horizon of (at least 16) 10 s slabs.
+    let b = boxes_of(
+        TEN_SECOND_SLABS,
+        &[line(100.0, [0., 0., 0.], 150.0, [50., 0., 0.])],
+    );
     assert_abs_diff_eq!(b.hi[0], Vec3::zeros(), epsilon = 1e-12);
     assert_abs_diff_eq!(b.lo[12], Vec3::new(20., 0., 0.), epsilon = 1e-9);
     assert_abs_diff_eq!(b.hi[12], Vec3::new(30., 0., 0.), epsilon = 1e-9);
-    assert_abs_diff_eq!(b.lo[31], Vec3::new(50., 0., 0.), epsilon = 1e-12);
+    assert_abs_diff_eq!(b.lo[SLABS - 1], Vec3::new(50., 0., 0.), epsilon = 1e-12);
 }
 
 #[test]
@@ -61,7 +68,8 @@ fn parallel_tracks_are_near_only_within_their_spacing() {
 fn tracks_that_cross_at_different_times_are_pruned() {
     // A runs east along y = 0 at 1 m/s; B leaves (160, 0) at t = 0 northwards at 1 m/s. The
     // tracks cross at (160, 0), but A gets there 160 s after B left: the closest approach is
-    // 80·√2 = 113.1 m at t = 80 s, and the 10 s boxes come no closer than √(80² + 70²) = 106.3 m.
+    // 80·√2 = 113.1 m at t = 80 s, and the 10 s boxes come no closer than √(80² + 70²) = 106.3 m
+    // (the last slab's, from 150 s on, are 150 m apart).
     let fleet = [
         line(0.0, [0., 0., 0.], 320.0, [320., 0., 0.]),
         line(0.0, [160., 0., 0.], 320.0, [160., 320., 0.]),
@@ -71,7 +79,7 @@ fn tracks_that_cross_at_different_times_are_pruned() {
         80.0 * 2f64.sqrt(),
         epsilon = 1e-9
     );
-    let b = boxes_of(320.0, &fleet);
+    let b = boxes_of(TEN_SECOND_SLABS, &fleet);
     assert!(!b.near(0, 1, 50.0));
     assert!(!b.near(0, 1, 106.2));
     assert!(b.near(0, 1, 106.4));
@@ -95,13 +103,17 @@ fn pair_sets_iterate_in_row_order() {
 
 #[test]
 fn slab_masks_become_merged_windows_by_hand() {
-    // 32 slabs of 10 s: slabs 0–1, 5 and 30–31 give [0, 20), [50, 60) and [300, ∞).
-    let b = boxes_of(320.0, &[line(0.0, [0., 0., 0.], 320.0, [1., 0., 0.])]);
+    // Slabs of 10 s: slabs 0–1, 5 and the last two give [0, 20), [50, 60) and [h − 20, ∞).
+    let h = TEN_SECOND_SLABS;
+    let b = boxes_of(h, &[line(0.0, [0., 0., 0.], h, [1., 0., 0.])]);
     let mut w = Vec::new();
-    b.windows(0b11 | 1 << 5 | 0b11 << 30, &mut w);
-    assert_eq!(w, vec![(0.0, 20.0), (50.0, 60.0), (300.0, f64::INFINITY)]);
-    b.windows(1 << 31, &mut w);
-    assert_eq!(w, vec![(310.0, f64::INFINITY)]);
+    b.windows(0b11 | 1 << 5 | 0b11 << (SLABS - 2), &mut w);
+    assert_eq!(
+        w,
+        vec![(0.0, 20.0), (50.0, 60.0), (h - 20.0, f64::INFINITY)]
+    );
+    b.windows(1 << (SLABS - 1), &mut w);
+    assert_eq!(w, vec![(h - 10.0, f64::INFINITY)]);
     b.windows(!0, &mut w);
     assert_eq!(w, vec![(0.0, f64::INFINITY)]);
     b.windows(0, &mut w);
@@ -113,9 +125,9 @@ fn marked_pairs_keep_their_slabs() {
     let mut p = PairSet::new();
     p.reset(4);
     p.mark(2, 1, 3);
-    p.mark(1, 2, 31);
+    p.mark(1, 2, SLABS - 1);
     p.insert(0, 3);
-    assert_eq!(p.slabs(1, 2), 1 << 3 | 1 << 31);
+    assert_eq!(p.slabs(1, 2), 1 << 3 | 1 << (SLABS - 1));
     assert_eq!(p.slabs(0, 3), 0);
     assert_eq!(p.iter().collect::<Vec<_>>(), vec![(0, 3), (1, 2)]);
 }
