@@ -111,16 +111,16 @@ impl FleetModel {
     pub fn bent_waypoints(&self, i: usize, shape: &[Vec3], bend: Bend, x: &mut Vec<f64>) {
         let m = self.layout.waypoints;
         let v = &self.scenario.vehicles[i];
-        let (a, b) = (v.start(), v.goal());
+        let line = BentLine::new(v.start(), v.goal(), m, shape);
         let amp = match bend {
             Bend::Amplitude(amp) => amp,
             Bend::Covering(target) => {
-                bend_for_length(a, b, m, shape, target, 2.0 * self.straight[i].max(1.0))
+                bend_for_length(&line, target, 2.0 * self.straight[i].max(1.0))
             }
         };
         // The chromosome's own bounds: a crawler's z genes are pinned.
         let first = self.layout.chromosome(i).start;
-        for (j, p) in bent_curve(a, b, m, shape, amp)[1..=m].iter().enumerate() {
+        for (j, p) in line.curve(amp)[1..=m].iter().enumerate() {
             for d in 0..3 {
                 let g = first + 3 * j + d;
                 x.push(p[d].clamp(self.lower[g], self.upper[g]));
@@ -139,12 +139,6 @@ pub enum Bend {
     Covering(f64),
 }
 
-/// The straight line `a→b` at `m + 2` stations (ends included) bent by `amp · Σ shape_k sin(kπf)`,
-/// with depth following the horizontal distance travelled, so the climb is spread evenly.
-fn bent_curve(a: Vec3, b: Vec3, m: usize, shape: &[Vec3], amp: f64) -> Vec<Vec3> {
-    BentLine::new(a, b, m, shape).curve(amp)
-}
-
 /// Cumulative horizontal distance along `pts`.
 fn horizontal_progress(pts: &[Vec3]) -> Vec<f64> {
     let mut along = vec![0.0; pts.len()];
@@ -155,9 +149,10 @@ fn horizontal_progress(pts: &[Vec3]) -> Vec<f64> {
     along
 }
 
-/// The straight line `a→b` at its stations with the sines of its bend at each, computed once
-/// for the many amplitudes a bisection tries (the sines cost more than the rest of a curve).
-/// Every amplitude's points come out to the last bit as a curve computed afresh.
+/// The straight line `a→b` at `m + 2` stations (ends included), to be bent by
+/// `amp · Σ shape_k sin(kπf)` with depth following the horizontal distance travelled, so the
+/// climb is spread evenly. The stations' sines are computed once for the many amplitudes a
+/// bisection tries (they cost more than the rest of a curve).
 struct BentLine<'s> {
     a: Vec3,
     b: Vec3,
@@ -228,8 +223,7 @@ impl<'s> BentLine<'s> {
 
 /// The bend amplitude (in `[0, max_amp]`) whose curve covers `target` metres horizontally, by
 /// bisection (the length grows with the amplitude); `max_amp` if even that falls short.
-fn bend_for_length(a: Vec3, b: Vec3, m: usize, shape: &[Vec3], target: f64, max_amp: f64) -> f64 {
-    let line = BentLine::new(a, b, m, shape);
+fn bend_for_length(line: &BentLine, target: f64, max_amp: f64) -> f64 {
     let length = |amp: f64| line.horizontal_length(amp);
     if length(max_amp) <= target {
         return max_amp;
@@ -291,8 +285,9 @@ mod tests {
             Vec3::new(-0.2, 0.4, 0.0),
             Vec3::zeros(),
         ];
-        let amp = bend_for_length(a, b, 30, &shape, 1700.0, 5000.0);
-        let pts = bent_curve(a, b, 30, &shape, amp);
+        let line = BentLine::new(a, b, 30, &shape);
+        let amp = bend_for_length(&line, 1700.0, 5000.0);
+        let pts = line.curve(amp);
         let along = horizontal_progress(&pts);
         assert!((along[31] - 1700.0).abs() < 1e-3, "{}", along[31]);
         // Depth follows horizontal progress: every leg climbs at atan(600 / 1700) = 19.4°.

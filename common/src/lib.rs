@@ -26,6 +26,8 @@ pub mod refine;
 pub mod scenario;
 pub mod separation;
 pub mod stats;
+#[cfg(test)]
+mod strategies;
 pub mod swarm;
 pub mod terrain;
 pub mod touch_up;

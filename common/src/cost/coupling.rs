@@ -301,6 +301,7 @@ fn all_pair_terms_into(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::strategies::crossing;
     use proptest::prelude::*;
 
     fn pair_terms(fleet: &[Trajectory], d_min: f64) -> Vec<PairTerms> {
@@ -315,30 +316,6 @@ mod tests {
         velocities.reset(fleet.len());
         all_pair_terms_into(fleet, d_min, &mut velocities, &mut out);
         out
-    }
-
-    /// A vehicle crossing a 1 km box in 2–5 straight legs at 0.5–2.5 m/s, from t = 0.
-    fn crossing() -> impl Strategy<Value = Trajectory> {
-        prop::collection::vec(
-            ((0.0..1000.0f64, 0.0..1000.0f64, 0.0..300.0f64), 0.5..2.5f64),
-            3..7,
-        )
-        .prop_map(|samples| {
-            let mut t = 0.0;
-            let mut out = Trajectory {
-                times: Vec::new(),
-                points: Vec::new(),
-            };
-            for ((x, y, z), speed) in samples {
-                let p = Vec3::new(x, y, z);
-                if let Some(q) = out.points.last() {
-                    t += (p - q).norm() / speed;
-                }
-                out.times.push(t);
-                out.points.push(p);
-            }
-            out
-        })
     }
 
     proptest! {

@@ -1,4 +1,5 @@
 use super::*;
+use crate::strategies::crossing;
 use approx::assert_abs_diff_eq;
 
 fn limits(pitch_deg: f64, turn_deg: f64) -> Limits {
@@ -245,28 +246,6 @@ fn a_leg_3_m_from_a_2_m_soft_sphere_is_half_a_radius_clear_and_one_inside_has_no
     soft_rows(&inside, &[sphere], 5.0, &mut rows);
     assert_eq!(rows.len(), 1);
     assert_abs_diff_eq!(rows[0].value, (2.0 - 10f64.sqrt()) / 2.0, epsilon = 1e-12);
-}
-
-/// A vehicle crossing a 1 km box in 2–5 straight legs at 0.5–2.5 m/s, from t = 0.
-fn crossing() -> impl proptest::strategy::Strategy<Value = Trajectory> {
-    use proptest::prelude::*;
-    prop::collection::vec(
-        ((0.0..1000.0f64, 0.0..1000.0f64, 0.0..300.0f64), 0.5..2.5f64),
-        3..7,
-    )
-    .prop_map(|samples| {
-        let (mut times, mut points) = (Vec::new(), Vec::<Vec3>::new());
-        let mut t = 0.0;
-        for ((x, y, z), speed) in samples {
-            let p = Vec3::new(x, y, z);
-            if let Some(q) = points.last() {
-                t += (p - q).norm() / speed;
-            }
-            times.push(t);
-            points.push(p);
-        }
-        Trajectory { times, points }
-    })
 }
 
 proptest::proptest! {
