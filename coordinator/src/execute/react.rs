@@ -5,9 +5,7 @@
 //! not safe becomes a hold, retried until one is. Every decision is an event, logged and
 //! published.
 //!
-//! Who gives way in a predicted conflict: a vehicle that can (not lost, holding or arrived);
-//! between two that can, the later one in scenario order — a fixed priority, so two
-//! coordinators' decisions never chase each other.
+//! Who gives way in a predicted conflict: see [`super::fleet::Fleet::gives_way`].
 
 use std::time::{Duration, Instant};
 
@@ -391,7 +389,10 @@ pub(super) fn check(x: &mut Exec, now: f64) {
             continue;
         }
         if v.holding {
-            replan_queue::request(x, i, "retrying after a hold", None);
+            // Retried from where it stands once it says it holds (or failed to answer).
+            if !v.awaiting_hold_answer(o.lost_after) {
+                replan_queue::request(x, i, "retrying after a hold", None);
+            }
             continue;
         }
         if let Some(p) = v.progress {
@@ -405,15 +406,7 @@ pub(super) fn check(x: &mut Exec, now: f64) {
         }
     }
     for c in x.fleet.conflicts_over(now, conflict_horizon_s(o)) {
-        let can = |i: usize| {
-            let v = &x.fleet.vehicles[i];
-            !v.lost && !v.holding && v.arrived_s.is_none() && v.fault_s.is_none()
-        };
-        let who = if can(c.b) {
-            c.b
-        } else if can(c.a) {
-            c.a
-        } else {
+        let Some(who) = x.fleet.gives_way(&c, o.lost_after) else {
             continue;
         };
         if x.queue.busy(who) || x.last_reaction[who].is_some_and(|t| t.elapsed() < COOL_DOWN) {

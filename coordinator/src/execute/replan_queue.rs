@@ -177,11 +177,16 @@ fn start(x: &mut Exec, w: Waiting) {
     let now = x.clock();
     let budget = budget(x, i);
     let t0 = now + update_lead_s(budget, o.time_scale);
-    if !holding {
+    if !v.hold_confirmed() {
         if let Some(detail) = course_blocked(x, i, t0) {
             x.last_reaction[i] = Some(Instant::now());
-            let when = format!("before an update could take effect at t = {t0:.0} s");
-            hold(x, i, &w.why, format!("{detail} {when}"));
+            // A hold not confirmed (refused, or unanswered for long) leaves the vehicle on
+            // its course: a retry would follow it through the conflict to t0. It waits, and
+            // the other vehicle gives way (`Fleet::gives_way`).
+            if !holding {
+                let when = format!("before an update could take effect at t = {t0:.0} s");
+                hold(x, i, &w.why, format!("{detail} {when}"));
+            }
             return;
         }
     }
@@ -299,6 +304,7 @@ fn apply(x: &mut Exec, u: UnderWay, result: Replanned) {
         v.revision = x.revision;
         v.holding = false;
         v.held_since_s = None;
+        v.held_at = None;
         x.send(
             &id,
             CoordinatorToAgent::Update {
@@ -377,6 +383,7 @@ fn hold(x: &mut Exec, i: usize, why: &str, detail: String) {
     let now = x.clock();
     x.fleet.vehicles[i].holding = true;
     x.fleet.vehicles[i].held_since_s = Some(now);
+    x.fleet.vehicles[i].held_at = Some(Instant::now());
     x.holds += 1;
     x.event(
         EVENT_HOLD,

@@ -1,10 +1,10 @@
 //! One vehicle as the coordinator sees it during an execution: its plan, its latest report and
 //! where that puts it on the plan, and where it stands when it is told to hold.
 
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 use shoal_common::execution::picture::{self, Progress};
-use shoal_common::execution::VehicleStatus;
+use shoal_common::execution::{CommandState, VehicleCommand, VehicleStatus};
 use shoal_common::geometry::Vec3;
 use shoal_common::trajectory::Trajectory;
 use shoal_common::wire::open::Telemetry;
@@ -60,6 +60,8 @@ pub struct Tracked {
     pub holding: bool,
     /// When the hold was commanded, mission seconds (`None` unless holding).
     pub held_since_s: Option<f64>,
+    /// When the hold was commanded, wall time: how long its answer has been awaited.
+    pub held_at: Option<Instant>,
     /// Since when its link reports a fault (its latest report does), mission seconds: it is
     /// not driven any more, so it is neither re-planned nor waited for.
     pub fault_s: Option<f64>,
@@ -76,6 +78,24 @@ impl Tracked {
                 .last
                 .as_ref()
                 .is_some_and(|t| still.contains(&t.state.status))
+    }
+
+    /// Whether it was told to hold less than `patience` ago and has not answered yet: no
+    /// report says it holds, nor that the hold failed. Until it answers it is predicted to
+    /// keep going, but the conflict it was held for is its hold's to settle.
+    pub fn awaiting_hold_answer(&self, patience: Duration) -> bool {
+        let refused = self
+            .last
+            .as_ref()
+            .and_then(|t| t.command.as_ref())
+            .is_some_and(|c| {
+                c.command == VehicleCommand::Hold
+                    && matches!(c.state, CommandState::Failed | CommandState::GaveUp)
+            });
+        self.holding
+            && !self.hold_confirmed()
+            && !refused
+            && self.held_at.is_some_and(|t| t.elapsed() < patience)
     }
 
     /// Where on its plan a holding vehicle stopped, as a plan time: the nearest point of the

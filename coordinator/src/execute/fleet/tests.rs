@@ -531,3 +531,63 @@ fn a_hold_counts_in_the_prediction_only_once_the_vehicle_confirms_it() {
         ahead(&f)
     );
 }
+
+/// The later vehicle gives way; one just told to hold settles the conflict unless it refuses,
+/// does not answer in time, or stands where the other must go round it.
+#[test]
+fn a_conflict_waits_for_a_held_vehicles_answer_before_the_other_gives_way() {
+    use shoal_common::execution::{CommandReport, CommandState, VehicleCommand};
+    let ids = vec!["a".to_string(), "b".to_string()];
+    let mut f = Fleet::new(&ids, &[straight(0.0), straight(10.0)], 50.0, 60.0);
+    let c = Conflict {
+        a: 0,
+        b: 1,
+        min_distance_m: 10.0,
+        at_s: 50.0,
+    };
+    let patience = Duration::from_secs(3);
+    // Neither has reported: an order sent now may reach no agent.
+    assert_eq!(f.gives_way(&c, patience), None);
+    f.report(
+        report("a", 0, 1.0, [1.0, 0.0, 0.0], VehicleStatus::Underway),
+        1,
+    );
+    assert_eq!(f.gives_way(&c, patience), None);
+    let mut r = report("b", 0, 1.0, [1.0, 10.0, 0.0], VehicleStatus::Underway);
+    f.report(r.clone(), 1);
+    assert_eq!(f.gives_way(&c, patience), Some(1));
+    f.vehicles[1].holding = true;
+    f.vehicles[1].held_since_s = Some(10.0);
+    f.vehicles[1].held_at = Some(Instant::now());
+    // Told, no answer yet: nobody else is told anything.
+    assert_eq!(f.gives_way(&c, patience), None);
+    // No answer within the patience: the other gives way.
+    assert_eq!(f.gives_way(&c, Duration::ZERO), Some(0));
+    // A report under way with the hold pending is no answer.
+    r.seq = 1;
+    r.state.t_s = 11.0;
+    let hold = |state| CommandReport {
+        command: VehicleCommand::Hold,
+        state,
+        detail: String::new(),
+        given_s: 10.0,
+    };
+    r.command = Some(hold(CommandState::Pending));
+    f.report(r.clone(), 2);
+    assert_eq!(f.gives_way(&c, patience), None);
+    // Refused: the other gives way at once.
+    r.seq = 2;
+    r.command = Some(hold(CommandState::GaveUp));
+    f.report(r.clone(), 3);
+    assert_eq!(f.gives_way(&c, patience), Some(0));
+    // Confirmed and still in the way: the other goes round where it stands.
+    r.seq = 3;
+    r.state.status = VehicleStatus::Holding;
+    r.command = Some(hold(CommandState::Confirmed));
+    f.report(r, 4);
+    assert!(f.vehicles[1].hold_confirmed());
+    assert_eq!(f.gives_way(&c, patience), Some(0));
+    // Neither can: lost and holding.
+    f.vehicles[0].lost = true;
+    assert_eq!(f.gives_way(&c, patience), None);
+}
