@@ -259,26 +259,31 @@ impl Fleet {
         picture::predicted_conflicts(&self.predictions_over(now, horizon_s), self.d_min)
     }
 
-    /// Which vehicle of conflict `c` gives way: one that can (not lost, holding, arrived or
-    /// faulted); of two that can, the later in scenario order, a fixed priority so two
-    /// coordinators' decisions never chase each other. `None` when neither can, or while the
-    /// answer of one of them is awaited:
-    /// - it has not reported yet: its agent may not have its order, and a command sent now
-    ///   is lost (a hold sent before the agents joined was, and the two met 1.8 m apart);
-    /// - it was told to hold less than `patience` ago and has not confirmed or refused: its
-    ///   hold settles the conflict, and the other would be told to leave a course the held
-    ///   one is already leaving (both held, when the answer came late).
-    pub fn gives_way(&self, c: &Conflict, patience: Duration) -> Option<usize> {
+    /// Which vehicle of conflict `c` gives way: one that can (it has reported, and is not
+    /// lost, holding, arrived or faulted); of two that can, the later in scenario order, a
+    /// fixed priority so two coordinators' decisions never chase each other. `None` when
+    /// neither can, or while the answer of one of them is awaited:
+    /// - while `starting`, one has not reported yet: its agent may not have its order, and a
+    ///   command sent now is lost (a hold sent before the agents joined was, and the two met
+    ///   1.8 m apart);
+    /// - it was told to hold less than `patience` ago and has neither confirmed nor given it
+    ///   up: its hold settles the conflict, and the other would be told to leave a course the
+    ///   held one is already leaving (both held, when the answer came late).
+    pub fn gives_way(&self, c: &Conflict, patience: Duration, starting: bool) -> Option<usize> {
         let awaited = |i: usize| {
             let v = &self.vehicles[i];
-            (v.last.is_none() && !v.lost) || v.awaiting_hold_answer(patience)
+            (starting && v.last.is_none() && !v.lost) || v.awaiting_hold_answer(patience)
         };
         if awaited(c.a) || awaited(c.b) {
             return None;
         }
         let can = |i: usize| {
             let v = &self.vehicles[i];
-            !v.lost && !v.holding && v.arrived_s.is_none() && v.fault_s.is_none()
+            v.last.is_some()
+                && !v.lost
+                && !v.holding
+                && v.arrived_s.is_none()
+                && v.fault_s.is_none()
         };
         [c.b, c.a].into_iter().find(|&i| can(i))
     }

@@ -29,6 +29,21 @@ pub(super) fn conflict_horizon_s(o: &super::state::ExecOptions) -> f64 {
 /// Wall time an update is given, over the replan budget, to reach the vehicle.
 const UPDATE_MARGIN: Duration = Duration::from_millis(250);
 
+/// How long a vehicle's answer to a hold is waited for before the other vehicle of its
+/// conflict gives way: two report periods and the delivery margin (1.25 s at 2 Hz). The agent
+/// reports at once after giving the hold, so a hold that reached it is answered (held, or
+/// pending while its link tries) within a report or two; a longer wait, at 500×, let a lost
+/// hold's conflict come before anyone else was told.
+pub(super) fn hold_answer_patience(telemetry_hz: f64) -> Duration {
+    let hz = if telemetry_hz.is_nan() {
+        0.01
+    } else {
+        telemetry_hz.clamp(0.01, 100.0)
+    };
+    let period = Duration::from_secs_f64(1.0 / hz);
+    period * 2 + UPDATE_MARGIN
+}
+
 /// Mission seconds between two retries of a held vehicle's replan: the others move 15–90 m in
 /// that time at 0.5–3 m/s, enough for a way to open, and a real vehicle stands no longer.
 pub(super) const HOLD_RETRY_S: f64 = 30.0;
@@ -98,6 +113,18 @@ mod tests {
         assert_eq!(hold_retry_after(10.0, Duration::ZERO, two), two);
         // 100×: 300 ms.
         assert_eq!(hold_retry_after(100.0, Duration::ZERO, two), ms(300));
+    }
+
+    #[test]
+    fn a_hold_is_answered_within_two_reports_and_the_delivery_margin() {
+        assert_eq!(hold_answer_patience(2.0), Duration::from_millis(1250));
+        assert_eq!(hold_answer_patience(10.0), Duration::from_millis(450));
+        // A rate out of bounds is clamped, never a panic.
+        assert_eq!(hold_answer_patience(0.0), Duration::from_millis(200_250));
+        assert_eq!(
+            hold_answer_patience(f64::NAN),
+            Duration::from_millis(200_250)
+        );
     }
 
     #[test]

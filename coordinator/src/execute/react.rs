@@ -18,7 +18,7 @@ use shoal_common::wire::open::{FleetStatus, Telemetry, OPEN_VERSION};
 use shoal_common::wire::topics;
 
 use super::confirmations;
-use super::lead::{conflict_horizon_s, hold_retry_after};
+use super::lead::{conflict_horizon_s, hold_answer_patience, hold_retry_after};
 use super::log::{Record, EVENT_FAULT, EVENT_IMPLAUSIBLE, EVENT_LOST, EVENT_OBSTACLE_DROPPED};
 use super::plausible::{self, FixLimits, LastFix, Reason};
 use super::replan_queue;
@@ -390,7 +390,7 @@ pub(super) fn check(x: &mut Exec, now: f64) {
         }
         if v.holding {
             // Retried from where it stands once it says it holds (or failed to answer).
-            if !v.awaiting_hold_answer(o.lost_after) {
+            if !v.awaiting_hold_answer(hold_answer_patience(o.telemetry_hz)) {
                 replan_queue::request(x, i, "retrying after a hold", None);
             }
             continue;
@@ -406,7 +406,9 @@ pub(super) fn check(x: &mut Exec, now: f64) {
         }
     }
     for c in x.fleet.conflicts_over(now, conflict_horizon_s(o)) {
-        let Some(who) = x.fleet.gives_way(&c, o.lost_after) else {
+        let patience = hold_answer_patience(o.telemetry_hz);
+        let starting = x.mission_clock.since_epoch() < o.lost_after;
+        let Some(who) = x.fleet.gives_way(&c, patience, starting) else {
             continue;
         };
         if x.queue.busy(who) || x.last_reaction[who].is_some_and(|t| t.elapsed() < COOL_DOWN) {

@@ -180,13 +180,16 @@ fn start(x: &mut Exec, w: Waiting) {
     if !v.hold_confirmed() {
         if let Some(detail) = course_blocked(x, i, t0) {
             x.last_reaction[i] = Some(Instant::now());
-            // A hold not confirmed (refused, or unanswered for long) leaves the vehicle on
-            // its course: a retry would follow it through the conflict to t0. It waits, and
-            // the other vehicle gives way (`Fleet::gives_way`).
-            if !holding {
-                let when = format!("before an update could take effect at t = {t0:.0} s");
-                hold(x, i, &w.why, format!("{detail} {when}"));
-            }
+            // Told to hold and not holding (the hold was lost, given up, or not yet
+            // answered): a retry would follow its course through the conflict to t0, so it is
+            // told again, and the other vehicle meanwhile gives way (`Fleet::gives_way`).
+            let when = format!("before an update could take effect at t = {t0:.0} s");
+            let again = if holding {
+                "its hold is not confirmed and "
+            } else {
+                ""
+            };
+            hold(x, i, &w.why, format!("{again}{detail} {when}"));
             return;
         }
     }

@@ -20,6 +20,10 @@ pub(super) const CONVERGE_S: f64 = 60.0;
 /// 1000×) and under half the 10 m between coverage rows.
 pub(super) const MATCH_SLACK_M: f64 = 5.0;
 
+/// How far an agent's mission clock may lag the coordinator's, mission seconds: a command's
+/// `given_s` (the agent's clock) is compared with when it was sent (the coordinator's).
+pub(super) const CLOCK_SKEW_S: f64 = 1.0;
+
 /// One vehicle as the coordinator sees it.
 #[derive(Debug, Clone)]
 pub struct Tracked {
@@ -81,21 +85,31 @@ impl Tracked {
     }
 
     /// Whether it was told to hold less than `patience` ago and has not answered yet: no
-    /// report says it holds, nor that the hold failed. Until it answers it is predicted to
-    /// keep going, but the conflict it was held for is its hold's to settle.
+    /// report says it holds, nor that its link gave the hold up (`Failed` is not an answer:
+    /// a fallback is under way). Until it answers it is predicted to keep going, but the
+    /// conflict it was held for is its hold's to settle.
     pub fn awaiting_hold_answer(&self, patience: Duration) -> bool {
-        let refused = self
-            .last
+        self.holding
+            && !self.hold_confirmed()
+            && !self.hold_refused()
+            && self.held_at.is_some_and(|t| t.elapsed() < patience)
+    }
+
+    /// Whether its latest report says its link gave up the hold it was last told (a refusal
+    /// of an earlier hold does not count: the hold it reports was given at or after this one
+    /// was sent, within [`CLOCK_SKEW_S`]).
+    pub fn hold_refused(&self) -> bool {
+        let Some(since) = self.held_since_s.filter(|_| self.holding) else {
+            return false;
+        };
+        self.last
             .as_ref()
             .and_then(|t| t.command.as_ref())
             .is_some_and(|c| {
                 c.command == VehicleCommand::Hold
-                    && matches!(c.state, CommandState::Failed | CommandState::GaveUp)
-            });
-        self.holding
-            && !self.hold_confirmed()
-            && !refused
-            && self.held_at.is_some_and(|t| t.elapsed() < patience)
+                    && c.state == CommandState::GaveUp
+                    && c.given_s >= since - CLOCK_SKEW_S
+            })
     }
 
     /// Where on its plan a holding vehicle stopped, as a plan time: the nearest point of the

@@ -532,8 +532,8 @@ fn a_hold_counts_in_the_prediction_only_once_the_vehicle_confirms_it() {
     );
 }
 
-/// The later vehicle gives way; one just told to hold settles the conflict unless it refuses,
-/// does not answer in time, or stands where the other must go round it.
+/// The later vehicle gives way; one just told to hold settles the conflict unless it gives the
+/// hold up, does not answer in time, or stands where the other must go round it.
 #[test]
 fn a_conflict_waits_for_a_held_vehicles_answer_before_the_other_gives_way() {
     use shoal_common::execution::{CommandReport, CommandState, VehicleCommand};
@@ -546,48 +546,59 @@ fn a_conflict_waits_for_a_held_vehicles_answer_before_the_other_gives_way() {
         at_s: 50.0,
     };
     let patience = Duration::from_secs(3);
-    // Neither has reported: an order sent now may reach no agent.
-    assert_eq!(f.gives_way(&c, patience), None);
+    // Neither has reported: at the start an order sent now may reach no agent; later, one
+    // that never reported cannot be commanded.
+    assert_eq!(f.gives_way(&c, patience, true), None);
+    assert_eq!(f.gives_way(&c, patience, false), None);
     f.report(
         report("a", 0, 1.0, [1.0, 0.0, 0.0], VehicleStatus::Underway),
         1,
     );
-    assert_eq!(f.gives_way(&c, patience), None);
+    assert_eq!(f.gives_way(&c, patience, true), None);
+    assert_eq!(f.gives_way(&c, patience, false), Some(0));
     let mut r = report("b", 0, 1.0, [1.0, 10.0, 0.0], VehicleStatus::Underway);
     f.report(r.clone(), 1);
-    assert_eq!(f.gives_way(&c, patience), Some(1));
+    assert_eq!(f.gives_way(&c, patience, true), Some(1));
     f.vehicles[1].holding = true;
     f.vehicles[1].held_since_s = Some(10.0);
     f.vehicles[1].held_at = Some(Instant::now());
     // Told, no answer yet: nobody else is told anything.
-    assert_eq!(f.gives_way(&c, patience), None);
+    assert_eq!(f.gives_way(&c, patience, false), None);
     // No answer within the patience: the other gives way.
-    assert_eq!(f.gives_way(&c, Duration::ZERO), Some(0));
-    // A report under way with the hold pending is no answer.
-    r.seq = 1;
-    r.state.t_s = 11.0;
-    let hold = |state| CommandReport {
+    assert_eq!(f.gives_way(&c, Duration::ZERO, false), Some(0));
+    let hold = |state, given_s| CommandReport {
         command: VehicleCommand::Hold,
         state,
         detail: String::new(),
-        given_s: 10.0,
+        given_s,
     };
-    r.command = Some(hold(CommandState::Pending));
-    f.report(r.clone(), 2);
-    assert_eq!(f.gives_way(&c, patience), None);
-    // Refused: the other gives way at once.
-    r.seq = 2;
-    r.command = Some(hold(CommandState::GaveUp));
-    f.report(r.clone(), 3);
-    assert_eq!(f.gives_way(&c, patience), Some(0));
+    let mut answer = |f: &mut Fleet, seq: u64, command: CommandReport| {
+        if command.state == CommandState::Confirmed {
+            r.state.status = VehicleStatus::Holding;
+        }
+        r.seq = seq;
+        r.state.t_s = 10.0 + seq as f64;
+        r.command = Some(command);
+        f.report(r.clone(), seq + 1);
+    };
+    // Pending, and failed with a fallback under way: no answer yet.
+    answer(&mut f, 1, hold(CommandState::Pending, 10.0));
+    assert_eq!(f.gives_way(&c, patience, false), None);
+    answer(&mut f, 2, hold(CommandState::Failed, 10.0));
+    assert_eq!(f.gives_way(&c, patience, false), None);
+    // An earlier hold given up is no answer to this one.
+    answer(&mut f, 3, hold(CommandState::GaveUp, 4.0));
+    assert!(!f.vehicles[1].hold_refused());
+    assert_eq!(f.gives_way(&c, patience, false), None);
+    // This one given up (its clock a little behind): the other gives way at once.
+    answer(&mut f, 4, hold(CommandState::GaveUp, 9.5));
+    assert!(f.vehicles[1].hold_refused());
+    assert_eq!(f.gives_way(&c, patience, false), Some(0));
     // Confirmed and still in the way: the other goes round where it stands.
-    r.seq = 3;
-    r.state.status = VehicleStatus::Holding;
-    r.command = Some(hold(CommandState::Confirmed));
-    f.report(r, 4);
+    answer(&mut f, 5, hold(CommandState::Confirmed, 10.0));
     assert!(f.vehicles[1].hold_confirmed());
-    assert_eq!(f.gives_way(&c, patience), Some(0));
+    assert_eq!(f.gives_way(&c, patience, false), Some(0));
     // Neither can: lost and holding.
     f.vehicles[0].lost = true;
-    assert_eq!(f.gives_way(&c, patience), None);
+    assert_eq!(f.gives_way(&c, patience, false), None);
 }
