@@ -97,7 +97,7 @@ impl Tracked {
 
     /// Whether its latest report says its link gave up the hold it was last told (a refusal
     /// of an earlier hold does not count: the hold it reports was given at or after this one
-    /// was sent, within [`CLOCK_SKEW_S`]).
+    /// was sent, within `CLOCK_SKEW_S`).
     pub fn hold_refused(&self) -> bool {
         let Some(since) = self.held_since_s.filter(|_| self.holding) else {
             return false;
