@@ -533,4 +533,6 @@ pub struct ExecutionFigures {
 }
 
 #[cfg(test)]
+mod hold_tests;
+#[cfg(test)]
 mod tests;
