@@ -279,11 +279,7 @@ impl Fleet {
         }
         let can = |i: usize| {
             let v = &self.vehicles[i];
-            v.last.is_some()
-                && !v.lost
-                && !v.holding
-                && v.arrived_s.is_none()
-                && v.fault_s.is_none()
+            v.last.is_some() && v.driven() && !v.holding
         };
         [c.b, c.a].into_iter().find(|&i| can(i))
     }

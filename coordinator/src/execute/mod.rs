@@ -340,11 +340,7 @@ fn run_loop(
             }
             x.log.flush();
         }
-        let done = x
-            .fleet
-            .vehicles
-            .iter()
-            .all(|v| v.lost || v.arrived_s.is_some() || v.fault_s.is_some());
+        let done = x.fleet.vehicles.iter().all(|v| !v.driven());
         if done {
             return "every vehicle arrived, is lost or reports a fault".into();
         }

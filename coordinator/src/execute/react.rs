@@ -361,6 +361,7 @@ pub(super) fn lose(x: &mut Exec, id: &str, why: &str) {
 /// The periodic checks (see the module doc).
 pub(super) fn check(x: &mut Exec, now: f64) {
     let o = x.options;
+    let patience = hold_answer_patience(o.telemetry_hz);
     for i in 0..x.fleet.vehicles.len() {
         let v = &x.fleet.vehicles[i];
         let silent = match v.heard {
@@ -378,7 +379,7 @@ pub(super) fn check(x: &mut Exec, now: f64) {
     }
     for i in 0..x.fleet.vehicles.len() {
         let v = &x.fleet.vehicles[i];
-        let active = !v.lost && v.arrived_s.is_none() && v.fault_s.is_none();
+        let active = v.driven();
         let wait = if v.holding {
             hold_retry_after(o.time_scale, x.last_attempt[i], COOL_DOWN)
         } else {
@@ -390,7 +391,7 @@ pub(super) fn check(x: &mut Exec, now: f64) {
         }
         if v.holding {
             // Retried from where it stands once it says it holds (or failed to answer).
-            if !v.awaiting_hold_answer(hold_answer_patience(o.telemetry_hz)) {
+            if !v.awaiting_hold_answer(patience) {
                 replan_queue::request(x, i, "retrying after a hold", None);
             }
             continue;
@@ -405,9 +406,8 @@ pub(super) fn check(x: &mut Exec, now: f64) {
             }
         }
     }
+    let starting = x.mission_clock.since_epoch() < o.lost_after;
     for c in x.fleet.conflicts_over(now, conflict_horizon_s(o)) {
-        let patience = hold_answer_patience(o.telemetry_hz);
-        let starting = x.mission_clock.since_epoch() < o.lost_after;
         let Some(who) = x.fleet.gives_way(&c, patience, starting) else {
             continue;
         };

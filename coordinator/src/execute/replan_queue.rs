@@ -170,7 +170,7 @@ fn start(x: &mut Exec, w: Waiting) {
     let i = w.vehicle;
     let o = x.options;
     let v = &x.fleet.vehicles[i];
-    if v.lost || v.arrived_s.is_some() || v.fault_s.is_some() {
+    if !v.driven() {
         return;
     }
     let holding = v.holding;
@@ -266,7 +266,7 @@ fn apply(x: &mut Exec, u: UnderWay, result: Replanned) {
     x.last_attempt[i] = result.elapsed;
     let v = &x.fleet.vehicles[i];
     let id = v.id.clone();
-    if v.lost || v.arrived_s.is_some() || v.fault_s.is_some() || v.holding != u.was_holding {
+    if !v.driven() || v.holding != u.was_holding {
         tracing::info!(
             "{id}'s replan ({}) is dropped: the vehicle's state changed while it ran",
             u.asked.why

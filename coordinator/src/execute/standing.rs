@@ -84,7 +84,7 @@ pub(super) fn check(x: &mut Exec, now: f64) {
         let at = x.fleet.vehicles[j].standing();
         for i in 0..n {
             let v = &x.fleet.vehicles[i];
-            let under_way = !v.lost && !v.holding && v.arrived_s.is_none() && v.fault_s.is_none();
+            let under_way = v.driven() && !v.holding;
             // One under replan now is looked at again once its update is in.
             let busy = x.queue.busy(i);
             if i == j || !under_way || busy || x.rounded.contains(&(i, j)) {

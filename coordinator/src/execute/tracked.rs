@@ -84,6 +84,12 @@ impl Tracked {
                 .is_some_and(|t| still.contains(&t.state.status))
     }
 
+    /// Whether it is still driven: neither lost, arrived nor faulted (a vehicle that is not is
+    /// neither re-planned nor waited for).
+    pub fn driven(&self) -> bool {
+        !self.lost && self.arrived_s.is_none() && self.fault_s.is_none()
+    }
+
     /// Whether it was told to hold less than `patience` ago and has not answered yet: no
     /// report says it holds, nor that its link gave the hold up (`Failed` is not an answer:
     /// a fallback is under way). Until it answers it is predicted to keep going, but the
