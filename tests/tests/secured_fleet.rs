@@ -15,6 +15,10 @@ use std::time::{Duration, Instant};
 use common::fleet::{free_port, Fleet};
 use common::process::{coordinator, root};
 use common::{interop_python, scenario, without_shoal_env, TestResult};
+use shoal_agent::network::coordinator_present;
+use shoal_common::wire::security::Security;
+use shoal_common::wire::{session, topics};
+use zenoh::Wait;
 
 fn deadline(s: u64) -> Instant {
     Instant::now() + Duration::from_secs(s)
@@ -141,6 +145,45 @@ fn an_operator_submits_to_a_secured_serve_and_a_vehicle_cannot() -> TestResult {
     assert_eq!(s.code(), Some(0), "{}", s.stderr);
     let report = common::read_json(&missions.join("secured-submit/execution.json"))?;
     assert!(report["figures"].is_object(), "{report}");
+    fleet.passed();
+    Ok(())
+}
+
+/// Zenoh's boxed error as a test failure.
+fn z<T>(r: zenoh::Result<T>) -> Result<T, String> {
+    r.map_err(|e| e.to_string())
+}
+
+/// After its coordinator's liveliness token goes, an agent asks the network whether it is really
+/// gone before it abandons the mission. Through the secured router and the access control
+/// `keys` writes, that question must find a token that is declared and none that is not.
+#[test]
+fn a_vehicle_asks_through_the_access_control_whether_its_coordinator_is_there() -> TestResult {
+    let mut fleet = Fleet::new();
+    let keys = fleet.dir().join("keys");
+    make_keys(&mut fleet, &keys);
+    let endpoint = format!("tls/127.0.0.1:{}", free_port());
+    let member = |name: &str| Security {
+        config_file: Some(keys.join(format!("{name}.json5"))),
+        ..Security::default()
+    };
+    let config = session::router_config(&[endpoint.clone()], &[], &member("coordinator"))?;
+    let router = z(zenoh::open(config).wait())?;
+    let key = topics::coordinator_liveliness("alpha")?;
+    let token = z(router.liveliness().declare_token(key.as_str()).wait())?;
+    let config = session::client_config(&[endpoint], false, &member("auv1"))?;
+    let vehicle = z(zenoh::open(config).wait())?;
+    let wait = Duration::from_secs(2);
+    assert!(coordinator_present(&vehicle, "alpha", wait));
+    assert!(!coordinator_present(&vehicle, "beta", wait));
+    z(token.undeclare().wait())?;
+    let end = deadline(10);
+    while coordinator_present(&vehicle, "alpha", wait) {
+        assert!(Instant::now() < end, "the undeclared token is still found");
+        std::thread::sleep(Duration::from_millis(100));
+    }
+    z(vehicle.close().wait())?;
+    z(router.close().wait())?;
     fleet.passed();
     Ok(())
 }

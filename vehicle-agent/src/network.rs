@@ -29,8 +29,11 @@ use crate::link;
 use crate::mission;
 use shoal_common::wire::open::Telemetry;
 
+mod coordinator_watch;
 mod drops;
 mod order_seq;
+pub use coordinator_watch::coordinator_present;
+use coordinator_watch::Departures;
 pub use drops::Drops;
 use order_seq::OrderSeqs;
 
@@ -137,17 +140,16 @@ pub fn serve(args: &AgentConfig, shutdown: &AtomicBool) -> anyhow::Result<()> {
         .callback(forward(tx))
         .wait()
         .map_err(|e| anyhow::anyhow!("cannot subscribe to {}: {e}", topics::ALL_FLEETS))?;
-    // A coordinator that leaves (exit, crash, cut link) ends its missions here at once, instead
-    // of after --idle-timeout.
-    let (gone_tx, gone_rx) = mpsc::channel::<String>();
+    // A coordinator that leaves (exit, crash, cut link) ends its missions here within a few
+    // seconds (the `coordinator_watch` module), instead of after --idle-timeout.
+    let (token_tx, token_rx) = mpsc::channel::<(String, bool)>();
     let _coordinators = session
         .liveliness()
         .declare_subscriber(topics::ALL_COORDINATORS)
         .callback(move |sample| {
-            if sample.kind() == zenoh::sample::SampleKind::Delete {
-                if let Some(m) = topics::mission_of_coordinator(sample.key_expr().as_str()) {
-                    let _ = gone_tx.send(m.to_string());
-                }
+            if let Some(m) = topics::mission_of_coordinator(sample.key_expr().as_str()) {
+                let declared = sample.kind() == zenoh::sample::SampleKind::Put;
+                let _ = token_tx.send((m.to_string(), declared));
             }
         })
         .wait()
@@ -165,6 +167,7 @@ pub fn serve(args: &AgentConfig, shutdown: &AtomicBool) -> anyhow::Result<()> {
     let mut workers: HashMap<String, Worker> = HashMap::new();
     let mut finished: HashSet<String> = HashSet::new();
     let mut served = 0usize;
+    let mut departures = Departures::new(token_rx);
     while !shutdown.load(Ordering::Relaxed) {
         match rx.recv_timeout(Duration::from_millis(100)) {
             Ok((key, bytes)) => {
@@ -181,7 +184,7 @@ pub fn serve(args: &AgentConfig, shutdown: &AtomicBool) -> anyhow::Result<()> {
             Err(RecvTimeoutError::Timeout) => {}
             Err(RecvTimeoutError::Disconnected) => break,
         }
-        while let Ok(m) = gone_rx.try_recv() {
+        for m in departures.poll(&session, |m| workers.contains_key(m)) {
             if let Some(w) = workers.get(&m) {
                 let _ = w.tx.send(CoordinatorToAgent::Stop {
                     mission: m,
@@ -205,6 +208,7 @@ pub fn serve(args: &AgentConfig, shutdown: &AtomicBool) -> anyhow::Result<()> {
                     ),
                     Err(_) => tracing::error!("mission {m}: the planning thread panicked"),
                 }
+                departures.forget(&m);
                 finished.insert(m);
                 served += 1;
             }
