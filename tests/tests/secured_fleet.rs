@@ -167,7 +167,8 @@ fn a_vehicle_asks_through_the_access_control_whether_its_coordinator_is_there() 
         config_file: Some(keys.join(format!("{name}.json5"))),
         ..Security::default()
     };
-    let config = session::router_config(&[endpoint.clone()], &[], &member("coordinator"))?;
+    let config =
+        session::router_config(std::slice::from_ref(&endpoint), &[], &member("coordinator"))?;
     let router = z(zenoh::open(config).wait())?;
     let key = topics::coordinator_liveliness("alpha")?;
     let token = z(router.liveliness().declare_token(key.as_str()).wait())?;

@@ -66,7 +66,7 @@ impl CoordinatorWatch {
 
     /// The missions whose coordinator has been gone for the grace period at `now`: the network
     /// is to be asked about each, once.
-    pub fn to_ask(&mut self, now: Instant) -> Vec<String> {
+    pub fn questions_due(&mut self, now: Instant) -> Vec<String> {
         let mut ask = Vec::new();
         for (mission, s) in &mut self.suspects {
             if let Suspect::GoneSince(t) = *s {
@@ -129,7 +129,7 @@ impl Departures {
                 self.watch.token_gone(&mission, now);
             }
         }
-        for mission in self.watch.to_ask(now) {
+        for mission in self.watch.questions_due(now) {
             ask(session, mission, self.answers_tx.clone());
         }
         let mut gone = Vec::new();
@@ -198,9 +198,9 @@ mod tests {
         let mut w = CoordinatorWatch::new(GRACE);
         let t0 = Instant::now();
         w.token_gone("m", t0);
-        assert!(w.to_ask(t0 + Duration::from_millis(1999)).is_empty());
+        assert!(w.questions_due(t0 + Duration::from_millis(1999)).is_empty());
         w.token_back("m");
-        assert!(w.to_ask(t0 + Duration::from_secs(10)).is_empty());
+        assert!(w.questions_due(t0 + Duration::from_secs(10)).is_empty());
     }
 
     #[test]
@@ -210,15 +210,15 @@ mod tests {
         w.token_gone("m", t0);
         // A second Delete does not restart the grace.
         w.token_gone("m", t0 + Duration::from_secs(1));
-        assert_eq!(w.to_ask(t0 + GRACE), vec!["m".to_string()]);
-        assert!(w.to_ask(t0 + GRACE * 5).is_empty(), "asked twice");
+        assert_eq!(w.questions_due(t0 + GRACE), vec!["m".to_string()]);
+        assert!(w.questions_due(t0 + GRACE * 5).is_empty(), "asked twice");
         assert!(w.answer("m", false), "no token answered: it left");
         assert!(!w.answer("m", false), "answered twice");
 
         w.token_gone("n", t0);
-        assert_eq!(w.to_ask(t0 + GRACE), vec!["n".to_string()]);
+        assert_eq!(w.questions_due(t0 + GRACE), vec!["n".to_string()]);
         assert!(!w.answer("n", true), "a token answered: it is there");
-        assert!(w.to_ask(t0 + GRACE * 5).is_empty());
+        assert!(w.questions_due(t0 + GRACE * 5).is_empty());
     }
 
     #[test]
@@ -226,13 +226,13 @@ mod tests {
         let mut w = CoordinatorWatch::new(GRACE);
         let t0 = Instant::now();
         w.token_gone("m", t0);
-        assert_eq!(w.to_ask(t0 + GRACE), vec!["m".to_string()]);
+        assert_eq!(w.questions_due(t0 + GRACE), vec!["m".to_string()]);
         w.token_back("m");
         assert!(!w.answer("m", false));
         // A mission that ended is forgotten with its suspicion.
         w.token_gone("k", t0);
         w.forget("k");
-        assert!(w.to_ask(t0 + GRACE).is_empty());
+        assert!(w.questions_due(t0 + GRACE).is_empty());
         assert!(!w.answer("k", false));
     }
 
@@ -242,8 +242,8 @@ mod tests {
         let t0 = Instant::now();
         w.token_gone("b", t0);
         w.token_gone("a", t0 + Duration::from_secs(1));
-        assert_eq!(w.to_ask(t0 + GRACE), vec!["b".to_string()]);
-        assert_eq!(w.to_ask(t0 + GRACE * 2), vec!["a".to_string()]);
+        assert_eq!(w.questions_due(t0 + GRACE), vec!["b".to_string()]);
+        assert_eq!(w.questions_due(t0 + GRACE * 2), vec!["a".to_string()]);
         assert!(!w.answer("a", true));
         assert!(w.answer("b", false));
     }
