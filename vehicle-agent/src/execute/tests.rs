@@ -1,0 +1,257 @@
+//! The execution loop driven against a link that records what it is asked (and can fail).
+
+use super::*;
+use crate::link::{LinkError, LinkOutcome};
+use shoal_common::execution::VehicleState;
+use shoal_common::geometry::Vec3;
+use std::sync::mpsc;
+use std::sync::{Arc, Mutex};
+
+/// A link that records what it is asked.
+#[derive(Clone, Default)]
+struct Recorder {
+    calls: Arc<Mutex<Vec<String>>>,
+    confirmed: Arc<Mutex<usize>>,
+    /// Every hold fails to reach the vehicle.
+    holds_fail: bool,
+}
+
+impl VehicleLink for Recorder {
+    fn name(&self) -> String {
+        "recorder".into()
+    }
+    fn upload(&mut self, plan: &Trajectory) -> Result<(), LinkError> {
+        self.calls
+            .lock()
+            .map_err(|e| LinkError::Io(e.to_string()))?
+            .push(format!("upload {}", plan.times.len()));
+        Ok(())
+    }
+    fn state(&mut self, now: f64) -> Result<VehicleState, LinkError> {
+        Ok(VehicleState {
+            t_s: now,
+            position: [0.0; 3],
+            velocity: [0.0; 3],
+            heading_deg: 0.0,
+            depth_m: None,
+            altitude_m: None,
+            battery: 1.0,
+            status: VehicleStatus::Underway,
+            arrived_s: None,
+        })
+    }
+    fn hold(&mut self, _now: f64) -> Result<(), LinkError> {
+        if self.holds_fail {
+            return Err(LinkError::Io("link down".into()));
+        }
+        self.calls
+            .lock()
+            .map_err(|e| LinkError::Io(e.to_string()))?
+            .push("hold".into());
+        Ok(())
+    }
+    fn stop(&mut self) -> Result<(), LinkError> {
+        self.calls
+            .lock()
+            .map_err(|e| LinkError::Io(e.to_string()))?
+            .push("stop".into());
+        Ok(())
+    }
+    /// Every command confirmed at once, as a simulator does.
+    fn outcomes(&mut self) -> Vec<LinkOutcome> {
+        let calls = self.calls.lock().map(|c| c.clone()).unwrap_or_default();
+        let mut seen = self.confirmed.lock().map(|n| *n).unwrap_or(0);
+        let done = calls[seen.min(calls.len())..]
+            .iter()
+            .map(|c| {
+                let command = match c.as_str() {
+                    "hold" => VehicleCommand::Hold,
+                    "stop" => VehicleCommand::Stop,
+                    _ => VehicleCommand::Upload,
+                };
+                LinkOutcome::confirmed(command, c.clone())
+            })
+            .collect();
+        seen = calls.len();
+        if let Ok(mut n) = self.confirmed.lock() {
+            *n = seen;
+        }
+        done
+    }
+}
+
+fn scenario_toml() -> String {
+    std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../scenarios/amp-pso-1.toml"
+    ))
+    .unwrap_or_default()
+}
+
+fn wire(samples: Vec<[f64; 4]>) -> WireTrajectory {
+    WireTrajectory {
+        vehicle: "auv1".into(),
+        samples,
+    }
+}
+
+#[test]
+fn bad_orders_are_refused_with_the_reason() {
+    let ok = wire(vec![[0.0, 1.0, 2.0, 3.0], [10.0, 4.0, 5.0, 6.0]]);
+    let s = scenario_toml();
+    assert!(Order::new("m", "auv1", &s, &ok, 0, 50.0, 2.0, 1).is_ok());
+    let e = |r: Result<Order, Unusable>| r.err().map(|e| e.to_string()).unwrap_or_default();
+    assert!(e(Order::new("m", "auv9", &s, &ok, 0, 50.0, 2.0, 1)).contains("no vehicle \"auv9\""));
+    assert!(e(Order::new("m", "auv1", &s, &ok, 0, 0.0, 2.0, 1)).contains("time scale 0"));
+    assert!(e(Order::new("m", "auv1", &s, &ok, 0, 1.0, 500.0, 1)).contains("telemetry rate 500"));
+    let backwards = wire(vec![[10.0, 1.0, 2.0, 3.0], [0.0, 4.0, 5.0, 6.0]]);
+    assert!(
+        e(Order::new("m", "auv1", &s, &backwards, 0, 1.0, 2.0, 1)).contains("not timed in order")
+    );
+    let nan = wire(vec![[0.0, f64::NAN, 2.0, 3.0]]);
+    assert!(e(Order::new("m", "auv1", &s, &nan, 0, 1.0, 2.0, 1)).contains("not finite"));
+}
+
+#[test]
+fn the_mission_clock_runs_scaled_from_its_epoch() {
+    let now_ms = unix_us() / 1000;
+    let c = MissionClock {
+        epoch_unix_ms: now_ms - 2000,
+        scale: 50.0,
+    };
+    // 2 s of wall time at 50×: about 100 s (the test itself takes a little).
+    let t = c.now();
+    assert!((100.0..110.0).contains(&t), "{t}");
+    let future = MissionClock {
+        epoch_unix_ms: now_ms + 60_000,
+        scale: 50.0,
+    };
+    assert_eq!(future.now(), 0.0);
+}
+
+/// A two-sample order for auv1 starting now, in real time, reported at 50 Hz.
+fn order_now() -> Order {
+    let order = Order::new(
+        "m",
+        "auv1",
+        &scenario_toml(),
+        &wire(vec![[0.0, 1.0, 2.0, 3.0], [10.0, 4.0, 5.0, 6.0]]),
+        unix_us() / 1000,
+        1.0,
+        50.0,
+        1,
+    );
+    let Ok(order) = order else {
+        panic!("{order:?}")
+    };
+    order
+}
+
+#[test]
+fn a_hold_the_link_cannot_give_is_reported_given_up_at_once() {
+    let mut link = Recorder {
+        holds_fail: true,
+        ..Recorder::default()
+    };
+    let (tx, rx) = mpsc::channel();
+    let _ = tx.send(CoordinatorToAgent::Hold {
+        mission: "m".into(),
+        vehicle: "auv1".into(),
+        reason: "test".into(),
+    });
+    let _ = tx.send(CoordinatorToAgent::Stop {
+        mission: "m".into(),
+        reason: "done".into(),
+    });
+    let sent = Mutex::new(Vec::<Telemetry>::new());
+    let publish = |t: &Telemetry| {
+        if let Ok(mut v) = sent.lock() {
+            v.push(t.clone());
+        }
+    };
+    let stop = AtomicBool::new(false);
+    let report = run(
+        order_now(),
+        &mut link,
+        &rx,
+        &publish,
+        &stop,
+        Duration::from_secs(30),
+    );
+    assert_eq!(report.outcome, "stopped: done");
+    let sent = sent.lock().map(|s| s.clone()).unwrap_or_default();
+    let hold = sent
+        .iter()
+        .filter_map(|t| t.command.as_ref())
+        .find(|c| c.command == VehicleCommand::Hold);
+    let Some(hold) = hold else {
+        panic!("no report carries the hold: {sent:?}")
+    };
+    assert_eq!(hold.state, CommandState::GaveUp, "{hold:?}");
+    assert!(hold.detail.contains("link down"), "{hold:?}");
+}
+
+#[test]
+fn reports_flow_updates_load_holds_hold_and_stop_ends() {
+    let order = order_now();
+    let mut link = Recorder::default();
+    let calls = Arc::clone(&link.calls);
+    let (tx, rx) = mpsc::channel();
+    let sent = Arc::new(Mutex::new(Vec::<Telemetry>::new()));
+    let out = Arc::clone(&sent);
+    let stop = AtomicBool::new(false);
+    let feeder = std::thread::spawn(move || {
+        std::thread::sleep(Duration::from_millis(150));
+        let traj = Trajectory {
+            times: vec![5.0, 20.0, 30.0],
+            points: vec![Vec3::zeros(); 3],
+        };
+        let _ = tx.send(CoordinatorToAgent::Update {
+            mission: "m".into(),
+            vehicle: "auv1".into(),
+            revision: 2,
+            trajectory: WireTrajectory::new("auv1", &traj),
+        });
+        // A stale revision is ignored.
+        let _ = tx.send(CoordinatorToAgent::Update {
+            mission: "m".into(),
+            vehicle: "auv1".into(),
+            revision: 1,
+            trajectory: WireTrajectory::new("auv1", &traj),
+        });
+        std::thread::sleep(Duration::from_millis(150));
+        let _ = tx.send(CoordinatorToAgent::Hold {
+            mission: "m".into(),
+            vehicle: "auv1".into(),
+            reason: "test".into(),
+        });
+        std::thread::sleep(Duration::from_millis(150));
+        let _ = tx.send(CoordinatorToAgent::Stop {
+            mission: "m".into(),
+            reason: "done".into(),
+        });
+    });
+    let report = run(
+        order,
+        &mut link,
+        &rx,
+        &|t| {
+            if let Ok(mut v) = out.lock() {
+                v.push(t.clone());
+            }
+        },
+        &stop,
+        Duration::from_secs(30),
+    );
+    let _ = feeder.join();
+    assert_eq!(report.outcome, "stopped: done");
+    let calls = calls.lock().map(|c| c.clone()).unwrap_or_default();
+    assert_eq!(calls, ["upload 2", "upload 3", "hold", "stop"]);
+    let sent = sent.lock().map(|s| s.clone()).unwrap_or_default();
+    // 50 Hz for about 0.45 s.
+    assert!(sent.len() >= 10, "{} reports", sent.len());
+    assert!(sent.windows(2).all(|w| w[1].seq == w[0].seq + 1));
+    assert_eq!(sent.first().map(|t| t.revision), Some(0));
+    assert_eq!(sent.last().map(|t| t.revision), Some(2));
+    assert_eq!(report.iterations as usize, sent.len());
+}
