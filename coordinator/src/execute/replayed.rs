@@ -80,6 +80,7 @@ impl Replayed {
                             fleet.vehicles[i].plan = Trajectory::from_samples(s);
                             fleet.vehicles[i].revision = p.revision;
                             fleet.vehicles[i].holding = false;
+                            fleet.vehicles[i].held_since_s = None;
                         }
                     }
                 }
@@ -97,7 +98,12 @@ impl Replayed {
                     if let Some(i) = fleet.index(v) {
                         match e.kind.as_str() {
                             log::EVENT_LOST => fleet.vehicles[i].lost = true,
-                            log::EVENT_HOLD => fleet.vehicles[i].holding = true,
+                            // Held since the event: the live run stamps it with the
+                            // mission time it sent the hold at.
+                            log::EVENT_HOLD => {
+                                fleet.vehicles[i].holding = true;
+                                fleet.vehicles[i].held_since_s = Some(e.t_s);
+                            }
                             _ => {}
                         }
                     }
@@ -166,5 +172,67 @@ impl Statuses {
     /// The status at mission time `t`.
     fn status(&self, t: f64) -> FleetStatus {
         self.replayed.fleet.status(&self.replayed.start.mission, t)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use shoal_common::wire::open::{PlanNotice, OPEN_VERSION};
+
+    fn plan(revision: u32, changed: &[&str]) -> Record {
+        let line = |y: f64| vec![[0.0, 0.0, y, 50.0], [1000.0, 1000.0, y, 50.0]];
+        Record::Plan(PlanNotice {
+            version: OPEN_VERSION,
+            mission: "m".into(),
+            revision,
+            changed: changed.iter().map(|v| v.to_string()).collect(),
+            trajectories: vec![("auv1".into(), line(0.0)), ("auv2".into(), line(500.0))],
+        })
+    }
+
+    fn event(kind: &str, t_s: f64) -> Record {
+        Record::Event(MissionEvent {
+            version: OPEN_VERSION,
+            mission: "m".into(),
+            t_s,
+            kind: kind.into(),
+            vehicles: vec!["auv1".into()],
+            detail: String::new(),
+        })
+    }
+
+    /// A logged hold is replayed as the live run held: since the event's mission time (where
+    /// the vehicle stands and where its retry resumes are reckoned from it), until a new plan.
+    /// Scenario 1 has the two vehicles the plans name, auv1 and auv2.
+    #[test]
+    fn a_logged_hold_holds_from_its_time_until_a_new_plan() -> anyhow::Result<()> {
+        let toml = std::fs::read_to_string(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../scenarios/amp-pso-1.toml"
+        ))?;
+        let records = vec![
+            Record::Start(Start {
+                mission: "m".into(),
+                scenario_toml: toml,
+                common_arrival_s: 1000.0,
+                arrival_window_s: 30.0,
+                horizon_s: 120.0,
+                time_scale: 10.0,
+                epoch_unix_ms: 0,
+            }),
+            plan(0, &[]),
+        ];
+        let mut r = Replayed::new(&records, Path::new("log.ndjson"))?;
+        r.apply(&event(log::EVENT_HOLD, 240.0));
+        let v = &r.fleet.vehicles[0];
+        assert!(v.holding);
+        assert_eq!(v.held_since_s, Some(240.0));
+        assert_eq!(r.fleet.vehicles[1].held_since_s, None);
+        r.apply(&plan(1, &["auv1"]));
+        let v = &r.fleet.vehicles[0];
+        assert!(!v.holding);
+        assert_eq!(v.held_since_s, None);
+        Ok(())
     }
 }
