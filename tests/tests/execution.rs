@@ -2,6 +2,7 @@
 //! embedded agent per AUV drives a simulated vehicle along its trajectory at 100× real time, an
 //! obstacle published on auv2's path mid-mission makes the coordinator replan auv2, `status`
 //! reads the live picture over Zenoh, and `replay` recomputes the same figures from the log.
+//! Also: a vehicle lost mid-mission, one with no safe replan, one whose agent joins late.
 
 mod common;
 
@@ -313,6 +314,71 @@ fn crawlers_report_hazard_clearance_and_the_auv_its_height_above_the_seabed() ->
     assert_eq!(auv["vehicle"], "auv1");
     assert!(num(auv, "min_seabed_clearance_m") > 0.0, "{auv}");
     assert_eq!(auv["min_hazard_clearance_m"], Value::Null, "{auv}");
+    fleet.passed();
+    Ok(())
+}
+
+#[test]
+fn a_vehicle_whose_agent_joins_after_its_replan_drives_the_replan() -> TestResult {
+    let mut fleet = Fleet::new();
+    let out = fleet.dir().join("out");
+    let port = free_port();
+    // An obstacle published at t = 0 where auv2 would be at t = 150 s: auv2 is replanned
+    // before its agent has joined, so the update sent then reaches no one.
+    let cmd = run_scenario_2(
+        &out,
+        "50",
+        &[
+            "--agents",
+            "external",
+            "--inject-obstacle",
+            "0:auv2,20",
+            "--listen",
+            &format!("tcp/127.0.0.1:{port}"),
+        ],
+    );
+    let c = fleet.spawn("coordinator", cmd);
+    for v in ["auv1", "auv3"] {
+        fleet.agent(v, &endpoint(port), &["--idle-timeout", "5"]);
+    }
+    fleet.wait_for_stderr(c, "executing mission", Instant::now() + LIMIT);
+    let log_path = out.join("mission.ndjson");
+    let replanned = |l: &str| l.contains("\"kind\":\"replanned\"") && l.contains("auv2");
+    let deadline = Instant::now() + Duration::from_secs(30);
+    while !std::fs::read_to_string(&log_path).is_ok_and(|log| log.lines().any(replanned)) {
+        assert!(Instant::now() < deadline, "auv2 was not replanned");
+        std::thread::sleep(Duration::from_millis(100));
+    }
+    fleet.agent("auv2", &endpoint(port), &["--idle-timeout", "5"]);
+    let r = fleet.wait(c, Instant::now() + LIMIT);
+    assert_eq!(r.code(), Some(0), "{}\n{}", r.stdout, r.stderr);
+    let report = read_json(&out.join("execution.json"))?;
+    let auv2 = &report["figures"]["vehicles"][1];
+    assert!(
+        num(auv2, "revision") >= 1.0,
+        "auv2 was not replanned: {auv2}"
+    );
+    assert!(num(auv2, "min_obstacle_clearance_m") > 0.0, "{auv2}");
+    // auv2 drives the replan it was sent before its agent joined.
+    let log = std::fs::read_to_string(&log_path)?;
+    let revisions: Vec<u64> = log
+        .lines()
+        .filter_map(|l| serde_json::from_str::<Value>(l).ok())
+        .filter(|r| r["record"] == "telemetry" && r["telemetry"]["vehicle"] == "auv2")
+        .filter_map(|r| r["telemetry"]["revision"].as_u64())
+        .collect();
+    assert!(
+        revisions.len() > 20,
+        "auv2 reported {} times",
+        revisions.len()
+    );
+    // The first revision past the first plan auv2 drives is the one sent before its agent
+    // joined: without it again, auv2 drove the first plan until a second replan took it off.
+    assert_eq!(
+        revisions.iter().find(|&&r| r >= 1),
+        Some(&1),
+        "auv2's revisions, report by report: {revisions:?}"
+    );
     fleet.passed();
     Ok(())
 }

@@ -21,6 +21,7 @@ mod repair;
 pub mod replan;
 mod replan_queue;
 pub mod replayed;
+mod resend;
 mod standing;
 mod state;
 mod track;
@@ -287,21 +288,10 @@ fn run_loop(
         let now_wall = Instant::now();
         if now_wall >= resend {
             resend = now_wall + Duration::from_secs(1);
-            for (i, v) in x.fleet.vehicles.iter().enumerate() {
-                if v.last.is_none() {
-                    x.send(
-                        &v.id,
-                        CoordinatorToAgent::Execute {
-                            mission: x.mission.clone(),
-                            vehicle: v.id.clone(),
-                            scenario_toml: scenario_toml.to_string(),
-                            trajectory: WireTrajectory::new(&v.id, &plans[i]),
-                            epoch_unix_ms: x.mission_clock.epoch_unix_ms,
-                            time_scale: o.time_scale,
-                            telemetry_hz: o.telemetry_hz,
-                            seed: o.seed.wrapping_add(i as u64),
-                        },
-                    );
+            for (i, planned) in plans.iter().enumerate().take(x.fleet.vehicles.len()) {
+                for order in resend::repeated(&x.fleet.vehicles[i]) {
+                    let m = repeated_order(x, i, order, planned, scenario_toml);
+                    x.send(&x.fleet.vehicles[i].id, m);
                 }
             }
         }
@@ -350,5 +340,42 @@ fn run_loop(
         if started.elapsed() > Duration::from_secs(30) && x.fleet.reports == 0 {
             return "no telemetry from any vehicle within 30 s".into();
         }
+    }
+}
+
+/// Vehicle `i`'s `order`, repeated until it first reports (see [`resend`]); `planned` is its
+/// plan of revision 0.
+fn repeated_order(
+    x: &Exec,
+    i: usize,
+    order: resend::Repeated,
+    planned: &Trajectory,
+    scenario_toml: &str,
+) -> CoordinatorToAgent {
+    let o = x.options;
+    let v = &x.fleet.vehicles[i];
+    let (mission, vehicle) = (x.mission.clone(), v.id.clone());
+    match order {
+        resend::Repeated::Execute => CoordinatorToAgent::Execute {
+            trajectory: WireTrajectory::new(&v.id, planned),
+            mission,
+            vehicle,
+            scenario_toml: scenario_toml.to_string(),
+            epoch_unix_ms: x.mission_clock.epoch_unix_ms,
+            time_scale: o.time_scale,
+            telemetry_hz: o.telemetry_hz,
+            seed: o.seed.wrapping_add(i as u64),
+        },
+        resend::Repeated::Update => CoordinatorToAgent::Update {
+            trajectory: WireTrajectory::new(&v.id, &v.plan),
+            mission,
+            vehicle,
+            revision: v.revision,
+        },
+        resend::Repeated::Hold => CoordinatorToAgent::Hold {
+            mission,
+            vehicle,
+            reason: "told to hold before its first report".to_string(),
+        },
     }
 }
