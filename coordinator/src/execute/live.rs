@@ -230,30 +230,36 @@ impl LiveFeed {
 /// at mission time `t_s` and `position`, underway at 1 m/s east.
 #[cfg(test)]
 pub(crate) fn test_report(vehicle: &str, seq: u64, t_s: f64, position: [f64; 3]) -> LiveMessage {
-    use shoal_common::execution::{VehicleState, VehicleStatus};
     LiveMessage::Record(Record::Telemetry {
         received_unix_us: seq,
-        telemetry: Telemetry {
-            version: shoal_common::wire::open::OPEN_VERSION,
-            mission: "m".into(),
-            vehicle: vehicle.into(),
-            seq,
-            revision: 0,
-            sent_unix_us: seq,
-            state: VehicleState {
-                t_s,
-                position,
-                velocity: [1.0, 0.0, 0.0],
-                heading_deg: 0.0,
-                depth_m: None,
-                altitude_m: None,
-                battery: 1.0,
-                status: VehicleStatus::Underway,
-                arrived_s: None,
-            },
-            command: None,
-        },
+        telemetry: test_telemetry(vehicle, seq, t_s, position),
     })
+}
+
+/// The report of [`test_report`].
+#[cfg(test)]
+pub(crate) fn test_telemetry(vehicle: &str, seq: u64, t_s: f64, position: [f64; 3]) -> Telemetry {
+    use shoal_common::execution::{VehicleState, VehicleStatus};
+    Telemetry {
+        version: shoal_common::wire::open::OPEN_VERSION,
+        mission: "m".into(),
+        vehicle: vehicle.into(),
+        seq,
+        revision: 0,
+        sent_unix_us: seq,
+        state: VehicleState {
+            t_s,
+            position,
+            velocity: [1.0, 0.0, 0.0],
+            heading_deg: 0.0,
+            depth_m: None,
+            altitude_m: None,
+            battery: 1.0,
+            status: VehicleStatus::Underway,
+            arrived_s: None,
+        },
+        command: None,
+    }
 }
 
 #[cfg(test)]

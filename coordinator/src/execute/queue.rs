@@ -39,8 +39,12 @@ pub(super) struct UnderWay {
     /// Mission time its update takes effect; the vehicle drives `course` until then.
     pub(super) t0: f64,
     pub(super) course: Trajectory,
-    /// Whether the vehicle was holding when it started.
+    /// Whether the vehicle was told to hold when it started.
     pub(super) was_holding: bool,
+    /// Whether it stood still on a hold it had confirmed when it started: its replan starts
+    /// where it stands, with no course to keep (one told to hold that has not confirmed it
+    /// drives on, and is replanned as a vehicle under way).
+    pub(super) was_standing: bool,
     /// Obstacles the scenario had when it started: any published since are checked against
     /// its result.
     pub(super) obstacles: usize,
@@ -84,20 +88,21 @@ impl ReplanQueue {
             .sum::<Duration>()
     }
 
-    /// Where a replan of a vehicle under way is queued: before every held vehicle's retry
-    /// (`holding` tells which vehicles hold). A held vehicle is safe where it is; one under way
-    /// drives on into what it must avoid while it waits.
-    pub(super) fn slot(&self, holding: impl Fn(usize) -> bool) -> usize {
+    /// Where a replan of a vehicle under way is queued: before every standing vehicle's retry
+    /// (`standing` tells which vehicles confirmed their hold). A vehicle standing still is safe
+    /// where it is; one under way (a hold it has not confirmed included) drives on into what it
+    /// must avoid while it waits.
+    pub(super) fn slot(&self, standing: impl Fn(usize) -> bool) -> usize {
         self.waiting
             .iter()
-            .position(|w| holding(w.vehicle))
+            .position(|w| standing(w.vehicle))
             .unwrap_or(self.waiting.len())
     }
 
-    /// A held vehicle's retry under way stops at its next iteration and gives its best so far
-    /// (for a vehicle under way that needs the thread, see [`Self::slot`]).
+    /// A standing vehicle's retry under way stops at its next iteration and gives its best so
+    /// far (for a vehicle under way that needs the thread, see [`Self::slot`]).
     pub(super) fn yield_retry(&self) {
-        if let Some(u) = self.under_way.as_ref().filter(|u| u.was_holding) {
+        if let Some(u) = self.under_way.as_ref().filter(|u| u.was_standing) {
             u.stop.store(true, Ordering::Relaxed);
         }
     }

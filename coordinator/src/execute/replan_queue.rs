@@ -8,7 +8,9 @@
 //! starts, so two replans at once could each plan into the other's old path. A vehicle under
 //! way goes first: its replan is queued before every held vehicle's retry, and a retry under
 //! way yields to it (its swarm stops at the next iteration with its best so far; cut short and
-//! not safe, it is not counted as a failed retry). A held vehicle is safe where it is. What the loop
+//! not safe, it is not counted as a failed retry). A held vehicle is safe where it is, once its
+//! report confirms the hold: until then it is replanned, queued and given a budget as one under
+//! way, from its course (see [`ReplanStart`]). What the loop
 //! learns while one thinks is checked when its result comes: a vehicle lost, arrived or told
 //! to hold meanwhile drops it; a result that enters an obstacle published meanwhile is planned
 //! again at once. And a vehicle that must wait its turn is held at once when its course until
@@ -20,6 +22,7 @@ use std::sync::mpsc::{self, TryRecvError};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
+use shoal_common::geometry::Vec3;
 use shoal_common::scenario::Scenario;
 use shoal_common::trajectory::Trajectory;
 use shoal_common::wire::coordinator_to_agent::CoordinatorToAgent;
@@ -30,11 +33,12 @@ use super::log::EVENT_HOLD;
 use super::queue::{Job, UnderWay, Waiting};
 use super::replan::Replanned;
 use super::state::Exec;
+use super::tracked::Tracked;
 
-/// The budget of vehicle `i`'s next replan: a holding vehicle is safe where it is, so each
-/// retry may think longer: the budget doubles per failed retry, up to 8 ×.
+/// The budget of vehicle `i`'s next replan: a vehicle standing on a hold it confirmed is safe
+/// where it is, so each retry may think longer: the budget doubles per failed retry, up to 8 ×.
 fn budget(x: &Exec, i: usize) -> Duration {
-    if x.fleet.vehicles[i].holding {
+    if x.fleet.vehicles[i].hold_confirmed() {
         x.options.replan_budget * (1u32 << x.hold_retries[i].min(3))
     } else {
         x.options.replan_budget
@@ -68,13 +72,13 @@ fn course_blocked(x: &Exec, i: usize, until: f64) -> Option<String> {
 /// hold instead (obeyed at once; its retries start from there).
 pub(super) fn request(x: &mut Exec, i: usize, why: &str, obstacle_received: Option<Instant>) {
     let o = x.options;
-    let holding = x.fleet.vehicles[i].holding;
-    if !holding && !x.queue.busy(i) {
+    let standing = x.fleet.vehicles[i].hold_confirmed();
+    if !standing && !x.queue.busy(i) {
         x.queue.yield_retry();
     }
     let waiting_at = x.queue.waiting.iter().position(|w| w.vehicle == i);
     let fleet = &x.fleet;
-    let slot = x.queue.slot(|j| fleet.vehicles[j].holding);
+    let slot = x.queue.slot(|j| fleet.vehicles[j].hold_confirmed());
     // When its update could take effect at the earliest (when it starts at once, `start`
     // looks).
     let effect = match &x.queue.under_way {
@@ -93,7 +97,7 @@ pub(super) fn request(x: &mut Exec, i: usize, why: &str, obstacle_received: Opti
             )
         }
     };
-    if let Some(effect) = effect.filter(|_| !holding) {
+    if let Some(effect) = effect.filter(|_| !standing) {
         if let Some(detail) = course_blocked(x, i, effect) {
             x.queue.waiting.retain(|w| w.vehicle != i);
             x.last_reaction[i] = Some(Instant::now());
@@ -120,7 +124,7 @@ pub(super) fn request(x: &mut Exec, i: usize, why: &str, obstacle_received: Opti
         obstacle_received,
         budget: budget(x, i),
     };
-    if holding {
+    if standing {
         x.queue.waiting.push_back(w);
     } else {
         x.queue.waiting.insert(slot, w);
@@ -196,10 +200,7 @@ fn start(x: &mut Exec, w: Waiting) {
     let remaining = (x.common_arrival_s + o.arrival_window_s - now).max(o.horizon_s);
     // Long enough to cover the lead (near the end of a fast run it can be the longer).
     let predictions = x.fleet.predictions_over(now, remaining.max(t0 - now));
-    let p0 = predictions[i].position_at(t0);
-    // The course there: where the prediction was heading over the last few seconds before.
-    let heading = Some(p0 - predictions[i].position_at((t0 - 5.0).max(now)))
-        .filter(|d| d.x.hypot(d.y) > 1e-3 && !holding);
+    let from = ReplanStart::of(&x.fleet.vehicles[i], &predictions[i], now, t0);
     // A retry must not repeat the swarm that just failed.
     let seed =
         o.seed ^ (u64::from(x.revision) << 8) ^ (u64::from(x.hold_retries[i]) << 32) ^ i as u64;
@@ -209,10 +210,10 @@ fn start(x: &mut Exec, w: Waiting) {
         scenario: x.scenario.clone(),
         vehicle: i,
         t0,
-        p0,
-        heading,
+        p0: from.p0,
+        heading: from.heading,
         current: x.fleet.vehicles[i].plan.clone(),
-        resume_s: x.fleet.vehicles[i].resume_s(),
+        resume_s: from.resume_s,
         arrival_s: x.fleet.vehicles[i].planned_arrival_s,
         budget,
         separation_buffer_m: o.separation_buffer_m,
@@ -227,6 +228,7 @@ fn start(x: &mut Exec, w: Waiting) {
         t0,
         course,
         was_holding: holding,
+        was_standing: from.standing,
         obstacles: x.scenario.obstacles.len(),
         started: Instant::now(),
         result: rx,
@@ -250,6 +252,41 @@ fn start(x: &mut Exec, w: Waiting) {
     }
 }
 
+/// Where and how a vehicle's replan starts.
+#[derive(Debug, Clone, PartialEq)]
+struct ReplanStart {
+    /// Where it will be when the update takes effect.
+    p0: Vec3,
+    /// The course it will be on there, for the new path's first turn; none for a vehicle
+    /// standing still.
+    heading: Option<Vec3>,
+    /// For a vehicle standing still, the plan time where it stopped (see
+    /// [`Tracked::resume_s`]).
+    resume_s: Option<f64>,
+    /// Whether it stands still on a hold it confirmed.
+    standing: bool,
+}
+
+impl ReplanStart {
+    /// Vehicle `v`'s replan at mission time `now` taking effect at `t0`, when `course` is its
+    /// prediction. A vehicle told to hold is taken as standing only once its report confirms
+    /// it: one whose hold is not confirmed (in flight, refused, lost) drives on, and a path
+    /// that starts as from a stop would ask it for a turn it cannot make.
+    fn of(v: &Tracked, course: &Trajectory, now: f64, t0: f64) -> ReplanStart {
+        let standing = v.hold_confirmed();
+        let p0 = course.position_at(t0);
+        // The course there: where the prediction was heading over the last few seconds before.
+        let heading = Some(p0 - course.position_at((t0 - 5.0).max(now)))
+            .filter(|d| d.x.hypot(d.y) > 1e-3 && !standing);
+        ReplanStart {
+            p0,
+            heading,
+            resume_s: v.resume_s().filter(|_| standing),
+            standing,
+        }
+    }
+}
+
 /// Whether `t` enters the inflated sphere of a hard obstacle of `scenario` from the
 /// `from`-th on.
 fn enters_new_obstacle(t: &Trajectory, scenario: &Scenario, from: usize) -> bool {
@@ -266,7 +303,7 @@ fn apply(x: &mut Exec, u: UnderWay, result: Replanned) {
     x.last_attempt[i] = result.elapsed;
     let v = &x.fleet.vehicles[i];
     let id = v.id.clone();
-    if !v.driven() || v.holding != u.was_holding {
+    if !v.driven() || v.holding != u.was_holding || v.hold_confirmed() != u.was_standing {
         tracing::info!(
             "{id}'s replan ({}) is dropped: the vehicle's state changed while it ran",
             u.asked.why
@@ -295,9 +332,9 @@ fn apply(x: &mut Exec, u: UnderWay, result: Replanned) {
         x.revision += 1;
         let v = &mut x.fleet.vehicles[i];
         // Under way, the vehicle goes on as predicted (its old course, its lag included) until
-        // the new one starts at the predicted point; holding, it waits where it is for it. The
-        // plan before now stays, for the record.
-        let plan = if v.holding {
+        // the new one starts at the predicted point; standing on a hold it confirmed, it waits
+        // where it is for it. The plan before now stays, for the record.
+        let plan = if u.was_standing {
             result.trajectory.clone()
         } else {
             v.plan

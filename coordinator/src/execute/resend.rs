@@ -41,8 +41,7 @@ pub(super) fn repeated(v: &Tracked) -> Vec<Repeated> {
 mod tests {
     use super::*;
     use crate::execute::fleet::Fleet;
-    use crate::execute::live::{test_report, LiveMessage};
-    use crate::execute::log::Record;
+    use crate::execute::live::test_telemetry;
     use shoal_common::geometry::Vec3;
     use shoal_common::trajectory::Trajectory;
 
@@ -53,13 +52,6 @@ mod tests {
         };
         let fleet = Fleet::new(&["auv1".to_string()], &[plan], 20.0, 60.0);
         fleet.vehicles[0].clone()
-    }
-
-    fn test_report_record() -> Record {
-        match test_report("auv1", 1, 1.0, [0.0; 3]) {
-            LiveMessage::Record(r) => r,
-            other => panic!("not a record: {other:?}"),
-        }
     }
 
     #[test]
@@ -82,10 +74,7 @@ mod tests {
         let mut v = vehicle();
         v.revision = 1;
         v.holding = true;
-        let Record::Telemetry { telemetry, .. } = test_report_record() else {
-            panic!("a test report is a telemetry record")
-        };
-        v.last = Some(telemetry);
+        v.last = Some(test_telemetry("auv1", 1, 1.0, [0.0; 3]));
         assert_eq!(repeated(&v), Vec::new());
     }
 }

@@ -2,6 +2,7 @@
 
 use super::super::queue::ReplanQueue;
 use super::*;
+use shoal_common::execution::VehicleStatus;
 use shoal_common::geometry::Vec3;
 use shoal_common::scenario::{Obstacle, ObstacleKind};
 
@@ -34,6 +35,7 @@ fn a_replan_waits_for_the_rest_of_the_one_under_way_and_the_budgets_ahead_of_it(
             points: Vec::new(),
         },
         was_holding: false,
+        was_standing: false,
         obstacles: 0,
         started: Instant::now() - Duration::from_millis(1200),
         result: rx,
@@ -54,9 +56,15 @@ fn a_replan_waits_for_the_rest_of_the_one_under_way_and_the_budgets_ahead_of_it(
     // It is no held vehicle's retry: it does not yield.
     q.yield_retry();
     assert!(q.wait_for(0) > Duration::from_millis(1900));
-    // A held vehicle's retry yields: nothing left of it to wait for.
+    // Nor one told to hold that has not confirmed it: it is under way.
     if let Some(u) = q.under_way.as_mut() {
         u.was_holding = true;
+    }
+    q.yield_retry();
+    assert!(q.under_way.as_ref().is_some_and(|u| !u.yielded()));
+    // A standing vehicle's retry yields: nothing left of it to wait for.
+    if let Some(u) = q.under_way.as_mut() {
+        u.was_standing = true;
     }
     q.yield_retry();
     assert!(q.under_way.as_ref().is_some_and(|u| u.yielded()));
@@ -117,4 +125,62 @@ fn failed_retries_1_2_4_8_and_so_on_are_told() {
     assert_eq!(told, vec![1, 2, 4, 8, 16]);
     // The 166 retries of a crawler held for good at 500× make 8 events.
     assert_eq!((1..=166).filter(|&n| told_retry(n)).count(), 8);
+}
+
+/// East at 1 m/s along y = 0 from x = 0 (plan time = x).
+fn east() -> Trajectory {
+    Trajectory {
+        times: vec![0.0, 1000.0],
+        points: vec![Vec3::zeros(), Vec3::new(1000.0, 0.0, 0.0)],
+    }
+}
+
+/// A vehicle told at t = 100 s to hold, whose latest report (at t = 110 s, x = 110 m) has
+/// `status`.
+fn told_to_hold(status: VehicleStatus) -> Tracked {
+    use crate::execute::fleet::Fleet;
+    let mut f = Fleet::new(&["a".to_string()], &[east()], 50.0, 60.0);
+    f.vehicles[0].holding = true;
+    f.vehicles[0].held_since_s = Some(100.0);
+    let mut t = crate::execute::live::test_telemetry("a", 1, 110.0, [110.0, 0.0, 0.0]);
+    t.state.status = status;
+    f.report(t, 1);
+    f.vehicles[0].clone()
+}
+
+#[test]
+fn a_vehicle_whose_hold_is_not_confirmed_is_replanned_from_its_course() {
+    // Predicted on east at 1 m/s from x = 110 m at t = 110 s; the update takes effect at 140 s.
+    let course = Trajectory {
+        times: vec![110.0, 1000.0],
+        points: vec![Vec3::new(110.0, 0.0, 0.0), Vec3::new(1000.0, 0.0, 0.0)],
+    };
+    let moving = ReplanStart::of(
+        &told_to_hold(VehicleStatus::Underway),
+        &course,
+        110.0,
+        140.0,
+    );
+    assert!(!moving.standing);
+    assert!(
+        (moving.p0 - Vec3::new(140.0, 0.0, 0.0)).norm() < 1e-9,
+        "{moving:?}"
+    );
+    // Heading east: the position 5 s before t0 to the position at t0.
+    let heading = moving.heading.unwrap_or_else(Vec3::zeros);
+    assert!(
+        (heading - Vec3::new(5.0, 0.0, 0.0)).norm() < 1e-9,
+        "{moving:?}"
+    );
+    assert_eq!(moving.resume_s, None);
+    // Standing on the hold it confirmed: no course to keep, and it resumes where it stopped.
+    let still = Trajectory {
+        times: vec![110.0, 1000.0],
+        points: vec![Vec3::new(110.0, 0.0, 0.0); 2],
+    };
+    let standing = ReplanStart::of(&told_to_hold(VehicleStatus::Holding), &still, 110.0, 140.0);
+    assert!(standing.standing);
+    assert_eq!(standing.heading, None);
+    let resume = standing.resume_s.unwrap_or(f64::NAN);
+    assert!((resume - 110.0).abs() < 1e-6, "{standing:?}");
 }
