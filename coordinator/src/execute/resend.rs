@@ -5,9 +5,9 @@
 //! side. The coordinator meanwhile counts that vehicle as replanned or held. So until the
 //! vehicle's first report, every second it is sent its mission again and then, in the order
 //! the coordinator gave them, what it holds the vehicle to since: the latest plan revision and
-//! a hold (a replan ends a hold, so a hold still standing came after it). The agent takes each
-//! once (an update of a revision it has, a hold it is keeping, change nothing), so the first
-//! report shows what the coordinator believes of it.
+//! a hold (a replan ends a hold, so a hold still standing came after it). An update of a
+//! revision the agent has changes nothing; a hold is given to the vehicle again, which one
+//! holding keeps. So the first report shows what the coordinator believes of it.
 
 use super::tracked::Tracked;
 
