@@ -262,8 +262,7 @@ fn same_figures(logged: &ExecutionFigures, replayed: &ExecutionFigures) -> bool 
 mod tests {
     use super::*;
     use crate::execute::log::{LogWriter, Record, Start};
-    use shoal_common::execution::{VehicleState, VehicleStatus};
-    use shoal_common::wire::open::{PlanNotice, Telemetry};
+    use shoal_common::wire::open::PlanNotice;
 
     fn plan(revision: u32, changed: &[&str], tracks: &[(&str, Vec<[f64; 4]>)]) -> Record {
         Record::Plan(PlanNotice {
@@ -283,28 +282,14 @@ mod tests {
     }
 
     fn report_of(vehicle: &str, seq: u64, revision: u32, t_s: f64, position: [f64; 3]) -> Record {
+        let mut telemetry = crate::execute::live::test_telemetry(vehicle, seq, t_s, position);
+        telemetry.version = 1;
+        telemetry.revision = revision;
+        telemetry.sent_unix_us = 1_000_000;
+        telemetry.state.heading_deg = 90.0;
         Record::Telemetry {
             received_unix_us: 1_000_000 + seq,
-            telemetry: Telemetry {
-                version: 1,
-                mission: "m".into(),
-                vehicle: vehicle.into(),
-                seq,
-                revision,
-                sent_unix_us: 1_000_000,
-                state: VehicleState {
-                    t_s,
-                    position,
-                    velocity: [1.0, 0.0, 0.0],
-                    heading_deg: 90.0,
-                    depth_m: None,
-                    altitude_m: None,
-                    battery: 1.0,
-                    status: VehicleStatus::Underway,
-                    arrived_s: None,
-                },
-                command: None,
-            },
+            telemetry,
         }
     }
 

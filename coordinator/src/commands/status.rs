@@ -174,7 +174,6 @@ pub fn table(s: &FleetStatus) -> String {
 mod tests {
     use super::*;
     use shoal_common::execution::picture::Progress;
-    use shoal_common::execution::{VehicleState, VehicleStatus};
     use shoal_common::wire::open::{VehicleStatusRow, OPEN_VERSION};
 
     #[test]
@@ -188,17 +187,8 @@ mod tests {
             lost: false,
             command: None,
         };
-        let state = VehicleState {
-            t_s: 10.0,
-            position: [100.4, 200.6, -30.0],
-            velocity: [1.0, 0.0, 0.0],
-            heading_deg: 0.0,
-            depth_m: None,
-            altitude_m: None,
-            battery: 1.0,
-            status: VehicleStatus::Underway,
-            arrived_s: None,
-        };
+        let state =
+            crate::execute::live::test_telemetry("auv1", 0, 10.0, [100.4, 200.6, -30.0]).state;
         let progress = Progress {
             along_m: 50.0,
             fraction: 0.25,

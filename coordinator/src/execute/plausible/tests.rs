@@ -1,9 +1,8 @@
 use std::path::Path;
 use std::time::{Duration, Instant};
 
-use shoal_common::execution::{VehicleState, VehicleStatus};
 use shoal_common::scenario::{Bounds, Obstacle, ObstacleKind, Scenario};
-use shoal_common::wire::open::{Telemetry, OPEN_VERSION};
+use shoal_common::wire::open::Telemetry;
 
 use super::*;
 
@@ -26,26 +25,10 @@ fn limits() -> FixLimits {
 }
 
 fn report(seq: u64, t_s: f64, position: [f64; 3]) -> Telemetry {
-    Telemetry {
-        version: OPEN_VERSION,
-        mission: "m".into(),
-        vehicle: "auv1".into(),
-        seq,
-        revision: 0,
-        sent_unix_us: 0,
-        state: VehicleState {
-            t_s,
-            position,
-            velocity: [0.0; 3],
-            heading_deg: 0.0,
-            depth_m: None,
-            altitude_m: None,
-            battery: 1.0,
-            status: VehicleStatus::Underway,
-            arrived_s: None,
-        },
-        command: None,
-    }
+    let mut t = crate::execute::live::test_telemetry("auv1", seq, t_s, position);
+    t.sent_unix_us = 0;
+    t.state.velocity = [0.0; 3];
+    t
 }
 
 /// The last accepted fix: number 10 at (500, 500, 500), t = 100 s, 5 wall seconds ago.
