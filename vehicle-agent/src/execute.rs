@@ -132,17 +132,24 @@ impl Driver<'_> {
     /// and the fallback's confirmation a few milliseconds later are two reports).
     fn collect(&mut self) {
         for outcome in self.link.outcomes() {
+            let uploaded = outcome.command == VehicleCommand::Upload
+                && outcome.state == CommandState::Confirmed;
+            if uploaded {
+                // The vehicle has the plan, whatever was given since: a hold given after the
+                // upload holds on it, and the reports' revision must say which plan that is.
+                self.revision = self.pending_revision.take().unwrap_or(self.revision);
+            }
             let Some(report) = self
                 .command
                 .as_mut()
                 .filter(|c| c.command == outcome.command)
             else {
-                continue; // of a command given before the latest one
+                // Of a command given before the latest one: only a new revision is news.
+                if uploaded {
+                    self.report();
+                }
+                continue;
             };
-            if outcome.command == VehicleCommand::Upload && outcome.state == CommandState::Confirmed
-            {
-                self.revision = self.pending_revision.take().unwrap_or(self.revision);
-            }
             let mission = &self.order.mission;
             tracing::info!(
                 "mission {mission}: {:?} {:?}: {}",

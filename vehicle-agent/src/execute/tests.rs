@@ -14,6 +14,9 @@ struct Recorder {
     confirmed: Arc<Mutex<usize>>,
     /// Every hold fails to reach the vehicle.
     holds_fail: bool,
+    /// An update's upload (not the mission's first) is confirmed only once another command
+    /// was given after it, as over a link whose vehicle answers after the agent's next order.
+    uploads_answer_late: bool,
 }
 
 impl VehicleLink for Recorder {
@@ -57,9 +60,14 @@ impl VehicleLink for Recorder {
             .push("stop".into());
         Ok(())
     }
-    /// Every command confirmed at once, as a simulator does.
+    /// Every command confirmed at once, as a simulator does (an update's upload, with
+    /// `uploads_answer_late`, only once a command follows it).
     fn outcomes(&mut self) -> Vec<LinkOutcome> {
-        let calls = self.calls.lock().map(|c| c.clone()).unwrap_or_default();
+        let mut calls = self.calls.lock().map(|c| c.clone()).unwrap_or_default();
+        let update_last = calls.len() > 1 && calls.last().is_some_and(|c| c.starts_with("upload"));
+        if self.uploads_answer_late && update_last {
+            calls.pop();
+        }
         let mut seen = self.confirmed.lock().map(|n| *n).unwrap_or(0);
         let done = calls[seen.min(calls.len())..]
             .iter()
@@ -147,18 +155,22 @@ fn order_now() -> Order {
     order
 }
 
-#[test]
-fn a_hold_the_link_cannot_give_is_reported_given_up_at_once() {
-    let mut link = Recorder {
-        holds_fail: true,
-        ..Recorder::default()
-    };
-    let (tx, rx) = mpsc::channel();
-    let _ = tx.send(CoordinatorToAgent::Hold {
+/// The coordinator's hold for auv1.
+fn hold() -> CoordinatorToAgent {
+    CoordinatorToAgent::Hold {
         mission: "m".into(),
         vehicle: "auv1".into(),
         reason: "test".into(),
-    });
+    }
+}
+
+/// Runs [`order_now`] on `link` with `messages` already waiting, then the coordinator's stop,
+/// checks that the mission ended on that stop, and returns every report sent.
+fn run_to_the_stop(link: &mut Recorder, messages: Vec<CoordinatorToAgent>) -> Vec<Telemetry> {
+    let (tx, rx) = mpsc::channel();
+    for m in messages {
+        let _ = tx.send(m);
+    }
     let _ = tx.send(CoordinatorToAgent::Stop {
         mission: "m".into(),
         reason: "done".into(),
@@ -172,14 +184,24 @@ fn a_hold_the_link_cannot_give_is_reported_given_up_at_once() {
     let stop = AtomicBool::new(false);
     let report = run(
         order_now(),
-        &mut link,
+        link,
         &rx,
         &publish,
         &stop,
         Duration::from_secs(30),
     );
     assert_eq!(report.outcome, "stopped: done");
-    let sent = sent.lock().map(|s| s.clone()).unwrap_or_default();
+    let reports = sent.lock().map(|s| s.clone()).unwrap_or_default();
+    reports
+}
+
+#[test]
+fn a_hold_the_link_cannot_give_is_reported_given_up_at_once() {
+    let mut link = Recorder {
+        holds_fail: true,
+        ..Recorder::default()
+    };
+    let sent = run_to_the_stop(&mut link, vec![hold()]);
     let hold = sent
         .iter()
         .filter_map(|t| t.command.as_ref())
@@ -254,4 +276,35 @@ fn reports_flow_updates_load_holds_hold_and_stop_ends() {
     assert_eq!(sent.first().map(|t| t.revision), Some(0));
     assert_eq!(sent.last().map(|t| t.revision), Some(2));
     assert_eq!(report.iterations as usize, sent.len());
+}
+
+#[test]
+fn a_plan_confirmed_after_a_later_hold_is_the_revision_reported() {
+    let mut link = Recorder {
+        uploads_answer_late: true,
+        ..Recorder::default()
+    };
+    let traj = Trajectory {
+        times: vec![5.0, 20.0],
+        points: vec![Vec3::zeros(); 2],
+    };
+    let update = CoordinatorToAgent::Update {
+        mission: "m".into(),
+        vehicle: "auv1".into(),
+        revision: 3,
+        trajectory: WireTrajectory::new("auv1", &traj),
+    };
+    let sent = run_to_the_stop(&mut link, vec![update, hold()]);
+    // The upload's answer came after the hold was given: the hold is what the reports carry,
+    // and from then on the revision is the uploaded plan's.
+    let held = sent.iter().find(|t| {
+        t.command.as_ref().is_some_and(|c| {
+            c.command == VehicleCommand::Hold && c.state == CommandState::Confirmed
+        })
+    });
+    let Some(held) = held else {
+        panic!("no report confirms the hold: {sent:?}")
+    };
+    assert_eq!(held.revision, 3, "{held:?}");
+    assert_eq!(sent.last().map(|t| t.revision), Some(3));
 }
