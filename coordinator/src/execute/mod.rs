@@ -353,29 +353,19 @@ fn repeated_order(
     scenario_toml: &str,
 ) -> CoordinatorToAgent {
     let o = x.options;
-    let v = &x.fleet.vehicles[i];
-    let (mission, vehicle) = (x.mission.clone(), v.id.clone());
+    let id = &x.fleet.vehicles[i].id;
     match order {
         resend::Repeated::Execute => CoordinatorToAgent::Execute {
-            trajectory: WireTrajectory::new(&v.id, planned),
-            mission,
-            vehicle,
+            trajectory: WireTrajectory::new(id, planned),
+            mission: x.mission.clone(),
+            vehicle: id.clone(),
             scenario_toml: scenario_toml.to_string(),
             epoch_unix_ms: x.mission_clock.epoch_unix_ms,
             time_scale: o.time_scale,
             telemetry_hz: o.telemetry_hz,
             seed: o.seed.wrapping_add(i as u64),
         },
-        resend::Repeated::Update => CoordinatorToAgent::Update {
-            trajectory: WireTrajectory::new(&v.id, &v.plan),
-            mission,
-            vehicle,
-            revision: v.revision,
-        },
-        resend::Repeated::Hold => CoordinatorToAgent::Hold {
-            mission,
-            vehicle,
-            reason: "told to hold before its first report".to_string(),
-        },
+        resend::Repeated::Update => x.update_of(i),
+        resend::Repeated::Hold => x.hold_of(i, "told to hold before its first report"),
     }
 }

@@ -25,8 +25,6 @@ use std::time::{Duration, Instant};
 use shoal_common::geometry::Vec3;
 use shoal_common::scenario::Scenario;
 use shoal_common::trajectory::Trajectory;
-use shoal_common::wire::coordinator_to_agent::CoordinatorToAgent;
-use shoal_common::wire::WireTrajectory;
 
 use super::lead::{course_conflict, course_enters_obstacle, enters_any, update_lead_s};
 use super::log::EVENT_HOLD;
@@ -281,7 +279,7 @@ impl ReplanStart {
         ReplanStart {
             p0,
             heading,
-            resume_s: v.resume_s().filter(|_| standing),
+            resume_s: if standing { v.resume_s() } else { None },
             standing,
         }
     }
@@ -340,20 +338,12 @@ fn apply(x: &mut Exec, u: UnderWay, result: Replanned) {
             v.plan
                 .followed_by(&u.course.followed_by(&result.trajectory))
         };
-        v.plan = plan.clone();
+        v.plan = plan;
         v.revision = x.revision;
         v.holding = false;
         v.held_since_s = None;
         v.held_at = None;
-        x.send(
-            &id,
-            CoordinatorToAgent::Update {
-                mission: x.mission.clone(),
-                vehicle: id.clone(),
-                revision: x.revision,
-                trajectory: WireTrajectory::new(&id, &plan),
-            },
-        );
+        x.send(&id, x.update_of(i));
         x.pending[i] = Some((x.revision, Instant::now()));
         x.replans += 1;
         if let Some(received) = u.asked.obstacle_received {
@@ -412,14 +402,7 @@ fn told_retry(n: u32) -> bool {
 /// Commands vehicle `i` to hold where it is (obeyed at once) and says why.
 fn hold(x: &mut Exec, i: usize, why: &str, detail: String) {
     let id = x.fleet.vehicles[i].id.clone();
-    x.send(
-        &id,
-        CoordinatorToAgent::Hold {
-            mission: x.mission.clone(),
-            vehicle: id.clone(),
-            reason: why.to_string(),
-        },
-    );
+    x.send(&id, x.hold_of(i, why));
     let now = x.clock();
     x.fleet.vehicles[i].holding = true;
     x.fleet.vehicles[i].held_since_s = Some(now);

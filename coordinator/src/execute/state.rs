@@ -153,6 +153,26 @@ impl Exec<'_> {
         self.fleet.status(&self.mission, self.clock())
     }
 
+    /// Vehicle `i`'s plan as the coordinator has it, as an update: its revision and trajectory.
+    pub(super) fn update_of(&self, i: usize) -> CoordinatorToAgent {
+        let v = &self.fleet.vehicles[i];
+        CoordinatorToAgent::Update {
+            mission: self.mission.clone(),
+            vehicle: v.id.clone(),
+            revision: v.revision,
+            trajectory: WireTrajectory::new(&v.id, &v.plan),
+        }
+    }
+
+    /// A hold for vehicle `i`, for `reason`.
+    pub(super) fn hold_of(&self, i: usize, reason: &str) -> CoordinatorToAgent {
+        CoordinatorToAgent::Hold {
+            mission: self.mission.clone(),
+            vehicle: self.fleet.vehicles[i].id.clone(),
+            reason: reason.to_string(),
+        }
+    }
+
     pub(super) fn send(&self, vehicle: &str, m: CoordinatorToAgent) {
         if let Err(e) = self.session.net.send(vehicle, m) {
             tracing::warn!("cannot send to {vehicle}: {e:#}");
