@@ -9,7 +9,10 @@
 //! than `reach` at some instant are, at that instant, inside their boxes of the same slab, so
 //! those boxes are closer than `reach`: a pair none of whose slab boxes come that close can be
 //! skipped without changing any term, which is what the property test below checks against all
-//! pairs. Within a slab a sweep and prune along the axis the boxes spread most over (Baraff
+//! pairs. Boxes of vehicles that move together overlap although the vehicles keep apart (one
+//! behind the other on a track, or side by side on parallel courses), so a pair whose boxes
+//! are near is tested again on its relative motion: each vehicle's straight run across the
+//! slab and how far it strays from it ([`SlabBoxes::chords_within`]). Within a slab a sweep and prune along the axis the boxes spread most over (Baraff
 //! 1992, "Dynamic simulation of non-penetrating rigid bodies", §6) finds the close boxes in
 //! `O(n log n)` rather than testing all `n²/2` pairs. Hand-written: the crates that do this
 //! (`parry`'s BVH, `broccoli`) index static shapes and allocate per query; this reuses its
@@ -17,7 +20,10 @@
 
 use crate::geometry::Vec3;
 
+mod pairs;
 pub mod spheres;
+
+pub use pairs::{PairSet, SlabMask};
 
 /// Time slabs per mission. More slabs give smaller boxes (fewer pairs survive) but more boxes
 /// to build and sort; 16 slabs of a one-hour mission keep a box under 350 m along a 3-knot
@@ -35,6 +41,13 @@ pub struct SlabBoxes {
     lo: Vec<Vec3>,
     /// Upper corners, in the same order.
     hi: Vec<Vec3>,
+    /// Positions at the slabs' bounds, vehicle-major: vehicle `v` at time `k * slab` at
+    /// `v * (SLABS + 1) + k` (the last at the horizon): the ends of each slab's chord.
+    bounds: Vec<Vec3>,
+    /// How far each slab's positions stray from its chord (the straight run between its bound
+    /// positions at constant speed), in the order of `lo`; infinite when the vehicle moves past
+    /// the horizon, where the last slab has no chord.
+    stray: Vec<f64>,
     /// One slab's boxes in sweep order, reused: contiguous, so the sweep reads no strided
     /// memory, and kept in the previous slab's order, which the next slab changes little.
     sweep: Vec<SweepBox>,
@@ -80,6 +93,8 @@ impl SlabBoxes {
         };
         self.lo.clear();
         self.hi.clear();
+        self.bounds.clear();
+        self.stray.clear();
     }
 
     /// Vehicles added so far.
@@ -101,39 +116,77 @@ impl SlabBoxes {
             let far = Vec3::repeat(f64::INFINITY);
             self.lo.extend(std::iter::repeat_n(far, SLABS));
             self.hi.extend(std::iter::repeat_n(far, SLABS));
+            self.bounds.extend(std::iter::repeat_n(far, SLABS + 1));
+            self.stray.extend(std::iter::repeat_n(f64::INFINITY, SLABS));
             return;
         }
         let slab = self.horizon / SLABS as f64;
+        let per_slab = 1.0 / slab;
+        let arrival = times[n - 1];
         let mut seg = 0usize;
         let mut start = position(times, points, &mut seg, 0.0);
-        self.lo.reserve(SLABS);
-        self.hi.reserve(SLABS);
+        self.bounds.push(start);
+        // Slab 0's samples start at the first: a chain of samples at t = 0 the start position
+        // skipped (the separation counts them).
+        let mut first = 0usize;
         for k in 0..SLABS {
+            let t0 = k as f64 * slab;
             let t1 = if k + 1 == SLABS {
                 f64::INFINITY
             } else {
                 (k + 1) as f64 * slab
             };
-            let (mut lo, mut hi) = (start, start);
-            if k == 0 {
-                // The samples at t = 0 the start position skipped (the separation counts them).
-                for p in &points[..=seg] {
-                    lo = lo.inf(p);
-                    hi = hi.sup(p);
-                }
-            }
             // Every sample up to and including t1 (a chain of samples at one instant too).
             while seg + 1 < n && times[seg + 1] <= t1 {
                 seg += 1;
-                lo = lo.inf(&points[seg]);
-                hi = hi.sup(&points[seg]);
             }
             // `seg` is now the last sample at or before t1.
             let end = position_on_leg(times, points, seg, t1);
-            self.lo.push(lo.inf(&end));
-            self.hi.push(hi.sup(&end));
+            let (mut lo, mut hi) = (start.inf(&end), start.sup(&end));
+            // The positions minus the chord are piecewise linear in time with corners only at
+            // the samples, so the farthest a slab strays from its chord is at one of them.
+            let run = end - start;
+            let mut stray2 = 0.0f64;
+            for (t, p) in times[first..=seg].iter().zip(&points[first..=seg]) {
+                lo = lo.inf(p);
+                hi = hi.sup(p);
+                let off = (p - start - run * ((t - t0) * per_slab)).norm_squared();
+                // (A NaN sample is ignored here as by `f64::max`: its box is never near.)
+                if off > stray2 {
+                    stray2 = off;
+                }
+            }
+            self.lo.push(lo);
+            self.hi.push(hi);
+            self.bounds.push(end);
+            // The last slab's chord ends at the horizon: past it, one that still moves has none.
+            let past_horizon = k + 1 == SLABS && arrival > self.horizon;
+            self.stray.push(if past_horizon {
+                f64::INFINITY
+            } else {
+                stray2.sqrt()
+            });
+            first = seg + 1;
             start = end;
         }
+    }
+
+    /// Whether vehicle `a` of `self` and vehicle `b` of `other` may come closer than `reach`
+    /// in slab `k` by their chords: at every instant of the slab each lies within its stray of
+    /// its chord, and the two chords run over the same times, so the pair's relative position
+    /// lies within the sum of the strays of the straight run between its values at the slab's
+    /// bounds; a run that passes farther than `reach` plus that sum from the origin proves the
+    /// pair apart (the moving-sphere test of Ericson 2005, "Real-Time Collision Detection",
+    /// §5.5.7, on the relative motion). Two boxes that overlap because both vehicles sweep the
+    /// same stretch of sea one after the other, or side by side, are told apart by it.
+    #[inline]
+    fn chords_within(&self, a: usize, other: &SlabBoxes, b: usize, k: usize, reach: f64) -> bool {
+        let slack = self.stray[a * SLABS + k] + other.stray[b * SLABS + k];
+        let (i, j) = (a * (SLABS + 1) + k, b * (SLABS + 1) + k);
+        let d0 = other.bounds[j] - self.bounds[i];
+        let d1 = other.bounds[j + 1] - self.bounds[i + 1];
+        // Kept unless provably apart: every comparison with a NaN or an infinite stray is false.
+        !run_apart(&d0, &d1, reach + slack + REACH_GUARD_M)
     }
 
     /// Whether vehicles `a` and `b` have boxes of some slab closer than `reach`: false proves
@@ -184,6 +237,7 @@ impl SlabBoxes {
             .filter(|&k| {
                 let (i, j) = (a * SLABS + k, b * SLABS + k);
                 gap2(&self.lo[i], &self.hi[i], &other.lo[j], &other.hi[j]) < r2
+                    && self.chords_within(a, other, b, k, reach)
             })
             .fold(0, |m, k| m | 1 << k)
     }
@@ -227,7 +281,9 @@ impl SlabBoxes {
                     if b.lo[axis] >= limit {
                         break;
                     }
-                    if sweep_gap2(a, b) < r2 {
+                    if sweep_gap2(a, b) < r2
+                        && self.chords_within(a.v as usize, self, b.v as usize, k, reach)
+                    {
                         pairs.mark(a.v as usize, b.v as usize, k);
                     }
                 }
@@ -278,6 +334,24 @@ pub fn boxes_within(a: &(Vec3, Vec3), b: &(Vec3, Vec3), reach: f64) -> bool {
 /// positions with other roundings, so a pair whose closest approach is `reach` to the last
 /// bit is kept rather than pruned.
 const REACH_GUARD_M: f64 = 1e-6;
+
+/// Whether the straight run from `d0` to `d1` passes at least `limit` from the origin, without
+/// a division (the closest point's parameter is a ratio, compared here multiplied out).
+#[inline]
+fn run_apart(d0: &Vec3, d1: &Vec3, limit: f64) -> bool {
+    let limit2 = limit * limit;
+    let step = d1 - d0;
+    let along = d0.dot(&step);
+    if along >= 0.0 {
+        return d0.norm_squared() >= limit2;
+    }
+    if d1.dot(&step) <= 0.0 {
+        return d1.norm_squared() >= limit2;
+    }
+    // The closest point is inside: |d0|² − along² / |step|² ≥ limit², times |step|² > 0.
+    let len2 = step.norm_squared();
+    d0.norm_squared() * len2 - along * along >= limit2 * len2
+}
 
 /// `(reach + guard)²`.
 fn guarded2(reach: f64) -> f64 {
@@ -417,96 +491,14 @@ impl SlabIndex {
                     break;
                 }
                 let j = other as usize * SLABS + k;
-                if !near[other as usize] && gap2(lo, hi, &indexed.lo[j], &indexed.hi[j]) < r2 {
+                if !near[other as usize]
+                    && gap2(lo, hi, &indexed.lo[j], &indexed.hi[j]) < r2
+                    && own.chords_within(v, indexed, other as usize, k, reach)
+                {
                     near[other as usize] = true;
                 }
             }
         }
-    }
-}
-
-/// The slabs a pair's boxes come near in: bit `k` for slab `k`.
-pub type SlabMask = u32;
-
-const _: () = assert!(SLABS <= SlabMask::BITS as usize);
-
-/// A set of vehicle pairs `(i, j)`, `i < j`, each with the slabs it was found in: one bit per
-/// ordered pair, so inserting is a bit set whatever the slab that found it, and iterating goes
-/// in row order `(0, 1), (0, 2), …`, the order the all-pairs loop sums in, so the fitness is the
-/// same to the last bit.
-#[derive(Debug, Clone, Default)]
-pub struct PairSet {
-    /// Vehicles.
-    n: usize,
-    /// Bit `i * n + j`.
-    words: Vec<u64>,
-    /// The pair's slabs at `i * n + j`.
-    slabs: Vec<SlabMask>,
-}
-
-impl PairSet {
-    /// Empty.
-    pub fn new() -> PairSet {
-        PairSet::default()
-    }
-
-    /// Clears the set for `n` vehicles, keeping its buffers.
-    pub fn reset(&mut self, n: usize) {
-        self.n = n;
-        self.words.clear();
-        self.words.resize((n * n).div_ceil(64), 0);
-        self.slabs.clear();
-        self.slabs.resize(n * n, 0);
-    }
-
-    /// The index of the pair of `a` and `b` (in either order), or `None` for `a == b` or a
-    /// vehicle out of range.
-    fn index(&self, a: usize, b: usize) -> Option<usize> {
-        let (i, j) = (a.min(b), a.max(b));
-        (i != j && j < self.n).then_some(i * self.n + j)
-    }
-
-    /// Marks the pair of `a` and `b` (in either order; `a == b` is ignored).
-    pub fn insert(&mut self, a: usize, b: usize) {
-        if let Some(bit) = self.index(a, b) {
-            self.words[bit / 64] |= 1 << (bit % 64);
-        }
-    }
-
-    /// Marks the pair of `a` and `b` as near in slab `k`.
-    pub fn mark(&mut self, a: usize, b: usize, k: usize) {
-        if let Some(bit) = self.index(a, b) {
-            self.words[bit / 64] |= 1 << (bit % 64);
-            self.slabs[bit] |= 1 << (k % SLABS);
-        }
-    }
-
-    /// Whether the pair of `a` and `b` is marked.
-    pub fn contains(&self, a: usize, b: usize) -> bool {
-        self.index(a, b)
-            .is_some_and(|bit| self.words[bit / 64] & (1 << (bit % 64)) != 0)
-    }
-
-    /// The slabs the pair of `a` and `b` was marked in (none for a pair only inserted).
-    pub fn slabs(&self, a: usize, b: usize) -> SlabMask {
-        self.index(a, b).map_or(0, |bit| self.slabs[bit])
-    }
-
-    /// The marked pairs in row order.
-    pub fn iter(&self) -> impl Iterator<Item = (usize, usize)> + '_ {
-        let n = self.n.max(1);
-        self.words.iter().enumerate().flat_map(move |(w, &word)| {
-            let mut rest = word;
-            std::iter::from_fn(move || {
-                if rest == 0 {
-                    return None;
-                }
-                let b = rest.trailing_zeros() as usize;
-                rest &= rest - 1;
-                let bit = w * 64 + b;
-                Some((bit / n, bit % n))
-            })
-        })
     }
 }
 

@@ -1,5 +1,5 @@
 use super::*;
-use crate::separation::pair_separation;
+use crate::separation::{closest_within, pair_separation, Motion};
 use crate::trajectory::Trajectory;
 use approx::assert_abs_diff_eq;
 use proptest::prelude::*;
@@ -68,21 +68,81 @@ fn parallel_tracks_are_near_only_within_their_spacing() {
 fn tracks_that_cross_at_different_times_are_pruned() {
     // A runs east along y = 0 at 1 m/s; B leaves (160, 0) at t = 0 northwards at 1 m/s. The
     // tracks cross at (160, 0), but A gets there 160 s after B left: the closest approach is
-    // 80·√2 = 113.1 m at t = 80 s, and the 10 s boxes come no closer than √(80² + 70²) = 106.3 m
-    // (the last slab's, from 150 s on, are 150 m apart).
+    // 80·√2 = 113.1 m at t = 80 s. The 10 s boxes come within √(80² + 70²) = 106.3 m (slab 7),
+    // but both tracks are straight, so their chords are the tracks themselves and prune the
+    // pair up to its exact closest approach.
     let fleet = [
         line(0.0, [0., 0., 0.], 320.0, [320., 0., 0.]),
         line(0.0, [160., 0., 0.], 320.0, [160., 320., 0.]),
     ];
+    let closest = 80.0 * 2f64.sqrt();
     assert_abs_diff_eq!(
         pair_separation(&fleet[0], &fleet[1], 50.0).min_distance,
-        80.0 * 2f64.sqrt(),
+        closest,
         epsilon = 1e-9
     );
     let b = boxes_of(TEN_SECOND_SLABS, &fleet);
     assert!(!b.near(0, 1, 50.0));
-    assert!(!b.near(0, 1, 106.2));
-    assert!(b.near(0, 1, 106.4));
+    assert!(!b.near(0, 1, 106.4));
+    assert!(!b.near(0, 1, closest - 1e-3));
+    assert!(b.near(0, 1, closest + 1e-3));
+    // Only the two slabs that meet at the closest approach (t = 80 s) keep them.
+    assert_eq!(b.near_slabs(0, 1, closest + 1e-3), 0b11 << 7);
+}
+
+#[test]
+fn one_vehicle_following_another_is_pruned_by_the_chords_by_hand() {
+    // B follows A along the x axis 15 m behind, both at 1 m/s for 20 s: their boxes of slab 0
+    // ([0, 20] and [−15, 5] along x) overlap, but the pair is 15 m apart at every instant,
+    // which the chords (straight, so without stray) see.
+    let slab = 20.0;
+    let fleet = [
+        line(0.0, [0., 0., 0.], slab, [20., 0., 0.]),
+        line(0.0, [-15., 0., 0.], slab, [5., 0., 0.]),
+    ];
+    let b = boxes_of(slab * SLABS as f64, &fleet);
+    let r2 = guarded2(14.0);
+    assert!(gap2(&b.lo[0], &b.hi[0], &b.lo[SLABS], &b.hi[SLABS]) < r2);
+    assert!(!b.near(0, 1, 14.0));
+    assert!(b.near(0, 1, 15.1));
+    assert_eq!(
+        b.near_slabs(0, 1, 15.1),
+        !0 >> (SlabMask::BITS as usize - SLABS)
+    );
+}
+
+#[test]
+fn a_bent_track_strays_from_its_chord_by_hand() {
+    // In slab 0 (20 s) the track goes out to (10, 10) and back to the x axis at (20, 0): its
+    // chord runs from (0, 0) to (20, 0) at 1 m/s, so at t = 10 s it strays 10 m. Another
+    // vehicle holding at (10, 25) is 15 m from the track's nearest point, and 25 m from the
+    // chord: the pair is near for a reach above 15 m only.
+    let slab = 20.0;
+    let bent = Trajectory {
+        times: vec![0.0, 10.0, slab],
+        points: vec![
+            Vec3::new(0., 0., 0.),
+            Vec3::new(10., 10., 0.),
+            Vec3::new(20., 0., 0.),
+        ],
+    };
+    let still = line(0.0, [10., 25., 0.], slab, [10., 25., 0.]);
+    let b = boxes_of(slab * SLABS as f64, &[bent, still]);
+    assert_abs_diff_eq!(b.stray[0], 10.0, epsilon = 1e-12);
+    assert_abs_diff_eq!(b.stray[1], 0.0, epsilon = 1e-12);
+    assert_abs_diff_eq!(b.stray[SLABS], 0.0, epsilon = 1e-12);
+    assert!(!b.near(0, 1, 14.9));
+    assert!(b.near(0, 1, 15.1));
+}
+
+#[test]
+fn a_vehicle_still_moving_past_the_horizon_has_no_last_chord() {
+    // The horizon is half the trajectory: the last slab holds everything after it, which no
+    // chord spans, so its stray is infinite and only its box decides.
+    let fleet = [line(0.0, [0., 0., 0.], 320.0, [320., 0., 0.])];
+    let b = boxes_of(160.0, &fleet);
+    assert!(b.stray[SLABS - 1].is_infinite());
+    assert!(b.stray[..SLABS - 1].iter().all(|s| *s < 1e-9));
 }
 
 #[test]
@@ -192,6 +252,15 @@ proptest! {
                 if !pairs.contains(i, j) {
                     prop_assert!(exact.min_distance >= d_min, "{} {} {}", i, j, exact.min_distance);
                     prop_assert_eq!(exact.breach_s, 0.0);
+                }
+                // Each slab left out is one in which the pair stays d_min apart throughout.
+                let (a, c) = (Motion::new(&fleet[i]), Motion::new(&fleet[j]));
+                let mask = pairs.slabs(i, j);
+                let mut apart = Vec::new();
+                b.windows(!mask & (!0 >> (SlabMask::BITS as usize - SLABS)), &mut apart);
+                for (from, to) in apart {
+                    let closest = closest_within(&a, &c, from, to);
+                    prop_assert!(closest >= d_min - 1e-6, "{} {} [{}, {}]: {}", i, j, from, to, closest);
                 }
             }
         }
