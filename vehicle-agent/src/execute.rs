@@ -17,7 +17,7 @@ use shoal_common::wire::open::{Telemetry, OPEN_VERSION};
 use shoal_common::wire::WireTrajectory;
 
 use crate::assignment::{parse_for, MissionReport, Unusable};
-use crate::link::{LinkError, VehicleLink};
+use crate::link::{CommandSerial, LinkError, VehicleLink};
 
 /// An `Execute` order, checked.
 #[derive(Debug, Clone)]
@@ -81,6 +81,9 @@ impl Order {
 pub const STOP_WAIT: Duration = Duration::from_secs(10);
 /// The same for the hold an agent gives its vehicle when it shuts down.
 pub const SHUTDOWN_WAIT: Duration = Duration::from_secs(3);
+/// Most uploads remembered while unanswered: a link may drop one a newer command supersedes
+/// (MAVLink gives up an exchange in progress), and such an upload is never answered.
+const UNANSWERED_UPLOADS: usize = 8;
 
 /// One execution under way: the order, the link, and what has been reported.
 struct Driver<'a> {
@@ -89,11 +92,14 @@ struct Driver<'a> {
     publish: &'a dyn Fn(&Telemetry),
     /// Next report number.
     seq: u64,
-    /// Revision of the plan the vehicle confirmed, and the one sent to it, if newer.
+    /// Revision of the plan the vehicle confirmed.
     revision: u32,
-    pending_revision: Option<u32>,
+    /// Uploads given and not answered yet, oldest first: each one's serial and revision.
+    unanswered: Vec<(CommandSerial, u32)>,
     /// The latest command and what the vehicle made of it, carried in every report.
     command: Option<CommandReport>,
+    /// The latest command's serial (none when it could not be given).
+    latest: Option<CommandSerial>,
     /// When the next periodic report is due.
     next: Instant,
     /// Whether the vehicle last reported itself arrived.
@@ -108,7 +114,7 @@ impl Driver<'_> {
         &mut self,
         command: VehicleCommand,
         plan: Option<&Trajectory>,
-    ) -> Result<(), LinkError> {
+    ) -> Result<CommandSerial, LinkError> {
         let now = self.order.clock.now();
         let given = match (command, plan) {
             (VehicleCommand::Upload, Some(plan)) => self.link.upload(plan),
@@ -116,9 +122,10 @@ impl Driver<'_> {
             _ => self.link.hold(now),
         };
         let (state, detail) = match &given {
-            Ok(()) => (CommandState::Pending, "sent".to_string()),
+            Ok(_) => (CommandState::Pending, "sent".to_string()),
             Err(e) => (CommandState::GaveUp, format!("not given: {e}")),
         };
+        self.latest = given.as_ref().ok().copied();
         self.command = Some(CommandReport {
             command,
             state,
@@ -128,24 +135,43 @@ impl Driver<'_> {
         given
     }
 
+    /// Gives the plan of `revision` to the vehicle, remembering which upload carries it.
+    fn upload(&mut self, plan: &Trajectory, revision: u32) -> Result<(), LinkError> {
+        let serial = self.give(VehicleCommand::Upload, Some(plan))?;
+        if self.unanswered.len() >= UNANSWERED_UPLOADS {
+            self.unanswered.remove(0);
+        }
+        self.unanswered.push((serial, revision));
+        Ok(())
+    }
+
+    /// The revision an upload's answer settles: a confirmed upload's plan is the vehicle's,
+    /// whatever was given since (a hold given after it holds on it). A link answers in the
+    /// order it was given, so the uploads before it are forgotten. Whether it is news.
+    fn settle_upload(&mut self, serial: CommandSerial, confirmed: bool) -> bool {
+        let Some(k) = self.unanswered.iter().position(|(s, _)| *s == serial) else {
+            return false;
+        };
+        let (_, revision) = self.unanswered[k];
+        self.unanswered.drain(..=k);
+        let news = confirmed && revision > self.revision;
+        if news {
+            self.revision = revision;
+        }
+        news
+    }
+
     /// Takes what the vehicle made of the commands, reporting each change at once (a refusal
     /// and the fallback's confirmation a few milliseconds later are two reports).
     fn collect(&mut self) {
         for outcome in self.link.outcomes() {
-            let uploaded = outcome.command == VehicleCommand::Upload
-                && outcome.state == CommandState::Confirmed;
-            if uploaded {
-                // The vehicle has the plan, whatever was given since: a hold given after the
-                // upload holds on it, and the reports' revision must say which plan that is.
-                self.revision = self.pending_revision.take().unwrap_or(self.revision);
-            }
-            let Some(report) = self
-                .command
-                .as_mut()
-                .filter(|c| c.command == outcome.command)
-            else {
+            let new_revision = outcome.command == VehicleCommand::Upload
+                && outcome.is_final()
+                && self.settle_upload(outcome.serial, outcome.state == CommandState::Confirmed);
+            let latest = self.latest == Some(outcome.serial);
+            let Some(report) = self.command.as_mut().filter(|_| latest) else {
                 // Of a command given before the latest one: only a new revision is news.
-                if uploaded {
+                if new_revision {
                     self.report();
                 }
                 continue;
@@ -224,10 +250,10 @@ impl Driver<'_> {
                 revision: r,
                 trajectory: t,
                 ..
-            } if r > self.revision && self.pending_revision.is_none_or(|p| r > p) => {
+            } if r > self.revision && self.unanswered.last().is_none_or(|&(_, p)| r > p) => {
                 match t.checked() {
-                    Ok(plan) => match self.give(VehicleCommand::Upload, Some(&plan)) {
-                        Ok(()) => self.pending_revision = Some(r),
+                    Ok(plan) => match self.upload(&plan, r) {
+                        Ok(()) => {}
                         Err(e) => {
                             tracing::warn!("mission {mission}: revision {r}: {e}");
                             self.report();
@@ -246,7 +272,7 @@ impl Driver<'_> {
             CoordinatorToAgent::Stop { reason, .. } => {
                 let given = self.give(VehicleCommand::Stop, None);
                 let stopped = match given {
-                    Ok(()) => self.settle(STOP_WAIT),
+                    Ok(_) => self.settle(STOP_WAIT),
                     Err(e) => format!("not given: {e}"),
                 };
                 return Some(format!("stopped: {reason}{}", suffix(&stopped)));
@@ -259,7 +285,7 @@ impl Driver<'_> {
     /// Holds the vehicle as the agent leaves, waiting a little for it to confirm.
     fn leave(&mut self) -> String {
         let held = match self.give(VehicleCommand::Hold, None) {
-            Ok(()) => self.settle(SHUTDOWN_WAIT),
+            Ok(_) => self.settle(SHUTDOWN_WAIT),
             Err(e) => format!("not given: {e}"),
         };
         format!(
@@ -296,12 +322,13 @@ pub fn run(
         publish,
         seq: 0,
         revision: 0,
-        pending_revision: None,
+        unanswered: Vec::new(),
         command: None,
+        latest: None,
         arrived: false,
     };
     let plan = d.order.plan.clone();
-    if let Err(e) = d.give(VehicleCommand::Upload, Some(&plan)) {
+    if let Err(e) = d.upload(&plan, 0) {
         return MissionReport {
             iterations: 0,
             elites_sent: 0,

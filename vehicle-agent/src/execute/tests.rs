@@ -1,7 +1,7 @@
 //! The execution loop driven against a link that records what it is asked (and can fail).
 
 use super::*;
-use crate::link::{LinkError, LinkOutcome};
+use crate::link::{CommandSerial, LinkError, LinkOutcome};
 use shoal_common::execution::VehicleState;
 use shoal_common::geometry::Vec3;
 use std::sync::mpsc;
@@ -17,18 +17,28 @@ struct Recorder {
     /// An update's upload (not the mission's first) is confirmed only once another command
     /// was given after it, as over a link whose vehicle answers after the agent's next order.
     uploads_answer_late: bool,
+    /// The serials of the commands the vehicle gives up (the others it confirms).
+    gives_up: Vec<CommandSerial>,
+}
+
+impl Recorder {
+    /// Records a command given; its serial (the commands given so far).
+    fn record(&self, call: String) -> Result<CommandSerial, LinkError> {
+        let mut calls = self
+            .calls
+            .lock()
+            .map_err(|e| LinkError::Io(e.to_string()))?;
+        calls.push(call);
+        Ok(calls.len() as CommandSerial)
+    }
 }
 
 impl VehicleLink for Recorder {
     fn name(&self) -> String {
         "recorder".into()
     }
-    fn upload(&mut self, plan: &Trajectory) -> Result<(), LinkError> {
-        self.calls
-            .lock()
-            .map_err(|e| LinkError::Io(e.to_string()))?
-            .push(format!("upload {}", plan.times.len()));
-        Ok(())
+    fn upload(&mut self, plan: &Trajectory) -> Result<CommandSerial, LinkError> {
+        self.record(format!("upload {}", plan.times.len()))
     }
     fn state(&mut self, now: f64) -> Result<VehicleState, LinkError> {
         Ok(VehicleState {
@@ -43,25 +53,17 @@ impl VehicleLink for Recorder {
             arrived_s: None,
         })
     }
-    fn hold(&mut self, _now: f64) -> Result<(), LinkError> {
+    fn hold(&mut self, _now: f64) -> Result<CommandSerial, LinkError> {
         if self.holds_fail {
             return Err(LinkError::Io("link down".into()));
         }
-        self.calls
-            .lock()
-            .map_err(|e| LinkError::Io(e.to_string()))?
-            .push("hold".into());
-        Ok(())
+        self.record("hold".into())
     }
-    fn stop(&mut self) -> Result<(), LinkError> {
-        self.calls
-            .lock()
-            .map_err(|e| LinkError::Io(e.to_string()))?
-            .push("stop".into());
-        Ok(())
+    fn stop(&mut self) -> Result<CommandSerial, LinkError> {
+        self.record("stop".into())
     }
-    /// Every command confirmed at once, as a simulator does (an update's upload, with
-    /// `uploads_answer_late`, only once a command follows it).
+    /// Every command answered at once, as a simulator does (an update's upload, with
+    /// `uploads_answer_late`, only once a command follows it), in the order given.
     fn outcomes(&mut self) -> Vec<LinkOutcome> {
         let mut calls = self.calls.lock().map(|c| c.clone()).unwrap_or_default();
         let update_last = calls.len() > 1 && calls.last().is_some_and(|c| c.starts_with("upload"));
@@ -69,15 +71,22 @@ impl VehicleLink for Recorder {
             calls.pop();
         }
         let mut seen = self.confirmed.lock().map(|n| *n).unwrap_or(0);
-        let done = calls[seen.min(calls.len())..]
+        let done = calls
             .iter()
-            .map(|c| {
+            .enumerate()
+            .skip(seen)
+            .map(|(k, c)| {
                 let command = match c.as_str() {
                     "hold" => VehicleCommand::Hold,
                     "stop" => VehicleCommand::Stop,
                     _ => VehicleCommand::Upload,
                 };
-                LinkOutcome::confirmed(command, c.clone())
+                let serial = k as CommandSerial + 1;
+                let mut outcome = LinkOutcome::confirmed(serial, command, c.clone());
+                if self.gives_up.contains(&serial) {
+                    outcome.state = CommandState::GaveUp;
+                }
+                outcome
             })
             .collect();
         seen = calls.len();
@@ -307,4 +316,53 @@ fn a_plan_confirmed_after_a_later_hold_is_the_revision_reported() {
     };
     assert_eq!(held.revision, 3, "{held:?}");
     assert_eq!(sent.last().map(|t| t.revision), Some(3));
+}
+
+/// An update of auv1's plan to `revision`.
+fn update(revision: u32) -> CoordinatorToAgent {
+    let traj = Trajectory {
+        times: vec![5.0, 20.0],
+        points: vec![Vec3::zeros(); 2],
+    };
+    CoordinatorToAgent::Update {
+        mission: "m".into(),
+        vehicle: "auv1".into(),
+        revision,
+        trajectory: WireTrajectory::new("auv1", &traj),
+    }
+}
+
+#[test]
+fn of_two_quick_updates_the_first_answered_is_the_revision_reported() {
+    // Updates 3 and 4 come at once; the vehicle answers the upload of 3 only once 4 is given,
+    // and the upload of 4 only once the stop is: the reports go 0, 3, 4, and 4 only with the
+    // stop (the answer to the upload of 3 is not the vehicle taking 4).
+    let mut link = Recorder {
+        uploads_answer_late: true,
+        ..Recorder::default()
+    };
+    let sent = run_to_the_stop(&mut link, vec![update(3), update(4)]);
+    let revisions: Vec<u32> = sent.iter().map(|t| t.revision).collect();
+    assert!(revisions.windows(2).all(|w| w[0] <= w[1]), "{revisions:?}");
+    assert!(revisions.contains(&3), "{revisions:?}");
+    let first_4 = sent.iter().find(|t| t.revision == 4);
+    let stop_given = first_4
+        .and_then(|t| t.command.as_ref())
+        .is_some_and(|c| c.command == VehicleCommand::Stop);
+    assert!(stop_given, "{sent:?}");
+}
+
+#[test]
+fn an_update_the_vehicle_gives_up_leaves_the_revision_it_confirmed() {
+    // As above, but the vehicle gives up the upload of 4 (the link's third command): it
+    // drives 3, and the reports never say 4.
+    let mut link = Recorder {
+        uploads_answer_late: true,
+        gives_up: vec![3],
+        ..Recorder::default()
+    };
+    let sent = run_to_the_stop(&mut link, vec![update(3), update(4)]);
+    let revisions: Vec<u32> = sent.iter().map(|t| t.revision).collect();
+    assert_eq!(revisions.last(), Some(&3), "{revisions:?}");
+    assert!(!revisions.contains(&4), "{revisions:?}");
 }

@@ -16,7 +16,9 @@ pub mod sim;
 mod types;
 
 use shoal_common::scenario::Scenario;
-pub use types::{LinkError, LinkKind, LinkOutcome, LinkSettings, MavlinkSettings, VehicleLink};
+pub use types::{
+    CommandSerial, LinkError, LinkKind, LinkOutcome, LinkSettings, MavlinkSettings, VehicleLink,
+};
 
 /// The origin a mission is flown on: the agent's and the scenario's, which must agree (to
 /// 1e-7° ≈ 1 cm and 1 cm in altitude) when both are given; one of them is needed.

@@ -11,7 +11,7 @@ use shoal_common::execution::{VehicleCommand, VehicleState};
 use shoal_common::scenario::{Scenario, VehicleKind};
 use shoal_common::trajectory::Trajectory;
 
-use super::types::{LinkError, LinkOutcome, VehicleLink};
+use super::types::{CommandSerial, LinkError, LinkOutcome, VehicleLink};
 
 /// A simulated vehicle.
 pub struct SimLink {
@@ -19,6 +19,8 @@ pub struct SimLink {
     kind: VehicleKind,
     /// Commands done and not yet collected: a simulator confirms each at once.
     outcomes: Vec<LinkOutcome>,
+    /// Commands given so far: the last one's serial.
+    given: CommandSerial,
 }
 
 impl SimLink {
@@ -82,7 +84,19 @@ impl SimLink {
             sim: Simulator::new(vehicle, model, settings),
             kind: vehicle.kind,
             outcomes: Vec::new(),
+            given: 0,
         })
+    }
+}
+
+impl SimLink {
+    /// A command just done: its outcome, confirmed, kept for collection; its serial.
+    fn done(&mut self, command: VehicleCommand, detail: &str) -> CommandSerial {
+        self.given += 1;
+        let serial = self.given;
+        self.outcomes
+            .push(LinkOutcome::confirmed(serial, command, detail));
+        serial
     }
 }
 
@@ -103,7 +117,7 @@ impl VehicleLink for SimLink {
         format!("sim ({:?})", self.kind).to_lowercase()
     }
 
-    fn upload(&mut self, plan: &Trajectory) -> Result<(), LinkError> {
+    fn upload(&mut self, plan: &Trajectory) -> Result<CommandSerial, LinkError> {
         if plan.times.is_empty() || plan.times.len() != plan.points.len() {
             return Err(LinkError::Refused(format!(
                 "a trajectory of {} times and {} points",
@@ -112,9 +126,7 @@ impl VehicleLink for SimLink {
             )));
         }
         self.sim.load(plan.clone());
-        let done = LinkOutcome::confirmed(VehicleCommand::Upload, "simulated: loaded");
-        self.outcomes.push(done);
-        Ok(())
+        Ok(self.done(VehicleCommand::Upload, "simulated: loaded"))
     }
 
     fn state(&mut self, now: f64) -> Result<VehicleState, LinkError> {
@@ -122,19 +134,15 @@ impl VehicleLink for SimLink {
         Ok(self.sim.state())
     }
 
-    fn hold(&mut self, now: f64) -> Result<(), LinkError> {
+    fn hold(&mut self, now: f64) -> Result<CommandSerial, LinkError> {
         self.sim.advance_to(now);
         self.sim.hold();
-        let done = LinkOutcome::confirmed(VehicleCommand::Hold, "simulated: holds");
-        self.outcomes.push(done);
-        Ok(())
+        Ok(self.done(VehicleCommand::Hold, "simulated: holds"))
     }
 
-    fn stop(&mut self) -> Result<(), LinkError> {
+    fn stop(&mut self) -> Result<CommandSerial, LinkError> {
         self.sim.stop();
-        let done = LinkOutcome::confirmed(VehicleCommand::Stop, "simulated: stopped");
-        self.outcomes.push(done);
-        Ok(())
+        Ok(self.done(VehicleCommand::Stop, "simulated: stopped"))
     }
 
     fn outcomes(&mut self) -> Vec<LinkOutcome> {

@@ -27,6 +27,10 @@ pub enum LinkError {
 /// What became of a command the link was given.
 #[derive(Debug, Clone, PartialEq)]
 pub struct LinkOutcome {
+    /// Which giving of it: the serial the link returned when it was given. Two uploads in quick
+    /// succession are told apart by it, so the agent reports the plan the vehicle confirmed,
+    /// not the last one it was sent.
+    pub serial: CommandSerial,
     /// Which command.
     pub command: VehicleCommand,
     /// Confirmed, failed (a fallback follows) or given up.
@@ -37,10 +41,15 @@ pub struct LinkOutcome {
 
 impl LinkOutcome {
     /// A command the vehicle confirmed.
-    pub fn confirmed(command: VehicleCommand, detail: impl Into<String>) -> LinkOutcome {
+    pub fn confirmed(
+        serial: CommandSerial,
+        command: VehicleCommand,
+        detail: impl Into<String>,
+    ) -> LinkOutcome {
         let detail = detail.into();
         let state = CommandState::Confirmed;
         LinkOutcome {
+            serial,
             command,
             state,
             detail,
@@ -53,24 +62,30 @@ impl LinkOutcome {
     }
 }
 
+/// The number a link gives each command it is given, growing from 1: what its outcomes carry.
+pub type CommandSerial = u64;
+
 /// A vehicle as the agent drives it.
 pub trait VehicleLink: Send {
     /// Short name for logs (`sim`, `mavlink udp:…`).
     fn name(&self) -> String;
     /// Starts loading a timed trajectory (mission-timed samples) that the vehicle follows from
-    /// then on, replacing what it followed before (and leaving a hold). Returns at once; an
-    /// error means the command could not even be given (a bad plan, a closed link).
-    fn upload(&mut self, plan: &Trajectory) -> Result<(), LinkError>;
+    /// then on, replacing what it followed before (and leaving a hold). Returns at once, with
+    /// the command's serial; an error means the command could not even be given (a bad plan, a
+    /// closed link).
+    fn upload(&mut self, plan: &Trajectory) -> Result<CommandSerial, LinkError>;
     /// The vehicle's state at mission time `now` (a simulator advances to it; a real vehicle
     /// reports its latest fix, stamped `now`), with the status the vehicle confirmed. Never
     /// waits on a command.
     fn state(&mut self, now: f64) -> Result<VehicleState, LinkError>;
     /// Starts a hold where it is at mission time `now`, until the next upload (a simulator
     /// first drives on to `now`: it is advanced only when asked for its state, up to a report
-    /// interval ago, which is 250 mission seconds at 2 Hz and 500×). Returns at once.
-    fn hold(&mut self, now: f64) -> Result<(), LinkError>;
-    /// Starts a stop: the mission is over for this vehicle. Returns at once.
-    fn stop(&mut self) -> Result<(), LinkError>;
+    /// interval ago, which is 250 mission seconds at 2 Hz and 500×). Returns at once, with the
+    /// command's serial.
+    fn hold(&mut self, now: f64) -> Result<CommandSerial, LinkError>;
+    /// Starts a stop: the mission is over for this vehicle. Returns at once, with the
+    /// command's serial.
+    fn stop(&mut self) -> Result<CommandSerial, LinkError>;
     /// What became of the commands given, since the last call, in order.
     fn outcomes(&mut self) -> Vec<LinkOutcome>;
 }

@@ -131,12 +131,20 @@ impl Commander {
         }
     }
 
-    fn report(&self, command: VehicleCommand, state: CommandState, detail: String, effect: Effect) {
+    fn report(
+        &self,
+        serial: u64,
+        command: VehicleCommand,
+        state: CommandState,
+        detail: String,
+        effect: Effect,
+    ) {
         match state {
             CommandState::Confirmed => tracing::info!("mavlink: {}: {detail}", command.name()),
             _ => tracing::warn!("mavlink: {} {state:?}: {detail}", command.name()),
         }
         let outcome = LinkOutcome {
+            serial,
             command,
             state,
             detail,
@@ -398,11 +406,11 @@ impl Commander {
                     last_item: items.last(),
                     goal,
                 };
-                self.report(upload, CommandState::Confirmed, detail, effect)
+                self.report(generation, upload, CommandState::Confirmed, detail, effect)
             }
             Err(Abort::Failed(e)) => {
                 let why = format!("mission upload: {e}");
-                self.report(upload, CommandState::GaveUp, why, Effect::None)
+                self.report(generation, upload, CommandState::GaveUp, why, Effect::None)
             }
             Err(Abort::Superseded) => {}
         }
@@ -428,6 +436,7 @@ impl Commander {
                 Ok(()) => {
                     let how = format!("{} acknowledged", step.label);
                     return self.report(
+                        generation,
                         command,
                         CommandState::Confirmed,
                         how,
@@ -441,7 +450,7 @@ impl Commander {
                         .get(k + 1)
                         .map_or("a mission ending where it is", |s| &s.label);
                     let why = format!("{}; trying {next}", failures.join("; "));
-                    self.report(command, CommandState::Failed, why, Effect::None);
+                    self.report(generation, command, CommandState::Failed, why, Effect::None);
                 }
             }
         }
@@ -449,6 +458,7 @@ impl Commander {
         let Some(here) = here else {
             failures.push("no position to hold at".into());
             return self.report(
+                generation,
                 command,
                 CommandState::GaveUp,
                 failures.join("; "),
@@ -463,12 +473,19 @@ impl Commander {
                     "by a mission ending where it is ({lat:.7}, {lon:.7}, {alt:.1} m): {detail}; after {}",
                     failures.join("; ")
                 );
-                self.report(command, CommandState::Confirmed, how, Effect::Still(status))
+                self.report(
+                    generation,
+                    command,
+                    CommandState::Confirmed,
+                    how,
+                    Effect::Still(status),
+                )
             }
             Err(Abort::Superseded) => {}
             Err(Abort::Failed(e)) => {
                 failures.push(format!("fallback mission: {e}"));
                 self.report(
+                    generation,
                     command,
                     CommandState::GaveUp,
                     failures.join("; "),

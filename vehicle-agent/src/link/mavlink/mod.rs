@@ -33,7 +33,7 @@ use mavlink::{Connectable, ConnectionAddress, MavConnection, MavHeader, MavlinkV
 use shoal_common::execution::{VehicleCommand, VehicleState, VehicleStatus};
 use shoal_common::trajectory::Trajectory;
 
-use super::types::{LinkError, LinkOutcome, MavlinkSettings, VehicleLink};
+use super::types::{CommandSerial, LinkError, LinkOutcome, MavlinkSettings, VehicleLink};
 pub use commander::FenceSource;
 use commander::{Commander, Done, Effect, Job};
 use reader::{Shared, READ_TICK};
@@ -180,10 +180,13 @@ impl MavlinkLink {
     }
 
     /// Hands `job` to the commander; anything older in progress gives way.
-    fn submit(&mut self, job: Job) -> Result<(), LinkError> {
+    /// Hands `job` to the commander; its serial, the generation that supersedes every job
+    /// before it.
+    fn submit(&mut self, job: Job) -> Result<CommandSerial, LinkError> {
         let generation = self.shared.generation.fetch_add(1, Ordering::Relaxed) + 1;
         self.jobs
             .send((generation, job))
+            .map(|()| generation)
             .map_err(|_| LinkError::Io("the commander thread has ended".into()))
     }
 
@@ -251,7 +254,7 @@ impl VehicleLink for MavlinkLink {
         format!("mavlink {}", self.settings.address)
     }
 
-    fn upload(&mut self, plan: &Trajectory) -> Result<(), LinkError> {
+    fn upload(&mut self, plan: &Trajectory) -> Result<CommandSerial, LinkError> {
         let ok = !plan.times.is_empty()
             && plan.times.len() == plan.points.len()
             && plan.times.iter().all(|t| t.is_finite())
@@ -309,13 +312,13 @@ impl VehicleLink for MavlinkLink {
         })
     }
 
-    fn hold(&mut self, _now: f64) -> Result<(), LinkError> {
+    fn hold(&mut self, _now: f64) -> Result<CommandSerial, LinkError> {
         self.submit(Job::Hold(VehicleCommand::Hold))
     }
 
     /// MAVLink has no "mission over" command short of landing or disarming, which an AUV must
     /// not do unasked: the vehicle holds where it is, and is reported Stopped once it confirms.
-    fn stop(&mut self) -> Result<(), LinkError> {
+    fn stop(&mut self) -> Result<CommandSerial, LinkError> {
         self.submit(Job::Hold(VehicleCommand::Stop))
     }
 
