@@ -69,7 +69,9 @@ impl<'a> Motion<'a> {
     /// [`Motion::velocities_of`] appending the velocities to a buffer the caller reuses;
     /// returns the fastest leg's speed.
     pub fn velocities_into(t: &Trajectory, out: &mut Vec<Vec3>) -> f64 {
-        let mut max_speed = 0.0f64;
+        // The top speed's square root once, not every leg's: the root is monotonic and
+        // correctly rounded, so the result is the same to the last bit.
+        let mut max_speed2 = 0.0f64;
         for (tt, pp) in t.times.windows(2).zip(t.points.windows(2)) {
             let dt = tt[1] - tt[0];
             let v = if dt > 0.0 {
@@ -77,10 +79,10 @@ impl<'a> Motion<'a> {
             } else {
                 Vec3::zeros()
             };
-            max_speed = max_speed.max(v.norm());
+            max_speed2 = max_speed2.max(v.norm_squared());
             out.push(v);
         }
-        max_speed
+        max_speed2.sqrt()
     }
 
     /// Position at `time` on leg `k` (or held at the end when `k` is past the last leg).
