@@ -12,7 +12,7 @@
 //! pairs. Boxes of vehicles that move together overlap although the vehicles keep apart (one
 //! behind the other on a track, or side by side on parallel courses), so a pair whose boxes
 //! are near is tested again on its relative motion: each vehicle's straight run across the
-//! slab and how far it strays from it ([`SlabBoxes::chords_within`]). Within a slab a sweep and prune along the axis the boxes spread most over (Baraff
+//! slab and how far it strays from it. Within a slab a sweep and prune along the axis the boxes spread most over (Baraff
 //! 1992, "Dynamic simulation of non-penetrating rigid bodies", §6) finds the close boxes in
 //! `O(n log n)` rather than testing all `n²/2` pairs. Hand-written: the crates that do this
 //! (`parry`'s BVH, `broccoli`) index static shapes and allocate per query; this reuses its
@@ -24,6 +24,8 @@ mod pairs;
 pub mod spheres;
 
 pub use pairs::{PairSet, SlabMask};
+
+const _: () = assert!(SLABS <= SlabMask::BITS as usize);
 
 /// Time slabs per mission. More slabs give smaller boxes (fewer pairs survive) but more boxes
 /// to build and sort; 16 slabs of a one-hour mission keep a box under 350 m along a 3-knot
@@ -42,7 +44,9 @@ pub struct SlabBoxes {
     /// Upper corners, in the same order.
     hi: Vec<Vec3>,
     /// Positions at the slabs' bounds, vehicle-major: vehicle `v` at time `k * slab` at
-    /// `v * (SLABS + 1) + k` (the last at the horizon): the ends of each slab's chord.
+    /// `v * (SLABS + 1) + k`, the ends of each slab's chord; the last is the final point,
+    /// where the vehicle is at the horizon unless it is still moving (then its stray is
+    /// infinite).
     bounds: Vec<Vec3>,
     /// How far each slab's positions stray from its chord (the straight run between its bound
     /// positions at constant speed), in the order of `lo`; infinite when the vehicle moves past
@@ -142,22 +146,28 @@ impl SlabBoxes {
             }
             // `seg` is now the last sample at or before t1.
             let end = position_on_leg(times, points, seg, t1);
-            let (mut lo, mut hi) = (start.inf(&end), start.sup(&end));
+            let (mut lo, mut hi) = (start, start);
             // The positions minus the chord are piecewise linear in time with corners only at
-            // the samples, so the farthest a slab strays from its chord is at one of them.
+            // the samples, so the farthest a slab strays from its chord is at one of them: every
+            // sample at or before t1 not taken by an earlier slab (none in the slabs before a
+            // trajectory's first sample, where it holds there).
             let run = end - start;
             let mut stray2 = 0.0f64;
-            for (t, p) in times[first..=seg].iter().zip(&points[first..=seg]) {
+            while first < n && times[first] <= t1 {
+                let p = &points[first];
                 lo = lo.inf(p);
                 hi = hi.sup(p);
-                let off = (p - start - run * ((t - t0) * per_slab)).norm_squared();
-                // (A NaN sample is ignored here as by `f64::max`: its box is never near.)
-                if off > stray2 {
+                let off = (p - start - run * ((times[first] - t0) * per_slab)).norm_squared();
+                if off.is_nan() {
+                    stray2 = f64::INFINITY;
+                } else if off > stray2 {
                     stray2 = off;
                 }
+                first += 1;
             }
-            self.lo.push(lo);
-            self.hi.push(hi);
+            // The end last: a NaN sample makes the running box forget what came before it.
+            self.lo.push(lo.inf(&end));
+            self.hi.push(hi.sup(&end));
             self.bounds.push(end);
             // The last slab's chord ends at the horizon: past it, one that still moves has none.
             let past_horizon = k + 1 == SLABS && arrival > self.horizon;
@@ -166,7 +176,6 @@ impl SlabBoxes {
             } else {
                 stray2.sqrt()
             });
-            first = seg + 1;
             start = end;
         }
     }
@@ -248,7 +257,7 @@ impl SlabBoxes {
         let n = self.len();
         pairs.reset(n);
         let r2 = guarded2(reach);
-        let reach = r2.sqrt();
+        let guarded = r2.sqrt();
         let axis = self.widest_axis(SLABS / 2);
         if self.sweep.len() != n {
             self.sweep.clear();
@@ -274,7 +283,7 @@ impl SlabBoxes {
                 insertion_sort(&mut self.sweep, axis);
             }
             for (p, a) in self.sweep.iter().enumerate() {
-                let limit = a.hi[axis] + reach;
+                let limit = a.hi[axis] + guarded;
                 for b in &self.sweep[p + 1..] {
                     // A box of a vehicle without samples is at infinity: it ends every sweep
                     // before it is tested.

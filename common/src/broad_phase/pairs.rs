@@ -1,11 +1,7 @@
 //! The pairs the vehicle–vehicle broad phase keeps, each with the time slabs it kept them in.
 
-use super::SLABS;
-
 /// The slabs a pair's boxes come near in: bit `k` for slab `k`.
 pub type SlabMask = u32;
-
-const _: () = assert!(SLABS <= SlabMask::BITS as usize);
 
 /// A set of vehicle pairs `(i, j)`, `i < j`, each with the slabs it was found in: one bit per
 /// ordered pair, so inserting is a bit set whatever the slab that found it, and iterating goes
@@ -54,7 +50,7 @@ impl PairSet {
     pub fn mark(&mut self, a: usize, b: usize, k: usize) {
         if let Some(bit) = self.index(a, b) {
             self.words[bit / 64] |= 1 << (bit % 64);
-            self.slabs[bit] |= 1 << (k % SLABS);
+            self.slabs[bit] |= 1 << (k % SlabMask::BITS as usize);
         }
     }
 

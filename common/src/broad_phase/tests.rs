@@ -146,6 +146,65 @@ fn a_vehicle_still_moving_past_the_horizon_has_no_last_chord() {
 }
 
 #[test]
+fn a_vehicle_that_starts_late_strays_where_it_starts() {
+    // A holds at the origin until 150 s, then runs to x = 100 by 160 s; B stands at x = −40
+    // until 140 s and is at x = 60 by 160 s: they meet at x = 0 at 148 s. In slab 7
+    // ([140, 160] s) A's chord runs from the origin to x = 100 at 5 m/s, so at 150 s A, still
+    // at the origin, is 50 m behind it: a stray the slab must keep.
+    let a = Trajectory {
+        times: vec![150.0, 160.0],
+        points: vec![Vec3::zeros(), Vec3::new(100., 0., 0.)],
+    };
+    let b = Trajectory {
+        times: vec![0.0, 140.0, 160.0, 320.0],
+        points: vec![
+            Vec3::new(-40., 0., 0.),
+            Vec3::new(-40., 0., 0.),
+            Vec3::new(60., 0., 0.),
+            Vec3::new(60., 0., 0.),
+        ],
+    };
+    let boxes = boxes_of(320.0, &[a, b]);
+    assert_abs_diff_eq!(boxes.stray[7], 50.0, epsilon = 1e-9);
+    assert_ne!(boxes.near_slabs(0, 1, 20.0) & 1 << 7, 0);
+}
+
+#[test]
+fn the_sweep_and_the_pair_test_keep_the_same_slabs_at_the_reach_itself() {
+    // B follows A 15 m and 1.5 µm behind: at reach 15 m the pair is apart by more than the
+    // guard, for the sweep as for the pair test.
+    let fleet = [
+        line(0.0, [0., 0., 0.], 20.0, [20., 0., 0.]),
+        line(0.0, [-15.000_001_5, 0., 0.], 20.0, [4.999_998_5, 0., 0.]),
+    ];
+    let mut b = boxes_of(320.0, &fleet);
+    let mut pairs = PairSet::new();
+    b.close_pairs(15.0, &mut pairs);
+    assert_eq!(pairs.slabs(0, 1), b.near_slabs(0, 1, 15.0));
+    assert!(!pairs.contains(0, 1));
+}
+
+#[test]
+fn a_sample_that_is_not_a_number_keeps_the_slab_near() {
+    // A has a NaN sample at 1 s, then runs from the origin at 2 s to x = 1000 at 100 s,
+    // passing B (holding at x = 30) at about 4.9 s, in slab 0 (6.25 s).
+    let a = Trajectory {
+        times: vec![0.0, 1.0, 2.0, 100.0],
+        points: vec![
+            Vec3::zeros(),
+            Vec3::repeat(f64::NAN),
+            Vec3::zeros(),
+            Vec3::new(1000., 0., 0.),
+        ],
+    };
+    let b = line(0.0, [30., 0., 0.], 100.0, [30., 0., 0.]);
+    let boxes = boxes_of(100.0, &[a, b]);
+    assert!(boxes.hi[0].x >= 43.0, "{:?}", boxes.hi[0]);
+    assert!(boxes.stray[0].is_infinite());
+    assert_ne!(boxes.near_slabs(0, 1, 10.0) & 1, 0);
+}
+
+#[test]
 fn pair_sets_iterate_in_row_order() {
     let mut p = PairSet::new();
     p.reset(5);
