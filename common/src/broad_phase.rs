@@ -12,8 +12,9 @@
 //! pairs. Boxes of vehicles that move together overlap although the vehicles keep apart (one
 //! behind the other on a track, or side by side on parallel courses), so a pair whose boxes
 //! are near is tested again on its relative motion: each vehicle's straight run across the
-//! slab and how far it strays from it. Within a slab a sweep and prune along the axis the boxes spread most over (Baraff
-//! 1992, "Dynamic simulation of non-penetrating rigid bodies", §6) finds the close boxes in
+//! slab and how far it strays from it. Within a slab a sweep and prune along the axis the
+//! boxes spread most over (Baraff 1992, "Dynamic simulation of non-penetrating rigid bodies",
+//! §6) finds the close boxes in
 //! `O(n log n)` rather than testing all `n²/2` pairs. Hand-written: the crates that do this
 //! (`parry`'s BVH, `broccoli`) index static shapes and allocate per query; this reuses its
 //! buffers across the swarm's evaluations.
@@ -181,6 +182,22 @@ impl SlabBoxes {
     }
 
     /// Whether vehicle `a` of `self` and vehicle `b` of `other` may come closer than `reach`
+    /// in slab `k` (`reach` with its guarded square `r2`): their boxes, then their chords.
+    #[inline]
+    fn slab_near(
+        &self,
+        a: usize,
+        other: &SlabBoxes,
+        b: usize,
+        k: usize,
+        (r2, reach): (f64, f64),
+    ) -> bool {
+        let (i, j) = (a * SLABS + k, b * SLABS + k);
+        gap2(&self.lo[i], &self.hi[i], &other.lo[j], &other.hi[j]) < r2
+            && self.chords_within(a, other, b, k, reach)
+    }
+
+    /// Whether vehicle `a` of `self` and vehicle `b` of `other` may come closer than `reach`
     /// in slab `k` by their chords: at every instant of the slab each lies within its stray of
     /// its chord, and the two chords run over the same times, so the pair's relative position
     /// lies within the sum of the strays of the straight run between its values at the slab's
@@ -243,11 +260,7 @@ impl SlabBoxes {
     pub fn near_slabs_other(&self, a: usize, other: &SlabBoxes, b: usize, reach: f64) -> SlabMask {
         let r2 = guarded2(reach);
         (0..SLABS)
-            .filter(|&k| {
-                let (i, j) = (a * SLABS + k, b * SLABS + k);
-                gap2(&self.lo[i], &self.hi[i], &other.lo[j], &other.hi[j]) < r2
-                    && self.chords_within(a, other, b, k, reach)
-            })
+            .filter(|&k| self.slab_near(a, other, b, k, (r2, reach)))
             .fold(0, |m, k| m | 1 << k)
     }
 
@@ -499,10 +512,8 @@ impl SlabIndex {
                 if key > to || other == u32::MAX {
                     break;
                 }
-                let j = other as usize * SLABS + k;
                 if !near[other as usize]
-                    && gap2(lo, hi, &indexed.lo[j], &indexed.hi[j]) < r2
-                    && own.chords_within(v, indexed, other as usize, k, reach)
+                    && own.slab_near(v, indexed, other as usize, k, (r2, reach))
                 {
                     near[other as usize] = true;
                 }

@@ -252,13 +252,12 @@ impl Driver<'_> {
                 ..
             } if r > self.revision && self.unanswered.last().is_none_or(|&(_, p)| r > p) => {
                 match t.checked() {
-                    Ok(plan) => match self.upload(&plan, r) {
-                        Ok(()) => {}
-                        Err(e) => {
+                    Ok(plan) => {
+                        if let Err(e) = self.upload(&plan, r) {
                             tracing::warn!("mission {mission}: revision {r}: {e}");
                             self.report();
                         }
-                    },
+                    }
                     Err(why) => tracing::warn!("mission {mission}: dropped an update: {why}"),
                 }
             }

@@ -14,7 +14,7 @@ use shoal_common::execution::{CommandState, VehicleCommand, VehicleStatus};
 use shoal_common::scenario::{Bounds, Obstacle};
 use shoal_common::trajectory::Trajectory;
 
-use super::super::types::{LinkError, LinkOutcome, MavlinkSettings};
+use super::super::types::{CommandSerial, LinkError, LinkOutcome, MavlinkSettings};
 use super::items::{self, Items, Profile};
 use super::reader::{Conn, Shared, READ_TICK};
 use shoal_common::geo::GeoOrigin;
@@ -133,7 +133,7 @@ impl Commander {
 
     fn report(
         &self,
-        serial: u64,
+        serial: CommandSerial,
         command: VehicleCommand,
         state: CommandState,
         detail: String,

@@ -179,9 +179,8 @@ impl MavlinkLink {
         self.shared.skipped.load(Ordering::Relaxed)
     }
 
-    /// Hands `job` to the commander; anything older in progress gives way.
-    /// Hands `job` to the commander; its serial, the generation that supersedes every job
-    /// before it.
+    /// Hands `job` to the commander, where anything older in progress gives way; its serial,
+    /// the generation that supersedes every job before it.
     fn submit(&mut self, job: Job) -> Result<CommandSerial, LinkError> {
         let generation = self.shared.generation.fetch_add(1, Ordering::Relaxed) + 1;
         self.jobs
