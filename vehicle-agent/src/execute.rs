@@ -81,8 +81,9 @@ impl Order {
 pub const STOP_WAIT: Duration = Duration::from_secs(10);
 /// The same for the hold an agent gives its vehicle when it shuts down.
 pub const SHUTDOWN_WAIT: Duration = Duration::from_secs(3);
-/// Most uploads remembered while unanswered: a link may drop one a newer command supersedes
-/// (MAVLink gives up an exchange in progress), and such an upload is never answered.
+/// Most uploads remembered while unanswered: every link answers each command it was given
+/// (one a newer command supersedes comes back given up), so this only bounds what a link that
+/// loses an answer costs.
 const UNANSWERED_UPLOADS: usize = 8;
 
 /// One execution under way: the order, the link, and what has been reported.

@@ -396,6 +396,36 @@ fn a_silent_vehicle_times_out_after_the_retries() -> TestResult {
 }
 
 #[test]
+fn an_exchange_a_newer_command_supersedes_is_answered_given_up() -> TestResult {
+    // The silent vehicle keeps the upload waiting for its first MISSION_REQUEST; the hold given
+    // meanwhile supersedes it. Both commands are answered: the upload given up as superseded,
+    // the hold given up (no position to hold at), each under its own serial.
+    let mock = Mock::start(Behaviour::Silent)?;
+    let mut link = connect(&settings(mock.port, 300, 5))?;
+    let upload = link.upload(&plan())?;
+    std::thread::sleep(Duration::from_millis(100));
+    let hold = link.hold(0.0)?;
+    assert_ne!(upload, hold);
+    let seen = settle(&mut link, VehicleCommand::Hold)?;
+    let answer = |serial| seen.iter().find(|o| o.serial == serial && o.is_final());
+    let superseded = answer(upload).ok_or(format!("the upload is not answered: {seen:?}"))?;
+    assert_eq!(superseded.command, VehicleCommand::Upload);
+    assert_eq!(superseded.state, CommandState::GaveUp);
+    assert!(superseded.detail.contains("superseded"), "{superseded:?}");
+    let held = answer(hold).ok_or(format!("the hold is not answered: {seen:?}"))?;
+    assert!(
+        held.state == CommandState::GaveUp && held.detail.contains("no position"),
+        "{held:?}"
+    );
+    assert_eq!(
+        mock.board().counts,
+        1,
+        "the upload stopped at its first try"
+    );
+    Ok(())
+}
+
+#[test]
 fn a_refused_mission_is_refused() -> TestResult {
     let mock = Mock::start(Behaviour::Refuses)?;
     let mut link = connect(&settings(mock.port, 200, 5))?;

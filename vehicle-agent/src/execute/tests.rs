@@ -19,8 +19,7 @@ struct Recorder {
     uploads_answer_late: bool,
     /// The serials of the commands the vehicle gives up (the others it confirms).
     gives_up: Vec<CommandSerial>,
-    /// The serials of the commands never answered, as a MAVLink link drops an exchange a
-    /// newer command supersedes.
+    /// The serials of the commands never answered, as over a link that loses an answer.
     silent: Vec<CommandSerial>,
 }
 
@@ -373,7 +372,7 @@ fn an_update_the_vehicle_gives_up_leaves_the_revision_it_confirmed() {
 
 #[test]
 fn an_upload_never_answered_is_passed_over_by_the_next_one_answered() {
-    // The upload of 3 (the link's second command) is superseded and never answered; the
+    // The upload of 3 (the link's second command) is never answered (a link that loses it); the
     // upload of 4 is confirmed: the reports go from 0 to 4 and never say 3.
     let mut link = Recorder {
         silent: vec![2],

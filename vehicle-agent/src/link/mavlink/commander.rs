@@ -1,7 +1,8 @@
 //! The commander thread: every exchange with the vehicle (mission and geofence uploads,
 //! COMMAND_LONG with its COMMAND_ACK, the hold ladder and its fallback) runs here, beside the
 //! agent's telemetry loop, never in it. Each finished command comes back as a [`Done`]; a
-//! newer command makes an exchange in progress give way (no report for the old one).
+//! newer command makes an exchange in progress give way, and the old one comes back given up,
+//! so that every command the agent gave is answered.
 
 use std::sync::atomic::Ordering;
 use std::sync::mpsc::{Receiver, RecvTimeoutError, Sender};
@@ -38,6 +39,16 @@ pub enum Job {
     },
     /// Hold (or stop) where it is.
     Hold(VehicleCommand),
+}
+
+impl Job {
+    /// The command the agent gave.
+    fn command(&self) -> VehicleCommand {
+        match self {
+            Job::Upload { .. } => VehicleCommand::Upload,
+            Job::Hold(command) => *command,
+        }
+    }
 }
 
 /// What a finished command changes in the link's picture of the vehicle.
@@ -120,7 +131,9 @@ impl Commander {
     pub fn run(mut self, jobs: &Receiver<(u64, Job)>) {
         while !self.shared.stop.load(Ordering::Relaxed) {
             match jobs.recv_timeout(READ_TICK) {
-                Ok((generation, _)) if self.shared.superseded(generation) => {}
+                Ok((generation, job)) if self.shared.superseded(generation) => {
+                    self.give_way(generation, job.command())
+                }
                 Ok((generation, Job::Upload { plan, after_t })) => {
                     self.upload(generation, &plan, after_t)
                 }
@@ -129,6 +142,12 @@ impl Commander {
                 Err(RecvTimeoutError::Disconnected) => break,
             }
         }
+    }
+
+    /// Answers a command a newer one superseded before the vehicle confirmed it: given up.
+    fn give_way(&self, serial: CommandSerial, command: VehicleCommand) {
+        let why = "superseded by a newer command before the vehicle confirmed it".to_string();
+        self.report(serial, command, CommandState::GaveUp, why, Effect::None)
     }
 
     fn report(
@@ -412,7 +431,7 @@ impl Commander {
                 let why = format!("mission upload: {e}");
                 self.report(generation, upload, CommandState::GaveUp, why, Effect::None)
             }
-            Err(Abort::Superseded) => {}
+            Err(Abort::Superseded) => self.give_way(generation, upload),
         }
     }
 
@@ -443,7 +462,7 @@ impl Commander {
                         Effect::Still(status),
                     );
                 }
-                Err(Abort::Superseded) => return,
+                Err(Abort::Superseded) => return self.give_way(generation, command),
                 Err(Abort::Failed(e)) => {
                     failures.push(format!("{}: {e}", step.label));
                     let next = steps
@@ -481,7 +500,7 @@ impl Commander {
                     Effect::Still(status),
                 )
             }
-            Err(Abort::Superseded) => {}
+            Err(Abort::Superseded) => self.give_way(generation, command),
             Err(Abort::Failed(e)) => {
                 failures.push(format!("fallback mission: {e}"));
                 self.report(
