@@ -10,6 +10,7 @@
 
 use std::fmt::Write as _;
 use std::fs::File;
+use std::os::unix::process::ExitStatusExt as _;
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, ExitStatus, Stdio};
 use std::thread;
@@ -278,6 +279,13 @@ impl Fleet {
         for w in &self.watched {
             let _ = write!(s, "\n===== {} =====\n{}", w.display(), read_lossy(w));
         }
+        let signalled = self
+            .procs
+            .iter()
+            .any(|p| p.status.is_some_and(|st| st.signal().is_some()));
+        if signalled {
+            let _ = write!(s, "\n===== the kernel's traps =====\n{}", kernel_traps());
+        }
         s
     }
 
@@ -308,5 +316,22 @@ impl Drop for Fleet {
                 self.logs()
             );
         }
+    }
+}
+
+/// The kernel's last lines about processes it trapped (an illegal instruction, a segfault, with
+/// the instruction's address), when a process died by a signal; what `dmesg` says otherwise.
+fn kernel_traps() -> String {
+    match Command::new("dmesg").output() {
+        Ok(out) if out.status.success() => {
+            let text = String::from_utf8_lossy(&out.stdout);
+            let traps: Vec<&str> = text
+                .lines()
+                .filter(|l| l.contains("trap") || l.contains("segfault") || l.contains("code:"))
+                .collect();
+            traps[traps.len().saturating_sub(20)..].join("\n")
+        }
+        Ok(out) => format!("dmesg: {}", String::from_utf8_lossy(&out.stderr).trim()),
+        Err(e) => format!("dmesg: {e}"),
     }
 }
