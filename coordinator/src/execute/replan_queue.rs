@@ -367,11 +367,12 @@ fn apply(x: &mut Exec, u: UnderWay, result: Replanned) {
         x.hold_retries[i] += 1;
         let n = x.hold_retries[i];
         if told_retry(n) {
+            let holds = holding_words(&x.fleet.vehicles[i]);
             x.event(
                 "still_holding",
                 vec![id.clone()],
                 format!(
-                    "{id} keeps holding: retry {n} found no safe replan in {:.0} ms ({}); the next event on it comes at retry {}",
+                    "{id} {holds}: retry {n} found no safe replan in {:.0} ms ({}); the next event on it comes at retry {}",
                     result.elapsed.as_secs_f64() * 1000.0,
                     result.shortfall(),
                     2 * n
@@ -389,6 +390,16 @@ fn apply(x: &mut Exec, u: UnderWay, result: Replanned) {
                 result.shortfall()
             ),
         );
+    }
+}
+
+/// How a held vehicle's failed retry describes it: by what the vehicle confirmed, not by what
+/// it was told.
+fn holding_words(v: &Tracked) -> &'static str {
+    if v.hold_confirmed() {
+        "keeps holding"
+    } else {
+        "is still told to hold (the vehicle has not confirmed it)"
     }
 }
 

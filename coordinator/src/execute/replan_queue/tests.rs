@@ -184,3 +184,13 @@ fn a_vehicle_whose_hold_is_not_confirmed_is_replanned_from_its_course() {
     let resume = standing.resume_s.unwrap_or(f64::NAN);
     assert!((resume - 110.0).abs() < 1e-6, "{standing:?}");
 }
+
+#[test]
+fn a_retry_says_holding_only_of_a_vehicle_that_confirmed_its_hold() {
+    assert_eq!(
+        holding_words(&told_to_hold(VehicleStatus::Holding)),
+        "keeps holding"
+    );
+    let moving = holding_words(&told_to_hold(VehicleStatus::Underway));
+    assert!(moving.contains("not confirmed"), "{moving}");
+}
