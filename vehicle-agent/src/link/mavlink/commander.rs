@@ -75,6 +75,9 @@ pub struct Done {
     pub effect: Effect,
 }
 
+/// A job a newer one superseded before it was answered (the caller answers it, given up).
+struct Superseded;
+
 /// Why an exchange ended early.
 enum Abort {
     /// A newer command came: this one gives way.
@@ -131,13 +134,22 @@ impl Commander {
     pub fn run(mut self, jobs: &Receiver<(u64, Job)>) {
         while !self.shared.stop.load(Ordering::Relaxed) {
             match jobs.recv_timeout(READ_TICK) {
-                Ok((generation, job)) if self.shared.superseded(generation) => {
-                    self.give_way(generation, job.command())
+                Ok((generation, job)) => {
+                    let command = job.command();
+                    let answered = if self.shared.superseded(generation) {
+                        Err(Superseded)
+                    } else {
+                        match job {
+                            Job::Upload { plan, after_t } => {
+                                self.upload(generation, &plan, after_t)
+                            }
+                            Job::Hold(command) => self.hold(generation, command),
+                        }
+                    };
+                    if answered.is_err() {
+                        self.give_way(generation, command);
+                    }
                 }
-                Ok((generation, Job::Upload { plan, after_t })) => {
-                    self.upload(generation, &plan, after_t)
-                }
-                Ok((generation, Job::Hold(command))) => self.hold(generation, command),
                 Err(RecvTimeoutError::Timeout) => {}
                 Err(RecvTimeoutError::Disconnected) => break,
             }
@@ -410,7 +422,14 @@ impl Commander {
         Ok(())
     }
 
-    fn upload(&mut self, generation: u64, plan: &Trajectory, after_t: Option<f64>) {
+    /// Uploads `plan` (its legs after `after_t`) with the geofence and starts it, reporting
+    /// the outcome; `Err` when a newer job superseded it, which [`Commander::run`] answers.
+    fn upload(
+        &mut self,
+        generation: u64,
+        plan: &Trajectory,
+        after_t: Option<f64>,
+    ) -> Result<(), Superseded> {
         let profile = self.profile(HEARTBEAT_WAIT);
         let frame = (profile, self.home_amsl());
         let items = items::mission_items(plan, &self.origin, after_t, self.target(), frame);
@@ -431,13 +450,15 @@ impl Commander {
                 let why = format!("mission upload: {e}");
                 self.report(generation, upload, CommandState::GaveUp, why, Effect::None)
             }
-            Err(Abort::Superseded) => self.give_way(generation, upload),
+            Err(Abort::Superseded) => return Err(Superseded),
         }
+        Ok(())
     }
 
     /// Holds (or stops) the vehicle: each of the profile's hold steps in turn, then the
-    /// fallback mission that ends where the vehicle is. Every failure is reported at once.
-    fn hold(&mut self, generation: u64, command: VehicleCommand) {
+    /// fallback mission that ends where the vehicle is. Every failure is reported at once;
+    /// `Err` when a newer job superseded it, which [`Commander::run`] answers.
+    fn hold(&mut self, generation: u64, command: VehicleCommand) -> Result<(), Superseded> {
         let status = match command {
             VehicleCommand::Stop => VehicleStatus::Stopped,
             _ => VehicleStatus::Holding,
@@ -454,15 +475,11 @@ impl Commander {
             ) {
                 Ok(()) => {
                     let how = format!("{} acknowledged", step.label);
-                    return self.report(
-                        generation,
-                        command,
-                        CommandState::Confirmed,
-                        how,
-                        Effect::Still(status),
-                    );
+                    let still = Effect::Still(status);
+                    self.report(generation, command, CommandState::Confirmed, how, still);
+                    return Ok(());
                 }
-                Err(Abort::Superseded) => return self.give_way(generation, command),
+                Err(Abort::Superseded) => return Err(Superseded),
                 Err(Abort::Failed(e)) => {
                     failures.push(format!("{}: {e}", step.label));
                     let next = steps
@@ -476,13 +493,9 @@ impl Commander {
         let here = self.shared.latest().geodetic(&self.origin);
         let Some(here) = here else {
             failures.push("no position to hold at".into());
-            return self.report(
-                generation,
-                command,
-                CommandState::GaveUp,
-                failures.join("; "),
-                Effect::None,
-            );
+            let why = failures.join("; ");
+            self.report(generation, command, CommandState::GaveUp, why, Effect::None);
+            return Ok(());
         };
         let items = items::fallback_items(here, self.target(), (profile, self.home_amsl()));
         match self.send_mission(&items, generation) {
@@ -500,7 +513,7 @@ impl Commander {
                     Effect::Still(status),
                 )
             }
-            Err(Abort::Superseded) => self.give_way(generation, command),
+            Err(Abort::Superseded) => return Err(Superseded),
             Err(Abort::Failed(e)) => {
                 failures.push(format!("fallback mission: {e}"));
                 self.report(
@@ -512,5 +525,6 @@ impl Commander {
                 )
             }
         }
+        Ok(())
     }
 }
