@@ -335,6 +335,13 @@ fn update(revision: u32) -> CoordinatorToAgent {
     }
 }
 
+/// Updates 3 and 4 at once, then the stop: every report, and the revisions they carry.
+fn updates_3_and_4(link: &mut Recorder) -> (Vec<Telemetry>, Vec<u32>) {
+    let sent = run_to_the_stop(link, vec![update(3), update(4)]);
+    let revisions = sent.iter().map(|t| t.revision).collect();
+    (sent, revisions)
+}
+
 #[test]
 fn of_two_quick_updates_the_first_answered_is_the_revision_reported() {
     // Updates 3 and 4 come at once; the vehicle answers the upload of 3 only once 4 is given,
@@ -344,8 +351,7 @@ fn of_two_quick_updates_the_first_answered_is_the_revision_reported() {
         uploads_answer_late: true,
         ..Recorder::default()
     };
-    let sent = run_to_the_stop(&mut link, vec![update(3), update(4)]);
-    let revisions: Vec<u32> = sent.iter().map(|t| t.revision).collect();
+    let (sent, revisions) = updates_3_and_4(&mut link);
     assert!(revisions.windows(2).all(|w| w[0] <= w[1]), "{revisions:?}");
     assert!(revisions.contains(&3), "{revisions:?}");
     let first_4 = sent.iter().find(|t| t.revision == 4);
@@ -364,8 +370,7 @@ fn an_update_the_vehicle_gives_up_leaves_the_revision_it_confirmed() {
         gives_up: vec![3],
         ..Recorder::default()
     };
-    let sent = run_to_the_stop(&mut link, vec![update(3), update(4)]);
-    let revisions: Vec<u32> = sent.iter().map(|t| t.revision).collect();
+    let (_, revisions) = updates_3_and_4(&mut link);
     assert_eq!(revisions.last(), Some(&3), "{revisions:?}");
     assert!(!revisions.contains(&4), "{revisions:?}");
 }
@@ -378,8 +383,7 @@ fn an_upload_never_answered_is_passed_over_by_the_next_one_answered() {
         silent: vec![2],
         ..Recorder::default()
     };
-    let sent = run_to_the_stop(&mut link, vec![update(3), update(4)]);
-    let revisions: Vec<u32> = sent.iter().map(|t| t.revision).collect();
+    let (_, revisions) = updates_3_and_4(&mut link);
     assert_eq!(revisions.last(), Some(&4), "{revisions:?}");
     assert!(!revisions.contains(&3), "{revisions:?}");
 }
