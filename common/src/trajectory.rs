@@ -331,16 +331,20 @@ pub fn leg_times(
         // T(α) and its slope on the current piece (the free legs' Σ l p).
         let eval = |a: f64| -> (f64, f64) {
             let (mut t, mut slope) = (0.0, 0.0);
+            // Selects, not branches: which legs are clamped changes from leg to leg, so
+            // branches mispredict (adding 0.0 to the slope leaves it as it was).
             for (l, &p) in lengths.iter().zip(paces) {
                 let q = a * p;
-                if q <= p_lo {
-                    t += l * p_lo;
-                } else if q >= p_hi {
-                    t += l * p_hi;
+                let (slow, fast) = (q <= p_lo, q >= p_hi);
+                let pace = if slow {
+                    p_lo
+                } else if fast {
+                    p_hi
                 } else {
-                    t += l * q;
-                    slope += l * p;
-                }
+                    q
+                };
+                t += l * pace;
+                slope += if slow || fast { 0.0 } else { l * p };
             }
             (t, slope)
         };

@@ -169,8 +169,7 @@ fn add_sphere(
     };
     let r2 = reach * reach;
     for (chunk, (lo, hi)) in boxes.iter().enumerate() {
-        let gap = (lo - s.centre).sup(&(s.centre - hi)).sup(&Vec3::zeros());
-        if gap.norm_squared() >= r2 {
+        if box_gap2(lo, hi, &s.centre) >= r2 {
             continue;
         }
         let start = chunk * CHUNK_LEGS;
@@ -193,6 +192,55 @@ fn add_sphere(
                     out.soft_inside += chord_inside_sphere(&a, &b, &s.centre, s.radius);
                 }
             }
+        }
+    }
+}
+
+/// Squared distance from `c` to the box `[lo, hi]` (0 inside): the value of
+/// `(lo - c).sup(&(c - hi)).sup(&0).norm_squared()` to the last bit, NaN included (simba's
+/// `simd_max` is the same comparison), in plain scalar comparisons, which the 32-vehicle
+/// crossing swarm measured 3–4 % faster as a whole.
+#[inline]
+fn box_gap2(lo: &Vec3, hi: &Vec3, c: &Vec3) -> f64 {
+    let larger = |a: f64, b: f64| if a > b { a } else { b };
+    let mut s = 0.0;
+    for d in 0..3 {
+        let g = larger(larger(lo[d] - c[d], c[d] - hi[d]), 0.0);
+        s += g * g;
+    }
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    #[test]
+    fn a_box_gap_by_hand() {
+        let (lo, hi) = (Vec3::new(0.0, 0.0, 0.0), Vec3::new(10.0, 20.0, 30.0));
+        // Inside: no gap.
+        assert_eq!(box_gap2(&lo, &hi, &Vec3::new(5.0, 5.0, 5.0)), 0.0);
+        // 3 m west, 4 m north of the box, level with it: 5 m.
+        assert!((box_gap2(&lo, &hi, &Vec3::new(-3.0, 24.0, 15.0)) - 25.0).abs() < 1e-12);
+        // Below a corner by (1, 2, 2): 3 m.
+        assert!((box_gap2(&lo, &hi, &Vec3::new(11.0, -2.0, -2.0)) - 9.0).abs() < 1e-12);
+    }
+
+    proptest! {
+        /// The same as nalgebra's component-wise form, to the last bit, NaN included.
+        #[test]
+        fn a_box_gap_is_nalgebras(
+            a in prop::array::uniform3(prop_oneof![-1e4..1e4f64, Just(f64::NAN)]),
+            b in prop::array::uniform3(-1e4..1e4f64),
+            c in prop::array::uniform3(prop_oneof![-1e4..1e4f64, Just(f64::NAN)]),
+        ) {
+            let (a, b, c) = (Vec3::from(a), Vec3::from(b), Vec3::from(c));
+            let (lo, hi) = (a.inf(&b), a.sup(&b));
+            let reference = (lo - c).sup(&(c - hi)).sup(&Vec3::zeros()).norm_squared();
+            let ours = box_gap2(&lo, &hi, &c);
+            prop_assert!(ours.to_bits() == reference.to_bits() || (ours.is_nan() && reference.is_nan()),
+                "{} against {}", ours, reference);
         }
     }
 }

@@ -297,20 +297,30 @@ pub fn update(
             .iter()
             .zip(&limits.inv_vmax[r.clone()])
             .fold(1.0f64, |m, (v, inv)| m.max(v.abs() * inv));
-        let scale = 1.0 / over;
-        for d in r {
-            let mut v = p.v[d] * scale;
-            let mut x = p.x[d] + v;
-            if x < limits.lower[d] {
-                x = limits.lower[d];
-                v = 0.0;
-            } else if x > limits.upper[d] {
-                x = limits.upper[d];
-                v = 0.0;
-            }
-            p.x[d] = x;
-            p.v[d] = v;
-        }
+        move_within(p, limits, r, 1.0 / over);
+    }
+}
+
+/// Scales the velocity of the dimensions `r` by `scale`, moves the position by it and clamps it
+/// into the bounds; a dimension that hits a wall stops there (its velocity becomes zero).
+/// Written as selects rather than branches: which particles hit a wall is random, so branches
+/// mispredict.
+#[inline]
+fn move_within(p: &mut Particle, limits: &Limits, r: std::ops::Range<usize>, scale: f64) {
+    let (lower, upper) = (&limits.lower[r.clone()], &limits.upper[r.clone()]);
+    let (x, v) = (&mut p.x[r.clone()], &mut p.v[r]);
+    for (((x, v), lo), hi) in x.iter_mut().zip(v.iter_mut()).zip(lower).zip(upper) {
+        let moved = *v * scale;
+        let to = *x + moved;
+        let (below, above) = (to < *lo, to > *hi);
+        *x = if below {
+            *lo
+        } else if above {
+            *hi
+        } else {
+            to
+        };
+        *v = if below || above { 0.0 } else { moved };
     }
 }
 
