@@ -39,9 +39,19 @@ pub fn length_term(length: f64, straight: f64) -> f64 {
 /// height `column`. Depth is linear along a leg, so each leg contributes `l (d_a + d_b) / 2`.
 /// 0 for a path along the surface, 1 for one along the bottom of the box.
 pub fn depth_term(points: &[Vec3], surface_z: f64, column: f64) -> f64 {
+    depth_term_of_legs(points, leg_norms(points), surface_z, column)
+}
+
+/// [`depth_term`] with the legs' lengths given (in order, as [`leg_norms`] gives them): the
+/// fitness has them already, and a square root per leg is a tenth of the depth term's cost.
+pub fn depth_term_of_legs(
+    points: &[Vec3],
+    legs: impl IntoIterator<Item = f64>,
+    surface_z: f64,
+    column: f64,
+) -> f64 {
     let (mut weighted, mut total) = (0.0, 0.0);
-    for w in points.windows(2) {
-        let l = (w[1] - w[0]).norm();
+    for (w, l) in points.windows(2).zip(legs) {
         weighted += l * 0.5 * ((surface_z - w[0].z) + (surface_z - w[1].z));
         total += l;
     }
@@ -49,6 +59,11 @@ pub fn depth_term(points: &[Vec3], surface_z: f64, column: f64) -> f64 {
         return points.first().map_or(0.0, |p| (surface_z - p.z) / column);
     }
     weighted / total / column
+}
+
+/// Each leg's length, in order.
+pub fn leg_norms(points: &[Vec3]) -> impl Iterator<Item = f64> + '_ {
+    points.windows(2).map(|w| (w[1] - w[0]).norm())
 }
 
 /// F_i(O) of eq. (9): metres of path inside inflated soft obstacles, over the straight-line
@@ -140,17 +155,25 @@ pub fn turn_penalty(points: &[Vec3], max_turn: f64) -> f64 {
             continue;
         }
         if let Some((px, py, pn)) = prev {
-            let dot = px * x + py * y;
-            if dot < cos_max * pn * n {
-                let t = (px * y - py * x).atan2(dot).abs();
-                if t > max_turn {
-                    p += 1.0 + (t - max_turn) / max_turn;
-                }
-            }
+            p += turn_excess(px * x + py * y, px * y - py * x, cos_max * pn * n, max_turn);
         }
         prev = Some((x, y, n));
     }
     p
+}
+
+/// One heading change's share of [`turn_penalty`]: `1 + excess / max_turn` for a turn past
+/// `max_turn`, else 0; from the two headings' dot and cross products and `bound`, the dot
+/// product of a turn of exactly `max_turn` (so only a turn past it pays for `atan2`).
+#[inline]
+fn turn_excess(dot: f64, cross: f64, bound: f64, max_turn: f64) -> f64 {
+    if dot < bound {
+        let t = cross.atan2(dot).abs();
+        if t > max_turn {
+            return 1.0 + (t - max_turn) / max_turn;
+        }
+    }
+    0.0
 }
 
 /// The turn penalty of entering `points` from a vehicle already moving along `heading` (its
@@ -197,6 +220,37 @@ pub fn pitch_penalty(points: &[Vec3], max_pitch: f64) -> f64 {
         }
     }
     p
+}
+
+/// `turn_penalty(points, max_turn) + pitch_penalty(points, max_pitch)` to the last bit, in one
+/// pass that takes each leg's horizontal extent once for both.
+pub fn turn_and_pitch_penalty(points: &[Vec3], max_turn: f64, max_pitch: f64) -> f64 {
+    let (cos_max, tan_max) = (max_turn.cos(), max_pitch.tan());
+    let (mut turn, mut climb) = (0.0, 0.0);
+    let mut prev: Option<(f64, f64, f64)> = None;
+    for w in points.windows(2) {
+        let d = w[1] - w[0];
+        let n = (d.x * d.x + d.y * d.y).sqrt();
+        if d.z.abs() > tan_max * n {
+            let a = pitch(&w[0], &w[1]).abs();
+            if a > max_pitch {
+                climb += 1.0 + (a - max_pitch) / max_pitch;
+            }
+        }
+        if n <= MIN_HEADING_EXTENT {
+            continue;
+        }
+        if let Some((px, py, pn)) = prev {
+            turn += turn_excess(
+                px * d.x + py * d.y,
+                px * d.y - py * d.x,
+                cos_max * pn * n,
+                max_turn,
+            );
+        }
+        prev = Some((d.x, d.y, n));
+    }
+    turn + climb
 }
 
 /// Each term of one vehicle, unweighted.
@@ -343,8 +397,10 @@ impl FleetModel {
         points.extend(draped);
     }
 
-    /// Vehicle-local terms of vehicle `i` (everything but F(S) and the separation penalty).
-    pub fn vehicle_terms(&self, i: usize, points: &[Vec3], length: f64) -> VehicleTerms {
+    /// Vehicle-local terms of vehicle `i` (everything but F(S) and the separation penalty), its
+    /// path through `points` with its legs' lengths `legs` (in order, as [`leg_norms`]).
+    pub fn vehicle_terms(&self, i: usize, points: &[Vec3], legs: &[f64]) -> VehicleTerms {
+        let length: f64 = legs.iter().sum();
         let s = &self.scenario;
         let v = &s.vehicles[i];
         if let Some((crawler, reference)) = &self.crawlers[i] {
@@ -367,14 +423,17 @@ impl FleetModel {
             .map_or(0.0, |(t, c)| seabed_penalty(points, t, c).0);
         VehicleTerms {
             length: length_term(length, self.straight[i]),
-            depth: depth_term(points, surface, column),
+            depth: depth_term_of_legs(points, legs.iter().copied(), surface, column),
             soft: spheres.soft_inside / self.straight[i].max(1e-9),
             time: time_term(length, v, s.fleet.mission_time_s),
             space: 0.0,
             separation: 0.0,
             hard: spheres.hard_penalty + seabed,
-            motion: turn_penalty(points, v.max_turn_deg.to_radians())
-                + pitch_penalty(points, v.max_pitch_deg.to_radians()),
+            motion: turn_and_pitch_penalty(
+                points,
+                v.max_turn_deg.to_radians(),
+                v.max_pitch_deg.to_radians(),
+            ),
             hard_hits: spheres.hard_hits,
             crawler: None,
         }
@@ -449,7 +508,7 @@ impl FleetModel {
         out.vehicles.clear();
         for (i, t) in out.trajectories.iter_mut().enumerate() {
             let v = &s.vehicles[i];
-            let mut terms = self.vehicle_terms(i, &t.points, lengths[i]);
+            let mut terms = self.vehicle_terms(i, &t.points, &legs[spans[i].clone()]);
             terms.motion += early_arrival_penalty(lengths[i], v, arrival);
             out.vehicles.push(terms);
             let span = spans[i].clone();
@@ -498,7 +557,7 @@ impl FleetModel {
             vehicles: base.vehicles.clone(),
             ..FleetEvaluation::default()
         };
-        out.vehicles[i] = self.vehicle_terms(i, &path.points, length);
+        out.vehicles[i] = self.vehicle_terms(i, &path.points, &legs);
         out.vehicles[i].motion += early_arrival_penalty(length, &s.vehicles[i], arrival);
         out.trajectories[i] = retime_legs(path, &legs, &s.vehicles[i], arrival);
         let d_min = s.fleet.d_min_m;

@@ -157,9 +157,37 @@ fn turn_and_pitch_penalties_by_hand() {
         v(2., 0., 1.0 + 10f64.to_radians().tan()),
     ];
     assert_abs_diff_eq!(pitch_penalty(&pts, pmax), 1.0 + 25.0 / 20.0, epsilon = 1e-9);
+    // Both at once: the climb's 1 + 25/20 and no turn (every leg heads east).
+    assert_abs_diff_eq!(
+        turn_and_pitch_penalty(&pts, max, pmax),
+        1.0 + 25.0 / 20.0,
+        epsilon = 1e-9
+    );
 }
 
 proptest::proptest! {
+    /// The one pass the fitness takes is the two penalties' sum to the last bit, on paths
+    /// with vertical legs and repeated points (a leg without a heading) among the others.
+    #[test]
+    fn turn_and_pitch_in_one_pass_are_the_two_penalties(
+        pts in proptest::collection::vec((0u8..4, -500.0f64..500.0, -500.0f64..500.0, -300.0f64..300.0), 2..30),
+        turn_deg in 5.0f64..90.0,
+        pitch_deg in 5.0f64..60.0,
+    ) {
+        let mut path = vec![v(0.0, 0.0, 0.0)];
+        for (kind, x, y, z) in pts {
+            let last = path[path.len() - 1];
+            path.push(match kind {
+                0 => last,
+                1 => last + v(0.0, 0.0, z),
+                _ => last + v(x, y, z),
+            });
+        }
+        let (turn, pitch) = (turn_deg.to_radians(), pitch_deg.to_radians());
+        let both = turn_penalty(&path, turn) + pitch_penalty(&path, pitch);
+        proptest::prop_assert_eq!(turn_and_pitch_penalty(&path, turn, pitch).to_bits(), both.to_bits());
+    }
+
     #[test]
     fn sphere_terms_match_the_brute_force(
         pts in proptest::collection::vec((0.0f64..1000.0, 0.0f64..1000.0, 0.0f64..1000.0), 2..30),
