@@ -44,7 +44,7 @@ pub fn depth_term(points: &[Vec3], surface_z: f64, column: f64) -> f64 {
 }
 
 /// [`depth_term`] with the legs' lengths given (in order, as [`leg_norms`] gives them): the
-/// fitness has them already, and a square root per leg is a tenth of the depth term's cost.
+/// fitness has them already, so the term takes no square root of its own.
 pub fn depth_term_of_legs(
     points: &[Vec3],
     legs: impl IntoIterator<Item = f64>,
