@@ -79,14 +79,10 @@ pub fn sample(control: &[Vec3], k: usize, samples: usize) -> Vec<Vec3> {
         .collect()
 }
 
-/// Length of the polyline through `points`.
-pub fn polyline_length(points: &[Vec3]) -> f64 {
-    points.windows(2).map(|w| (w[1] - w[0]).norm()).sum()
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::geometry::polyline_length;
     use approx::assert_abs_diff_eq;
 
     fn v(x: f64, y: f64, z: f64) -> Vec3 {

@@ -19,9 +19,8 @@
 //! separation breaches, each as `count + depth of the breach relative to its limit`, so the
 //! swarm feels both how many and how bad.
 
-use crate::bspline::polyline_length;
 use crate::crawler::{CrawlerModel, CrawlerTerms};
-use crate::geometry::Vec3;
+use crate::geometry::{leg_lengths, polyline_length, Vec3};
 use crate::scenario::{Scenario, Vehicle};
 use crate::terrain::Terrain;
 use crate::trajectory::{common_arrival, leg_times, retime_legs, Layout, Path, Trajectory};
@@ -40,10 +39,10 @@ pub fn length_term(length: f64, straight: f64) -> f64 {
 /// height `column`. Depth is linear along a leg, so each leg contributes `l (d_a + d_b) / 2`.
 /// 0 for a path along the surface, 1 for one along the bottom of the box.
 pub fn depth_term(points: &[Vec3], surface_z: f64, column: f64) -> f64 {
-    depth_term_of_legs(points, leg_norms(points), surface_z, column)
+    depth_term_of_legs(points, leg_lengths(points), surface_z, column)
 }
 
-/// [`depth_term`] with the legs' lengths given (in order, as [`leg_norms`] gives them): the
+/// [`depth_term`] with the legs' lengths given (in order, as [`leg_lengths`] gives them): the
 /// fitness has them already, so the term takes no square root of its own.
 pub fn depth_term_of_legs(
     points: &[Vec3],
@@ -60,11 +59,6 @@ pub fn depth_term_of_legs(
         return points.first().map_or(0.0, |p| (surface_z - p.z) / column);
     }
     weighted / total / column
-}
-
-/// Each leg's length, in order.
-pub fn leg_norms(points: &[Vec3]) -> impl Iterator<Item = f64> + '_ {
-    points.windows(2).map(|w| (w[1] - w[0]).norm())
 }
 
 /// F_i(O) of eq. (9): metres of path inside inflated soft obstacles, over the straight-line
@@ -288,9 +282,15 @@ impl FleetModel {
     }
 
     /// Vehicle-local terms of vehicle `i` (everything but F(S) and the separation penalty), its
-    /// path through `points` with its legs' lengths `legs` (in order, as [`leg_norms`]).
-    pub fn vehicle_terms(&self, i: usize, points: &[Vec3], legs: &[f64]) -> VehicleTerms {
-        let length: f64 = legs.iter().sum();
+    /// path through `points` with its legs' lengths `legs` (in order, as [`leg_lengths`]) and
+    /// their sum `length`: every caller has both already.
+    pub fn vehicle_terms(
+        &self,
+        i: usize,
+        points: &[Vec3],
+        legs: &[f64],
+        length: f64,
+    ) -> VehicleTerms {
         let s = &self.scenario;
         let v = &s.vehicles[i];
         if let Some((crawler, reference)) = &self.crawlers[i] {
@@ -384,7 +384,7 @@ impl FleetModel {
             t.points.clear();
             self.decode_into(i, &x[self.layout.chromosome(i)], &mut t.points, speeds);
             let start = legs.len();
-            legs.extend(t.points.windows(2).map(|w| (w[1] - w[0]).norm()));
+            legs.extend(leg_lengths(&t.points));
             spans.push(start..legs.len());
             lengths.push(legs[start..].iter().sum());
         }
@@ -398,7 +398,7 @@ impl FleetModel {
         out.vehicles.clear();
         for (i, t) in out.trajectories.iter_mut().enumerate() {
             let v = &s.vehicles[i];
-            let mut terms = self.vehicle_terms(i, &t.points, &legs[spans[i].clone()]);
+            let mut terms = self.vehicle_terms(i, &t.points, &legs[spans[i].clone()], lengths[i]);
             terms.motion += early_arrival_penalty(lengths[i], v, arrival);
             out.vehicles.push(terms);
             let span = spans[i].clone();
@@ -447,7 +447,7 @@ impl FleetModel {
             vehicles: base.vehicles.clone(),
             ..FleetEvaluation::default()
         };
-        out.vehicles[i] = self.vehicle_terms(i, &path.points, &legs);
+        out.vehicles[i] = self.vehicle_terms(i, &path.points, &legs, length);
         out.vehicles[i].motion += early_arrival_penalty(length, &s.vehicles[i], arrival);
         out.trajectories[i] = retime_legs(path, &legs, &s.vehicles[i], arrival);
         let d_min = s.fleet.d_min_m;

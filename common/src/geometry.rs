@@ -7,6 +7,16 @@
 /// A point or direction in the world frame, metres.
 pub type Vec3 = nalgebra::Vector3<f64>;
 
+/// Each leg's length along the polyline through `points`, in order, metres.
+pub fn leg_lengths(points: &[Vec3]) -> impl Iterator<Item = f64> + '_ {
+    points.windows(2).map(|w| (w[1] - w[0]).norm())
+}
+
+/// Length of the polyline through `points`, metres: its legs' lengths summed in order.
+pub fn polyline_length(points: &[Vec3]) -> f64 {
+    leg_lengths(points).sum()
+}
+
 /// Parameter `u ∈ [0, 1]` of the point of segment `a→b` closest to `p`.
 ///
 /// Hu et al. 2023, eq. (31) writes the segment as a line `a + u (b − a)`; clamping `u` to `[0, 1]` keeps

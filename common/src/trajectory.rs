@@ -13,7 +13,7 @@
 //! Timing: the requested speeds are only a *profile*. [`retime`] scales the profile so the vehicle
 //! arrives at the fleet's common arrival time, keeping every leg's speed inside the vehicle's range.
 
-use crate::geometry::Vec3;
+use crate::geometry::{leg_lengths, polyline_length, Vec3};
 use crate::scenario::{Scenario, Vehicle};
 
 /// Genes per waypoint: x, y, z and the status gene δ.
@@ -123,15 +123,12 @@ impl Path {
     /// Length of every leg, metres.
     #[inline]
     pub fn leg_lengths(&self) -> Vec<f64> {
-        self.points
-            .windows(2)
-            .map(|w| (w[1] - w[0]).norm())
-            .collect()
+        leg_lengths(&self.points).collect()
     }
 
     /// Total length, metres.
     pub fn length(&self) -> f64 {
-        self.points.windows(2).map(|w| (w[1] - w[0]).norm()).sum()
+        polyline_length(&self.points)
     }
 }
 

@@ -52,7 +52,7 @@ use std::ops::Range;
 use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
 
-use crate::bspline::polyline_length;
+use crate::geometry::polyline_length;
 use crate::cost::{FleetEvaluation, FleetModel};
 use crate::scenario::Scenario;
 use crate::swarm::core::parallel;

@@ -3,7 +3,7 @@
 //! quadratic program's model.
 
 use crate::broad_phase::{boxes_within, extent};
-use crate::bspline::polyline_length;
+use crate::geometry::polyline_length;
 use crate::cost::{depth_term, soft_threat_term, time_term, FleetModel, Sphere};
 use crate::geometry::Vec3;
 

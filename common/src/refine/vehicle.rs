@@ -13,7 +13,7 @@ use std::sync::Arc;
 use super::constraints::{entry_turn_row, Limits, Row};
 use super::search::{Arena, Search};
 use super::settings::RefineSettings;
-use crate::bspline::polyline_length;
+use crate::geometry::polyline_length;
 use crate::cost::FleetModel;
 use crate::geometry::Vec3;
 use crate::trajectory::Trajectory;

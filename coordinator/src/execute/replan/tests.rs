@@ -224,7 +224,7 @@ fn the_chosen_answer_is_refined_within_the_budget_unless_turned_off(
     };
     let refined = tightened(&r, Instant::now());
     let length =
-        |e: &VehicleEvaluation| shoal_common::bspline::polyline_length(&e.trajectory.points);
+        |e: &VehicleEvaluation| shoal_common::geometry::polyline_length(&e.trajectory.points);
     assert!(
         refined.total < chosen.total,
         "{} against {}",
