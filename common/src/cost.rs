@@ -380,13 +380,19 @@ impl FleetModel {
         speeds.clear();
         spans.clear();
         lengths.clear();
+        // Each vehicle is taken through as much as it can be while its path is in the
+        // first-level cache: decoded, measured and scored here, then timed and boxed below.
+        out.vehicles.clear();
         for (i, t) in out.trajectories.iter_mut().enumerate() {
             t.points.clear();
             self.decode_into(i, &x[self.layout.chromosome(i)], &mut t.points, speeds);
             let start = legs.len();
             legs.extend(leg_lengths(&t.points));
             spans.push(start..legs.len());
-            lengths.push(legs[start..].iter().sum());
+            let length = legs[start..].iter().sum();
+            lengths.push(length);
+            // Its own terms do not depend on the timing.
+            (out.vehicles).push(self.vehicle_terms(i, &t.points, &legs[start..], length));
         }
         let arrival = common_arrival(
             s.fleet.mission_time_s,
@@ -395,23 +401,26 @@ impl FleetModel {
                 .zip(&s.vehicles)
                 .map(|(l, v)| l / v.speed_max_mps),
         );
-        out.vehicles.clear();
-        for (i, t) in out.trajectories.iter_mut().enumerate() {
-            let v = &s.vehicles[i];
-            let mut terms = self.vehicle_terms(i, &t.points, &legs[spans[i].clone()], lengths[i]);
-            terms.motion += early_arrival_penalty(lengths[i], v, arrival);
-            out.vehicles.push(terms);
-            let span = spans[i].clone();
-            leg_times(
-                &legs[span.clone()],
-                &mut speeds[span],
-                v,
-                arrival,
-                &mut t.times,
-            );
-        }
+        let vehicles = &mut out.vehicles;
+        coupling::pair_terms_into(
+            &mut out.trajectories,
+            s.fleet.d_min_m,
+            arrival * (1.0 + SLABS_PAST_ARRIVAL),
+            &mut out.pairs,
+            |i, t| {
+                let v = &s.vehicles[i];
+                vehicles[i].motion += early_arrival_penalty(lengths[i], v, arrival);
+                let span = spans[i].clone();
+                leg_times(
+                    &legs[span.clone()],
+                    &mut speeds[span],
+                    v,
+                    arrival,
+                    &mut t.times,
+                );
+            },
+        );
         out.common_arrival = arrival;
-        coupling::pair_terms_into(&out.trajectories, s.fleet.d_min_m, &mut out.pairs);
         self.sum_into(out);
     }
 
@@ -473,6 +482,13 @@ impl FleetModel {
         out.total = objective + self.scenario.optimizer.penalty_weight * penalty;
     }
 }
+
+/// How far past the common arrival the fitness's time slabs end, relative to it: the timing
+/// lands every vehicle's last sample on the arrival to within about 1e-12 of it (the tolerance
+/// of [`leg_times`]), and a vehicle still moving when the slabs end would lose its last slab's
+/// chord test ([`crate::broad_phase`]), so they end a little later. Where they end changes no
+/// term, only how many pairs the broad phase keeps.
+const SLABS_PAST_ARRIVAL: f64 = 1e-9;
 
 /// The buffers of [`FleetModel::evaluate_into`] besides the evaluation's own.
 #[derive(Debug, Default)]

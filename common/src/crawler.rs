@@ -486,7 +486,11 @@ mod tests {
         assert_abs_diff_eq!(p[25], Vec3::new(29.6875, 22.5, 0.5), epsilon = 1e-9);
         // The reported length is the curve's, shorter than the polygon's 4 · √(25² + 20²).
         let t = m.terms(&p);
-        assert_abs_diff_eq!(t.length_m, crate::geometry::polyline_length(&p), epsilon = 1e-12);
+        assert_abs_diff_eq!(
+            t.length_m,
+            crate::geometry::polyline_length(&p),
+            epsilon = 1e-12
+        );
         assert!(t.length_m < 4.0 * (25.0f64 * 25.0 + 20.0 * 20.0).sqrt() - 5.0);
     }
 

@@ -162,7 +162,9 @@ impl<'a> VehicleProblem<'a> {
         let path = self.model.decode(self.vehicle, genes);
         let legs = path.leg_lengths();
         let length: f64 = legs.iter().sum();
-        let mut terms = self.model.vehicle_terms(self.vehicle, &path.points, &legs, length);
+        let mut terms = self
+            .model
+            .vehicle_terms(self.vehicle, &path.points, &legs, length);
         if let Some(h) = self.heading_in {
             terms.motion += entry_turn_penalty(h, &path.points, v.max_turn_deg.to_radians());
         }

@@ -49,6 +49,15 @@ impl Velocities {
         self.of.resize(n, None);
     }
 
+    /// Computes vehicle `k`'s velocities from its trajectory `t`, unless they are known.
+    fn prepare(&mut self, k: usize, t: &Trajectory) {
+        if self.of[k].is_none() {
+            let start = self.all.len();
+            let top = Motion::velocities_into(t, &mut self.all);
+            self.of[k] = Some((start, self.all.len(), top));
+        }
+    }
+
     /// The prepared motions of vehicles `i` and `j` of `trajectories`.
     fn pair<'a>(
         &'a mut self,
@@ -57,11 +66,7 @@ impl Velocities {
         j: usize,
     ) -> (Motion<'a>, Motion<'a>) {
         for k in [i, j] {
-            if self.of[k].is_none() {
-                let start = self.all.len();
-                let top = Motion::velocities_into(&trajectories[k], &mut self.all);
-                self.of[k] = Some((start, self.all.len(), top));
-            }
+            self.prepare(k, &trajectories[k]);
         }
         let this = &*self;
         let motion = |k: usize| {
@@ -103,10 +108,43 @@ pub struct PairTerms {
 }
 
 /// The terms of every pair the broad phase cannot rule out, in row order, into `out` (cleared
-/// first).
-pub(super) fn pair_terms_into(trajectories: &[Trajectory], d_min: f64, out: &mut Vec<PairTerms>) {
-    with_measure(trajectories, d_min, out, |scratch, out| {
-        boxes_of(trajectories, &mut scratch.boxes);
+/// first), after `time` has given each vehicle its timing (called once per vehicle, in order,
+/// with its index and trajectory).
+///
+/// Each vehicle's slab boxes are built as soon as it is timed, while its samples are still in
+/// the first-level cache: a fleet of 32 outgrows that cache, and boxing the fleet in a pass of
+/// its own after the timing missed it for most samples (measured with Cachegrind). The slabs
+/// end at `horizon`. Any horizon gives the same terms: the broad phase keeps every pair that
+/// comes within d_min whatever its slabs, and the pairs it keeps are measured over the whole
+/// mission. One just after the last arrival prunes most; when a trajectory ends later than
+/// `horizon` the boxes are built again over the time to its arrival.
+pub(super) fn pair_terms_into(
+    trajectories: &mut [Trajectory],
+    d_min: f64,
+    horizon: f64,
+    out: &mut Vec<PairTerms>,
+    mut time: impl FnMut(usize, &mut Trajectory),
+) {
+    out.clear();
+    with_scratch(|scratch| {
+        let small = trajectories.len() <= SMALL_FLEET;
+        scratch.velocities.reset(trajectories.len());
+        scratch.boxes.reset(horizon);
+        let mut last = 0.0f64;
+        for (i, t) in trajectories.iter_mut().enumerate() {
+            time(i, t);
+            if !small {
+                scratch.boxes.push(&t.times, &t.points);
+            }
+            last = t.times.last().map_or(last, |&end| last.max(end));
+        }
+        let trajectories = &*trajectories;
+        if small {
+            return all_pair_terms_into(trajectories, d_min, &mut scratch.velocities, out);
+        }
+        if !(last <= horizon) {
+            boxes_of(trajectories, &mut scratch.boxes);
+        }
         let Scratch {
             boxes,
             pairs,
@@ -132,8 +170,8 @@ pub(super) fn pair_terms_into(trajectories: &[Trajectory], d_min: f64, out: &mut
 ///
 /// The cost follows the vehicles near the changed one, not the fleet: slab boxes are built
 /// only for the others whose whole trajectory's box ([`extent`]) comes within d_min of the
-/// changed one's, since no slab box of the rest can. The slabs span the same time as the whole
-/// fleet's, so every kept pair gets the slabs [`pair_terms_into`] would find.
+/// changed one's, since no slab box of the rest can. The slabs span the time to the fleet's
+/// last arrival.
 pub(super) fn pair_terms_changed(
     trajectories: &[Trajectory],
     d_min: f64,
@@ -304,10 +342,25 @@ mod tests {
     use crate::strategies::crossing;
     use proptest::prelude::*;
 
-    fn pair_terms(fleet: &[Trajectory], d_min: f64) -> Vec<PairTerms> {
+    /// [`pair_terms_into`] of `fleet` with its slabs ending at `horizon`, each vehicle's
+    /// samples given to it by the timing (so boxes built before it would be empty).
+    fn pair_terms_at(fleet: &[Trajectory], d_min: f64, horizon: f64) -> Vec<PairTerms> {
+        let mut untimed: Vec<Trajectory> = fleet
+            .iter()
+            .map(|t| Trajectory {
+                times: Vec::new(),
+                points: t.points.clone(),
+            })
+            .collect();
         let mut out = Vec::new();
-        pair_terms_into(fleet, d_min, &mut out);
+        pair_terms_into(&mut untimed, d_min, horizon, &mut out, |i, t| {
+            t.times.clone_from(&fleet[i].times)
+        });
         out
+    }
+
+    fn pair_terms(fleet: &[Trajectory], d_min: f64) -> Vec<PairTerms> {
+        pair_terms_at(fleet, d_min, horizon_of(fleet))
     }
 
     fn all_pair_terms(fleet: &[Trajectory], d_min: f64) -> Vec<PairTerms> {
@@ -333,6 +386,22 @@ mod tests {
             };
             let all = nonzero(all_pair_terms(&fleet, d_min));
             prop_assert_eq!(nonzero(pair_terms(&fleet, d_min)), all);
+        }
+
+        /// Wherever the slabs end (before the last arrival, just after it, long after it, or
+        /// nowhere), the terms are the all-pairs ones.
+        #[test]
+        fn pair_terms_do_not_depend_on_where_the_slabs_end(
+            fleet in prop::collection::vec(crossing(), 6..14),
+            d_min in 20.0..200.0f64,
+            scale in prop_oneof![Just(0.3), Just(1.0 + 1e-9), Just(3.0), Just(f64::NAN)],
+        ) {
+            let nonzero = |pairs: Vec<PairTerms>| -> Vec<PairTerms> {
+                pairs.into_iter().filter(|p| p.breach_s != 0.0 || p.penalty != 0.0).collect()
+            };
+            let all = nonzero(all_pair_terms(&fleet, d_min));
+            let at = pair_terms_at(&fleet, d_min, horizon_of(&fleet) * scale);
+            prop_assert_eq!(nonzero(at), all);
         }
     }
 }

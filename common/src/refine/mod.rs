@@ -52,8 +52,8 @@ use std::ops::Range;
 use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
 
-use crate::geometry::polyline_length;
 use crate::cost::{FleetEvaluation, FleetModel};
+use crate::geometry::polyline_length;
 use crate::scenario::Scenario;
 use crate::swarm::core::parallel;
 use crate::trajectory::{shortest_pitch_feasible_length, Trajectory};
