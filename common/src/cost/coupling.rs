@@ -142,7 +142,7 @@ pub(super) fn pair_terms_into(
         if small {
             return all_pair_terms_into(trajectories, d_min, &mut scratch.velocities, out);
         }
-        if !(last <= horizon) {
+        if last > horizon || horizon.is_nan() {
             boxes_of(trajectories, &mut scratch.boxes);
         }
         let Scratch {
