@@ -392,7 +392,8 @@ impl FleetModel {
             let length = legs[start..].iter().sum();
             lengths.push(length);
             // Its own terms do not depend on the timing.
-            (out.vehicles).push(self.vehicle_terms(i, &t.points, &legs[start..], length));
+            out.vehicles
+                .push(self.vehicle_terms(i, &t.points, &legs[start..], length));
         }
         let arrival = common_arrival(
             s.fleet.mission_time_s,
