@@ -31,7 +31,7 @@
 //! (`1 + excess / limit` per leg).
 
 use crate::bspline;
-use crate::geometry::Vec3;
+use crate::geometry::{polyline_length, Vec3};
 use crate::swarm::Problem;
 use crate::terrain::{hazard_clearance, Hazard, Terrain};
 
@@ -147,7 +147,7 @@ impl CrawlerModel {
 
     /// Every term of a draped path.
     pub fn terms(&self, path: &[Vec3]) -> CrawlerTerms {
-        let length = crate::geometry::polyline_length(path);
+        let length = polyline_length(path);
         let undulation: f64 = path.windows(2).map(|w| (w[1].z - w[0].z).abs()).sum();
         let mut slip = 0.0;
         let mut clearance = f64::INFINITY;
@@ -486,11 +486,7 @@ mod tests {
         assert_abs_diff_eq!(p[25], Vec3::new(29.6875, 22.5, 0.5), epsilon = 1e-9);
         // The reported length is the curve's, shorter than the polygon's 4 · √(25² + 20²).
         let t = m.terms(&p);
-        assert_abs_diff_eq!(
-            t.length_m,
-            crate::geometry::polyline_length(&p),
-            epsilon = 1e-12
-        );
+        assert_abs_diff_eq!(t.length_m, polyline_length(&p), epsilon = 1e-12);
         assert!(t.length_m < 4.0 * (25.0f64 * 25.0 + 20.0 * 20.0).sqrt() - 5.0);
     }
 

@@ -6,7 +6,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::geometry::{pitch, segment_point_distance, turns};
+use crate::geometry::{pitch, polyline_length, segment_point_distance, turns};
 use crate::scenario::Scenario;
 use crate::separation::pair_separation;
 use crate::trajectory::{shortest_pitch_feasible_length, Trajectory};
@@ -98,7 +98,7 @@ pub fn assess(scenario: &Scenario, trajectories: &[Trajectory]) -> Assessment {
         if let Some(c) = &crawler {
             violations.extend(c.violations(&v.id));
         }
-        let length: f64 = pts.windows(2).map(|w| (w[1] - w[0]).norm()).sum();
+        let length = polyline_length(pts);
         let max_turn = turns(pts).map(f64::to_degrees).fold(0.0, f64::max);
         let max_pitch = pts
             .windows(2)
@@ -295,7 +295,7 @@ pub fn notices(
     let mut out = Vec::new();
     let mission = scenario.fleet.mission_time_s;
     for (v, t) in scenario.vehicles.iter().zip(trajectories) {
-        let length: f64 = t.points.windows(2).map(|w| (w[1] - w[0]).norm()).sum();
+        let length = polyline_length(&t.points);
         let earliest = length / v.speed_max_mps;
         let latest = length / v.speed_min_mps;
         let shortest = shortest_pitch_feasible_length(v);

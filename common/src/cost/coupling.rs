@@ -130,19 +130,17 @@ pub(super) fn pair_terms_into(
         let small = trajectories.len() <= SMALL_FLEET;
         scratch.velocities.reset(trajectories.len());
         scratch.boxes.reset(horizon);
-        let mut last = 0.0f64;
         for (i, t) in trajectories.iter_mut().enumerate() {
             time(i, t);
             if !small {
                 scratch.boxes.push(&t.times, &t.points);
             }
-            last = t.times.last().map_or(last, |&end| last.max(end));
         }
         let trajectories = &*trajectories;
         if small {
             return all_pair_terms_into(trajectories, d_min, &mut scratch.velocities, out);
         }
-        if last > horizon || horizon.is_nan() {
+        if horizon_of(trajectories) > horizon || horizon.is_nan() {
             boxes_of(trajectories, &mut scratch.boxes);
         }
         let Scratch {

@@ -9,7 +9,7 @@
 //! is coordinate `c` of point `k` of the path (points `1..=M` are the inner waypoints).
 
 use crate::cost::Sphere;
-use crate::geometry::{closest_param, Vec3, CONTACT_GUARD_M, MIN_HEADING_EXTENT};
+use crate::geometry::{closest_param, polyline_length, Vec3, CONTACT_GUARD_M, MIN_HEADING_EXTENT};
 use crate::trajectory::Trajectory;
 
 /// One linearised limit: its value at the current path (≤ 0 keeps it) and its sparse gradient.
@@ -327,7 +327,7 @@ fn leg_at(trajectory: &Trajectory, t: f64) -> (usize, f64) {
 /// for a path that must arrive by a time at its top speed, or not before it at its slowest.
 pub fn length_row(points: &[Vec3], limit: f64, sign: f64) -> Option<Row> {
     let inner = points.len().saturating_sub(2);
-    let length: f64 = points.windows(2).map(|w| (w[1] - w[0]).norm()).sum();
+    let length = polyline_length(points);
     let mut row = Row::new(sign * (length - limit) / limit);
     if row.value < FAR * 0.1 {
         return None;

@@ -4,8 +4,7 @@
 
 use crate::broad_phase::{boxes_within, extent};
 use crate::cost::{depth_term, soft_threat_term, time_term, FleetModel, Sphere};
-use crate::geometry::polyline_length;
-use crate::geometry::Vec3;
+use crate::geometry::{polyline_length, Vec3};
 
 /// Vehicle `i`'s smooth share of eq. (12): λ1 F(L) + λ2 F(D) + λ3 F(O) + λ4 F(T) (F(S) is
 /// zero while the separation rows hold), with F(O) measured against `soft`.

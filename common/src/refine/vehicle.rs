@@ -14,8 +14,7 @@ use super::constraints::{entry_turn_row, Limits, Row};
 use super::search::{Arena, Search};
 use super::settings::RefineSettings;
 use crate::cost::FleetModel;
-use crate::geometry::polyline_length;
-use crate::geometry::Vec3;
+use crate::geometry::{polyline_length, Vec3};
 use crate::trajectory::Trajectory;
 use crate::vehicle_problem::{VehicleEvaluation, VehicleProblem};
 

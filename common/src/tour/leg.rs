@@ -77,11 +77,6 @@ pub fn feasible(path: &[Vec3], spheres: &[Sphere]) -> bool {
     intersections(path, spheres) == 0
 }
 
-/// Length of a polyline (Hu et al. 2023, eq. (27)–(28)), metres.
-pub fn path_length(path: &[Vec3]) -> f64 {
-    path.windows(2).map(|w| (w[1] - w[0]).norm()).sum()
-}
-
 /// One leg between two points as a box-bounded problem.
 #[derive(Debug, Clone)]
 pub struct LegProblem {
@@ -255,6 +250,7 @@ impl Problem for LegProblem {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::geometry::{leg_lengths, polyline_length};
     use approx::assert_abs_diff_eq;
     use rand::SeedableRng;
 
@@ -294,7 +290,7 @@ mod tests {
         let path = p.path(&x);
         assert_eq!(p.intersections(&path), 0);
         assert_abs_diff_eq!(p.cost(&x), 2.0 * 3400f64.sqrt(), epsilon = 1e-9);
-        assert_abs_diff_eq!(path_length(&path), 116.619_037_896_906, epsilon = 1e-9);
+        assert_abs_diff_eq!(polyline_length(&path), 116.619_037_896_906, epsilon = 1e-9);
     }
 
     #[test]
@@ -361,11 +357,11 @@ mod tests {
                 .chain((0..9).map(|k| p.raw_waypoint(&x, k)))
                 .chain(std::iter::once(p.end))
                 .collect();
-            let lens: Vec<f64> = raw.windows(2).map(|w| (w[1] - w[0]).norm()).collect();
+            let lens: Vec<f64> = leg_lengths(&raw).collect();
             let longest = lens.iter().copied().fold(0.0, f64::max);
             let equal = lens.iter().filter(|l| (*l - longest).abs() < 1e-6).count();
             assert!(equal >= 9, "{lens:?}");
-            assert!(path_length(&raw) >= 100.0 - 1e-9);
+            assert!(polyline_length(&raw) >= 100.0 - 1e-9);
         }
         assert_eq!(p.move_groups(), vec![0..9, 9..18, 18..27]);
     }

@@ -28,8 +28,8 @@ pub use cages::{
 pub use figures::TourFigures;
 pub use fleet::{shares, FleetTours, NoTours};
 pub use leg::{
-    feasible, intersections, path_length, safety_spheres, segment_hits, LegProblem, Sphere,
-    CHORD_WEIGHT, HIT_PENALTY_M,
+    feasible, intersections, safety_spheres, segment_hits, LegProblem, Sphere, CHORD_WEIGHT,
+    HIT_PENALTY_M,
 };
 pub use order::{
     distance_matrix, open_order_length, optimal_tour_length, swap_sequence, tour_length, two_opt,

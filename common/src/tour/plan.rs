@@ -2,8 +2,9 @@
 //! the settings of both and the plan they give (Hu et al. 2023, §III–IV, Tables 3, 5 and 6).
 
 use super::cages::{Cage, InspectionPoint};
-use super::leg::{intersections, path_length, safety_spheres, LegProblem};
+use super::leg::{intersections, safety_spheres, LegProblem};
 use super::order::{distance_matrix, tour_length, Ordered, SwapPso};
+use crate::geometry::polyline_length;
 
 use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
@@ -309,7 +310,8 @@ pub fn plan_tour(
         evaluations += leg.evaluations;
         interrupted |= leg.interrupted;
         curves.push((leg.convergence, leg.cost));
-        leg_lengths.push(path_length(&leg.path));
+        // Hu et al. 2023, eq. (27)–(28).
+        leg_lengths.push(polyline_length(&leg.path));
         path.extend(leg.path.into_iter().skip(1));
     }
     let mut convergence = summed_curve(curves.iter().map(|(c, cost)| (c.as_slice(), *cost)));

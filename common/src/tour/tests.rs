@@ -1,7 +1,7 @@
 //! Tours and legs: plans of cage group A, the stop flag, the velocity cap, convergence curves.
 
 use super::*;
-use crate::geometry::Vec3;
+use crate::geometry::{polyline_length, Vec3};
 use approx::assert_abs_diff_eq;
 use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
@@ -79,7 +79,11 @@ fn de_pso_tour_of_group_a_is_safe_and_complete() {
     assert_visits_every_point_in_order(&pts, &plan);
     // Table 6's measures are consistent.
     assert_eq!(plan.leg_lengths.len(), pts.len() + 1);
-    assert_abs_diff_eq!(plan.tour_length_m, path_length(&plan.path), epsilon = 1e-6);
+    assert_abs_diff_eq!(
+        plan.tour_length_m,
+        polyline_length(&plan.path),
+        epsilon = 1e-6
+    );
     assert!(plan.growth_m >= 0.0, "{}", plan.growth_m);
     assert_abs_diff_eq!(
         plan.growth_m,
@@ -171,7 +175,11 @@ fn every_algorithm_plans_a_complete_tour() {
         let (pts, plan) = group_a_plan(alg, 2);
         assert_eq!(plan.order.len(), pts.len(), "{}", alg.name());
         assert!(plan.growth_m >= 0.0, "{}: {}", alg.name(), plan.growth_m);
-        assert_abs_diff_eq!(plan.tour_length_m, path_length(&plan.path), epsilon = 1e-6);
+        assert_abs_diff_eq!(
+            plan.tour_length_m,
+            polyline_length(&plan.path),
+            epsilon = 1e-6
+        );
     }
 }
 

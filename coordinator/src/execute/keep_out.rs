@@ -2,7 +2,7 @@
 //! its path as obstacles, a margin it is inside eased to let it out) and where a path meets
 //! them. Split from `repair`, which uses them.
 
-use shoal_common::geometry::Vec3;
+use shoal_common::geometry::{polyline_length, Vec3};
 use shoal_common::scenario::{Obstacle, ObstacleKind, Scenario};
 
 use super::replan::Request;
@@ -22,7 +22,7 @@ pub(super) fn drive_to_keep_out(
     out: &mut Vec<Vec3>,
     out_speeds: &mut Vec<f64>,
 ) -> (f64, f64) {
-    let total: f64 = pts.windows(2).map(|w| (w[1] - w[0]).norm()).sum();
+    let total = polyline_length(pts);
     let mut driven = 0.0;
     for (i, w) in pts.windows(2).enumerate() {
         let (a, b) = (w[0], w[1]);

@@ -39,7 +39,7 @@ use std::time::Instant;
 
 use shoal_common::coverage::path::Pose2;
 use shoal_common::coverage::reroute::WaysRound;
-use shoal_common::geometry::{segment_hits_sphere, Vec3};
+use shoal_common::geometry::{leg_lengths, polyline_length, segment_hits_sphere, Vec3};
 use shoal_common::scenario::{Obstacle, ObstacleKind, Scenario};
 use shoal_common::separation::{motion_separation, Motion};
 use shoal_common::trajectory::Trajectory;
@@ -116,7 +116,7 @@ fn repaired_path(r: &Request, scenario: &Scenario) -> Result<Repaired, String> {
             let Some(way) = crawler_way_round(r, ways, &pts, (0, 0), along) else {
                 return Err("no way back to its path on ground it may drive".into());
             };
-            let metres: f64 = way.windows(2).map(|w| (w[1] - w[0]).norm()).sum();
+            let metres = polyline_length(&way);
             tracing::info!(
                 "{id}: the straight way back to its path crosses ground it may not drive; \
                  rejoining by {metres:.0} m searched on the seabed map"
@@ -336,7 +336,7 @@ fn crawler_way_round(
 /// `points` flown at `speeds` scaled alike to take `duration` from `t0`, each leg kept within
 /// `[v_min, v_max]`.
 fn timed(points: Vec<Vec3>, speeds: &[f64], t0: f64, duration: f64, v: (f64, f64)) -> Trajectory {
-    let lengths: Vec<f64> = points.windows(2).map(|w| (w[1] - w[0]).norm()).collect();
+    let lengths: Vec<f64> = leg_lengths(&points).collect();
     let natural: f64 = lengths
         .iter()
         .zip(speeds)

@@ -23,7 +23,7 @@ use rand::rngs::StdRng;
 use rand::Rng;
 use shoal_common::cost::FleetModel;
 use shoal_common::coverage::reroute::CrawlerGround;
-use shoal_common::geometry::Vec3;
+use shoal_common::geometry::{polyline_length, Vec3};
 use shoal_common::refine::{refine_vehicle, RefineSettings};
 use shoal_common::scenario::Scenario;
 use shoal_common::swarm::pso::Pso;
@@ -178,7 +178,7 @@ pub fn warm_chromosome(
 
 /// The polyline `points` flown from mission time `t0` at the one speed that takes `duration`.
 fn at_even_speed(points: &[Vec3], t0: f64, duration: f64) -> Trajectory {
-    let length: f64 = points.windows(2).map(|w| (w[1] - w[0]).norm()).sum();
+    let length = polyline_length(points);
     let speed = (length / duration.max(1e-9)).max(1e-9);
     let mut t = t0;
     let mut times = Vec::with_capacity(points.len());
