@@ -320,77 +320,86 @@ pub fn leg_times(
         *v = 1.0 / v.clamp(vehicle.speed_min_mps, vehicle.speed_max_mps);
     }
     let paces = &*speeds;
-    let alpha = if total * p_lo >= target {
-        None
-    } else if total * p_hi <= target {
-        Some(f64::INFINITY)
-    } else {
-        // T(α) and its slope on the current piece (the free legs' Σ l p).
-        let eval = |a: f64| -> (f64, f64) {
-            let (mut t, mut slope) = (0.0, 0.0);
-            // Selects, not branches: which legs are clamped changes from leg to leg, so
-            // branches mispredict (adding 0.0 to the slope leaves it as it was).
-            for (l, &p) in lengths.iter().zip(paces) {
-                let q = a * p;
-                let (slow, fast) = (q <= p_lo, q >= p_hi);
-                let pace = if slow {
-                    p_lo
-                } else if fast {
-                    p_hi
-                } else {
-                    q
-                };
-                t += l * pace;
-                slope += if slow || fast { 0.0 } else { l * p };
-            }
-            (t, slope)
-        };
-        let (max_p, min_p) = paces
-            .iter()
-            .fold((f64::MIN, f64::MAX), |(hi, lo), p| (hi.max(*p), lo.min(*p)));
-        let (mut lo, mut hi) = (p_lo / max_p, p_hi / min_p);
-        // Start from the unclamped solution.
-        let free: f64 = lengths.iter().zip(paces).map(|(l, p)| l * p).sum();
-        let mut a = (target / free).clamp(lo, hi);
-        for _ in 0..100 {
-            let (t, slope) = eval(a);
-            let err = t - target;
-            if err.abs() <= 1e-12 * target {
-                break;
-            }
-            if err < 0.0 {
-                lo = a;
+    if total * p_lo >= target {
+        // Too long to make it: flat out.
+        time_legs(lengths, p_lo, times);
+        return;
+    }
+    if total * p_hi <= target {
+        // Too short to be late: as slow as it goes.
+        time_legs(lengths, p_hi, times);
+        return;
+    }
+    // The paces at `α` (selects, not branches: which legs are clamped changes from leg to leg,
+    // so branches mispredict), the samples' times into `times`, and T(α) with its slope on the
+    // current piece (the free legs' Σ l p; adding 0.0 leaves it as it was). The search stops on
+    // a step it has just timed, so its times are the answer.
+    times.reserve(lengths.len() + 1);
+    let timed_at = |a: f64, times: &mut Vec<f64>| -> (f64, f64) {
+        let (mut t, mut slope) = (0.0, 0.0);
+        times.clear();
+        times.push(0.0);
+        for (l, &p) in lengths.iter().zip(paces) {
+            let q = a * p;
+            let (slow, fast) = (q <= p_lo, q >= p_hi);
+            let pace = if slow {
+                p_lo
+            } else if fast {
+                p_hi
             } else {
-                hi = a;
-            }
-            let newton = if slope > 0.0 {
-                a - err / slope
-            } else {
-                f64::NAN
+                q
             };
-            a = if newton > lo && newton < hi {
-                newton
-            } else {
-                0.5 * (lo + hi)
-            };
-            if hi - lo <= 1e-15 * hi {
-                break;
-            }
+            t += l * pace;
+            slope += if slow || fast { 0.0 } else { l * p };
+            times.push(t);
         }
-        Some(a)
+        (t, slope)
     };
+    let (max_p, min_p) = paces
+        .iter()
+        .fold((f64::MIN, f64::MAX), |(hi, lo), p| (hi.max(*p), lo.min(*p)));
+    let (mut lo, mut hi) = (p_lo / max_p, p_hi / min_p);
+    // Start from the unclamped solution.
+    let free: f64 = lengths.iter().zip(paces).map(|(l, p)| l * p).sum();
+    let mut a = (target / free).clamp(lo, hi);
+    for _ in 0..100 {
+        let (t, slope) = timed_at(a, times);
+        let err = t - target;
+        if err.abs() <= 1e-12 * target {
+            return;
+        }
+        if err < 0.0 {
+            lo = a;
+        } else {
+            hi = a;
+        }
+        let newton = if slope > 0.0 {
+            a - err / slope
+        } else {
+            f64::NAN
+        };
+        a = if newton > lo && newton < hi {
+            newton
+        } else {
+            0.5 * (lo + hi)
+        };
+        if hi - lo <= 1e-15 * hi {
+            break;
+        }
+    }
+    timed_at(a, times);
+}
+
+/// The sample times of legs of `lengths` all flown at `pace` (s/m), into `times` (cleared
+/// first; from 0, one more than legs).
+fn time_legs(lengths: &[f64], pace: f64, times: &mut Vec<f64>) {
     let mut t = 0.0;
     times.clear();
     times.push(0.0);
-    for (l, p) in lengths.iter().zip(paces) {
-        let pace = match alpha {
-            None => p_lo,
-            Some(a) if a.is_infinite() => p_hi,
-            Some(a) => (a * p).clamp(p_lo, p_hi),
-        };
+    times.extend(lengths.iter().map(|l| {
         t += l * pace;
-        times.push(t);
-    }
+        t
+    }));
 }
 
 #[cfg(test)]
