@@ -263,9 +263,13 @@ impl Driver<'_> {
                 }
             }
             CoordinatorToAgent::Hold { reason, .. } => {
-                tracing::warn!("mission {mission}: hold: {reason}");
-                if let Err(e) = self.give(VehicleCommand::Hold, None) {
-                    tracing::warn!("mission {mission}: hold not given: {e}");
+                if self.keeps_its_hold() {
+                    tracing::debug!("mission {mission}: hold repeated; the vehicle keeps it");
+                } else {
+                    tracing::warn!("mission {mission}: hold: {reason}");
+                    if let Err(e) = self.give(VehicleCommand::Hold, None) {
+                        tracing::warn!("mission {mission}: hold not given: {e}");
+                    }
                 }
                 self.report();
             }
@@ -280,6 +284,21 @@ impl Driver<'_> {
             _ => {}
         }
         None
+    }
+
+    /// Whether the vehicle keeps the hold it was given last: it confirmed it, nothing was given
+    /// since, and it does not report itself moving (before its first fix it reports nothing).
+    /// A hold the coordinator repeats then is not given again: the coordinator repeats its
+    /// orders every second until the vehicle's first report, and a MAVLink vehicle would be put
+    /// back in its hold mode each time, over any mode its operator chose meanwhile.
+    fn keeps_its_hold(&mut self) -> bool {
+        let confirmed = self.command.as_ref().is_some_and(|c| {
+            c.command == VehicleCommand::Hold && c.state == CommandState::Confirmed
+        });
+        confirmed
+            && self.link.state(self.order.clock.now()).map_or(true, |s| {
+                matches!(s.status, VehicleStatus::Holding | VehicleStatus::Stopped)
+            })
     }
 
     /// Holds the vehicle as the agent leaves, waiting a little for it to confirm.

@@ -6,8 +6,8 @@
 //! vehicle's first report, every second it is sent its mission again and then, in the order
 //! the coordinator gave them, what it holds the vehicle to since: the latest plan revision and
 //! a hold (a replan ends a hold, so a hold still standing came after it). An update of a
-//! revision the agent has changes nothing; a hold is given to the vehicle again, which one
-//! holding keeps. So the first report shows what the coordinator believes of it.
+//! revision the agent has changes nothing, nor does a hold its vehicle confirmed and keeps (the
+//! agent does not give it again). So the first report shows what the coordinator believes of it.
 
 use super::tracked::Tracked;
 

@@ -14,6 +14,8 @@ struct Recorder {
     confirmed: Arc<Mutex<usize>>,
     /// Every hold fails to reach the vehicle.
     holds_fail: bool,
+    /// The vehicle has no position fix: it reports no state.
+    no_fix: bool,
     /// An update's upload (not the mission's first) is confirmed only once another command
     /// was given after it, as over a link whose vehicle answers after the agent's next order.
     uploads_answer_late: bool,
@@ -43,6 +45,9 @@ impl VehicleLink for Recorder {
         self.record(format!("upload {}", plan.times.len()))
     }
     fn state(&mut self, now: f64) -> Result<VehicleState, LinkError> {
+        if self.no_fix {
+            return Err(LinkError::Io("no position fix yet".into()));
+        }
         Ok(VehicleState {
             t_s: now,
             position: [0.0; 3],
@@ -386,4 +391,50 @@ fn an_upload_never_answered_is_passed_over_by_the_next_one_answered() {
     let (_, revisions) = updates_3_and_4(&mut link);
     assert_eq!(revisions.last(), Some(&4), "{revisions:?}");
     assert!(!revisions.contains(&3), "{revisions:?}");
+}
+
+/// The commands `link` was given for `messages`, then the stop.
+fn given(mut link: Recorder, messages: Vec<CoordinatorToAgent>) -> Vec<String> {
+    let calls = Arc::clone(&link.calls);
+    run_to_the_stop(&mut link, messages);
+    let given = calls.lock().map(|c| c.clone()).unwrap_or_default();
+    given
+}
+
+#[test]
+fn a_hold_repeated_before_the_first_fix_is_given_once() {
+    // The coordinator repeats a hold every second until the vehicle's first report, which a
+    // MAVLink vehicle sends only once it has a fix: the vehicle confirmed the first hold, so
+    // the repeats are not given (nor is the hold after an update, twice).
+    let no_fix = || Recorder {
+        no_fix: true,
+        ..Recorder::default()
+    };
+    assert_eq!(
+        given(no_fix(), vec![hold(), hold(), hold()]),
+        ["upload 2", "hold", "stop"]
+    );
+    assert_eq!(
+        given(no_fix(), vec![hold(), update(3), hold(), hold()]),
+        ["upload 2", "hold", "upload 2", "hold", "stop"]
+    );
+}
+
+#[test]
+fn a_repeated_hold_is_given_again_to_a_vehicle_that_moves_or_gave_it_up() {
+    // This vehicle reports itself under way although it confirmed the hold.
+    assert_eq!(
+        given(Recorder::default(), vec![hold(), hold()]),
+        ["upload 2", "hold", "hold", "stop"]
+    );
+    // The first hold (the link's second command) was given up.
+    let gave_up = Recorder {
+        no_fix: true,
+        gives_up: vec![2],
+        ..Recorder::default()
+    };
+    assert_eq!(
+        given(gave_up, vec![hold(), hold()]),
+        ["upload 2", "hold", "hold", "stop"]
+    );
 }
