@@ -19,7 +19,7 @@
 //! (`parry`'s BVH, `broccoli`) index static shapes and allocate per query; this reuses its
 //! buffers across the swarm's evaluations.
 
-use crate::geometry::Vec3;
+use crate::geometry::{lower_corner, upper_corner, Vec3};
 
 mod pairs;
 pub mod spheres;
@@ -71,12 +71,16 @@ struct SweepBox {
 
 /// Squared distance between two swept boxes, without branches: most box pairs the sweep
 /// meets are neither clearly apart nor clearly overlapping, so branching on each axis
-/// mispredicts. (Boxes at infinity never get here; see [`SlabBoxes::close_pairs`].)
+/// mispredicts. Each gap is the larger by `x > y ? x : y`, one `maxsd` instruction, where
+/// `f64::max`, which passes a NaN over, takes three. The same gaps but where a NaN is involved,
+/// and there never larger, so no pair `f64::max` would keep is dropped. (Boxes at infinity
+/// never get here; see [`SlabBoxes::close_pairs`].)
 #[inline]
 fn sweep_gap2(a: &SweepBox, b: &SweepBox) -> f64 {
+    let larger = |x: f64, y: f64| if x > y { x } else { y };
     let mut s = 0.0;
     for d in 0..3 {
-        let g = (a.lo[d] - b.hi[d]).max(b.lo[d] - a.hi[d]).max(0.0);
+        let g = larger(larger(a.lo[d] - b.hi[d], b.lo[d] - a.hi[d]), 0.0);
         s += g * g;
     }
     s
@@ -156,8 +160,8 @@ impl SlabBoxes {
             let mut stray2 = 0.0f64;
             while first < n && times[first] <= t1 {
                 let p = &points[first];
-                lo = lo.inf(p);
-                hi = hi.sup(p);
+                lo = lower_corner(&lo, p);
+                hi = upper_corner(&hi, p);
                 let off = (p - start - run * ((times[first] - t0) * per_slab)).norm_squared();
                 if off.is_nan() {
                     stray2 = f64::INFINITY;
@@ -167,8 +171,8 @@ impl SlabBoxes {
                 first += 1;
             }
             // The end last: a NaN sample makes the running box forget what came before it.
-            self.lo.push(lo.inf(&end));
-            self.hi.push(hi.sup(&end));
+            self.lo.push(lower_corner(&lo, &end));
+            self.hi.push(upper_corner(&hi, &end));
             self.bounds.push(end);
             // The last slab's chord ends at the horizon: past it, one that still moves has none.
             let past_horizon = k + 1 == SLABS && arrival > self.horizon;
@@ -320,8 +324,8 @@ impl SlabBoxes {
         for v in 0..self.len() {
             let c = self.lo[v * SLABS + k] + self.hi[v * SLABS + k];
             if c.iter().all(|x| x.is_finite()) {
-                lo = lo.inf(&c);
-                hi = hi.sup(&c);
+                lo = lower_corner(&lo, &c);
+                hi = upper_corner(&hi, &c);
             }
         }
         let spread = hi - lo;
@@ -340,9 +344,9 @@ pub fn extent(points: &[Vec3]) -> (Vec3, Vec3) {
         let far = Vec3::repeat(f64::INFINITY);
         return (far, far);
     };
-    points
-        .iter()
-        .fold((*first, *first), |(lo, hi), p| (lo.inf(p), hi.sup(p)))
+    points.iter().fold((*first, *first), |(lo, hi), p| {
+        (lower_corner(&lo, p), upper_corner(&hi, p))
+    })
 }
 
 /// Whether boxes `a` and `b` (lower, upper corner) are closer than `reach`, by the test the

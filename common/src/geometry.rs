@@ -17,6 +17,25 @@ pub fn polyline_length(points: &[Vec3]) -> f64 {
     leg_lengths(points).sum()
 }
 
+/// The lower corner of the box of `a` and `b`: each coordinate's smaller. The value of
+/// nalgebra's `a.inf(b)` (a NaN in either gives `b`'s coordinate too), except that of two zeros
+/// of opposite sign it gives `b`'s, not `a`'s, which no difference, square or comparison tells
+/// apart. `x < y ? x : y` is one `minsd` instruction where `inf`'s `x <= y ? x : y` takes
+/// four; bounding boxes are built for every vehicle at every fleet evaluation.
+#[inline]
+pub fn lower_corner(a: &Vec3, b: &Vec3) -> Vec3 {
+    let min = |x: f64, y: f64| if x < y { x } else { y };
+    Vec3::new(min(a.x, b.x), min(a.y, b.y), min(a.z, b.z))
+}
+
+/// The upper corner of the box of `a` and `b`, as [`lower_corner`] the lower: nalgebra's
+/// `a.sup(b)` but for the sign of a zero.
+#[inline]
+pub fn upper_corner(a: &Vec3, b: &Vec3) -> Vec3 {
+    let max = |x: f64, y: f64| if x > y { x } else { y };
+    Vec3::new(max(a.x, b.x), max(a.y, b.y), max(a.z, b.z))
+}
+
 /// Parameter `u ∈ [0, 1]` of the point of segment `a→b` closest to `p`.
 ///
 /// Hu et al. 2023, eq. (31) writes the segment as a line `a + u (b − a)`; clamping `u` to `[0, 1]` keeps
@@ -342,5 +361,52 @@ mod tests {
             -36.869_897_645_844_02,
             epsilon = 1e-9
         );
+    }
+
+    #[test]
+    fn box_corners_by_hand() {
+        let (a, b) = (v(1., -2., 3.), v(-1., 5., 3.));
+        assert_eq!(lower_corner(&a, &b), v(-1., -2., 3.));
+        assert_eq!(upper_corner(&a, &b), v(1., 5., 3.));
+        // A NaN gives the second point's coordinate, as nalgebra's inf and sup do.
+        let nan = v(f64::NAN, 0., 0.);
+        assert_eq!(lower_corner(&nan, &a).x, 1.0);
+        assert!(lower_corner(&a, &nan).x.is_nan());
+        assert!(upper_corner(&a, &nan).x.is_nan());
+    }
+
+    mod corners {
+        use super::*;
+        use proptest::prelude::*;
+
+        /// Ordinary coordinates, zeros of either sign, NaN and an infinity.
+        fn coordinate(infinity: f64) -> impl Strategy<Value = f64> {
+            prop_oneof![
+                -1e4..1e4f64,
+                Just(0.0),
+                Just(-0.0),
+                Just(f64::NAN),
+                Just(infinity)
+            ]
+        }
+
+        proptest! {
+            #[test]
+            fn box_corners_are_nalgebras_but_for_the_sign_of_a_zero(
+                a in prop::array::uniform3(coordinate(f64::INFINITY)),
+                b in prop::array::uniform3(coordinate(f64::NEG_INFINITY)),
+            ) {
+                let (a, b) = (Vec3::from(a), Vec3::from(b));
+                let same = |ours: Vec3, theirs: Vec3| {
+                    ours.iter().zip(theirs.iter()).all(|(x, y)| {
+                        x.to_bits() == y.to_bits()
+                            || (x.is_nan() && y.is_nan())
+                            || (*x == 0.0 && *y == 0.0)
+                    })
+                };
+                prop_assert!(same(lower_corner(&a, &b), a.inf(&b)), "{:?} {:?}", a, b);
+                prop_assert!(same(upper_corner(&a, &b), a.sup(&b)), "{:?} {:?}", a, b);
+            }
+        }
     }
 }

@@ -8,7 +8,7 @@
 use std::cell::RefCell;
 
 use crate::broad_phase::spheres::SphereGrid;
-use crate::geometry::{chord_inside_sphere, Vec3, CONTACT_GUARD_M};
+use crate::geometry::{chord_inside_sphere, lower_corner, upper_corner, Vec3, CONTACT_GUARD_M};
 
 /// A sphere the cost functions test against: centre and radius already inflated.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -87,9 +87,9 @@ impl SphereIndex {
         marks.clear();
         marks.resize(self.grid.words(), 0);
         if let Some(first) = boxes.first() {
-            let (lo, hi) = boxes
-                .iter()
-                .fold(*first, |(lo, hi), (l, h)| (lo.inf(l), hi.sup(h)));
+            let (lo, hi) = boxes.iter().fold(*first, |(lo, hi), (l, h)| {
+                (lower_corner(&lo, l), upper_corner(&hi, h))
+            });
             self.grid.mark_near(&lo, &hi, marks);
         }
         let mut out = SphereTerms::default();
@@ -146,8 +146,8 @@ fn chunk_boxes(points: &[Vec3], boxes: &mut Vec<ChunkBox>) {
     let n_legs = points.len().saturating_sub(1);
     boxes.extend((0..n_legs).step_by(CHUNK_LEGS).map(|start| {
         let pts = &points[start..(start + CHUNK_LEGS + 1).min(points.len())];
-        let lo = pts.iter().fold(pts[0], |m, p| m.inf(p));
-        let hi = pts.iter().fold(pts[0], |m, p| m.sup(p));
+        let lo = pts.iter().fold(pts[0], |m, p| lower_corner(&m, p));
+        let hi = pts.iter().fold(pts[0], |m, p| upper_corner(&m, p));
         (lo, hi)
     }));
 }
