@@ -16,6 +16,10 @@
 use crate::geometry::{leg_lengths, polyline_length, Vec3};
 use crate::scenario::{Scenario, Vehicle};
 
+mod timing;
+
+pub use timing::{arrival_window, common_arrival, leg_times};
+
 /// Genes per waypoint: x, y, z and the status gene δ.
 pub const GENES_PER_WAYPOINT: usize = 4;
 
@@ -265,22 +269,6 @@ pub fn required_horizontal_length(vehicle: &Vehicle) -> f64 {
     horizontal.max(d.z.abs() / vehicle.max_pitch_deg.to_radians().tan())
 }
 
-/// Earliest and latest arrival a path allows: `t_min = L / v_max`, `t_max = L / v_min`
-/// (Zhi & Zuo 2024, eq. (2)), seconds.
-pub fn arrival_window(length: f64, vehicle: &Vehicle) -> (f64, f64) {
-    (
-        length / vehicle.speed_max_mps,
-        length / vehicle.speed_min_mps,
-    )
-}
-
-/// The arrival time all vehicles aim for: the mission time when every vehicle can make it, else
-/// the earliest time the slowest-to-arrive vehicle can make (Zhi & Zuo 2024, §2.2.2: the task "cannot be
-/// completed on time"). Never earlier than the mission time.
-pub fn common_arrival(mission_time: f64, earliest: impl IntoIterator<Item = f64>) -> f64 {
-    earliest.into_iter().fold(mission_time, f64::max)
-}
-
 /// Times `path` so the vehicle arrives at `target` seconds, with every leg's speed inside
 /// `[v_min, v_max]` and the legs' speeds in the proportions the status genes request as far as
 /// the limits allow.
@@ -300,106 +288,6 @@ pub fn retime_legs(path: Path, lengths: &[f64], vehicle: &Vehicle, target: f64) 
     let mut times = Vec::with_capacity(points.len());
     leg_times(lengths, &mut speeds, vehicle, target, &mut times);
     Trajectory { times, points }
-}
-
-/// The sample times of [`retime`] for legs of `lengths` at the requested `speeds` (one per leg,
-/// overwritten with the legs' requested paces), into `times` (cleared first; one more than
-/// legs): what the fitness calls on buffers it reuses, so timing a path allocates nothing.
-pub fn leg_times(
-    lengths: &[f64],
-    speeds: &mut [f64],
-    vehicle: &Vehicle,
-    target: f64,
-    times: &mut Vec<f64>,
-) {
-    let (p_lo, p_hi) = (1.0 / vehicle.speed_max_mps, 1.0 / vehicle.speed_min_mps);
-    let total: f64 = lengths.iter().sum();
-    // Each leg's requested pace (s/m), computed once: the search below revisits every leg
-    // several times.
-    for v in speeds.iter_mut() {
-        *v = 1.0 / v.clamp(vehicle.speed_min_mps, vehicle.speed_max_mps);
-    }
-    let paces = &*speeds;
-    if total * p_lo >= target {
-        // Too long to make it: flat out.
-        time_legs(lengths, p_lo, times);
-        return;
-    }
-    if total * p_hi <= target {
-        // Too short to be late: as slow as it goes.
-        time_legs(lengths, p_hi, times);
-        return;
-    }
-    // The paces at `α` (selects, not branches: which legs are clamped changes from leg to leg,
-    // so branches mispredict), the samples' times into `times`, and T(α) with its slope on the
-    // current piece (the free legs' Σ l p; adding 0.0 leaves it as it was). The search stops on
-    // a step it has just timed, so its times are the answer.
-    times.reserve(lengths.len() + 1);
-    let timed_at = |a: f64, times: &mut Vec<f64>| -> (f64, f64) {
-        let (mut t, mut slope) = (0.0, 0.0);
-        times.clear();
-        times.push(0.0);
-        for (l, &p) in lengths.iter().zip(paces) {
-            let q = a * p;
-            let (slow, fast) = (q <= p_lo, q >= p_hi);
-            let pace = if slow {
-                p_lo
-            } else if fast {
-                p_hi
-            } else {
-                q
-            };
-            t += l * pace;
-            slope += if slow || fast { 0.0 } else { l * p };
-            times.push(t);
-        }
-        (t, slope)
-    };
-    let (max_p, min_p) = paces
-        .iter()
-        .fold((f64::MIN, f64::MAX), |(hi, lo), p| (hi.max(*p), lo.min(*p)));
-    let (mut lo, mut hi) = (p_lo / max_p, p_hi / min_p);
-    // Start from the unclamped solution.
-    let free: f64 = lengths.iter().zip(paces).map(|(l, p)| l * p).sum();
-    let mut a = (target / free).clamp(lo, hi);
-    for _ in 0..100 {
-        let (t, slope) = timed_at(a, times);
-        let err = t - target;
-        if err.abs() <= 1e-12 * target {
-            return;
-        }
-        if err < 0.0 {
-            lo = a;
-        } else {
-            hi = a;
-        }
-        let newton = if slope > 0.0 {
-            a - err / slope
-        } else {
-            f64::NAN
-        };
-        a = if newton > lo && newton < hi {
-            newton
-        } else {
-            0.5 * (lo + hi)
-        };
-        if hi - lo <= 1e-15 * hi {
-            break;
-        }
-    }
-    timed_at(a, times);
-}
-
-/// The sample times of legs of `lengths` all flown at `pace` (s/m), into `times` (cleared
-/// first; from 0, one more than legs).
-fn time_legs(lengths: &[f64], pace: f64, times: &mut Vec<f64>) {
-    let mut t = 0.0;
-    times.clear();
-    times.push(0.0);
-    times.extend(lengths.iter().map(|l| {
-        t += l * pace;
-        t
-    }));
 }
 
 #[cfg(test)]
