@@ -17,23 +17,42 @@ pub fn polyline_length(points: &[Vec3]) -> f64 {
     leg_lengths(points).sum()
 }
 
-/// The lower corner of the box of `a` and `b`: each coordinate's smaller. The value of
+/// The larger of `x` and `y` as `x > y ? x : y`: one `maxsd` instruction, where `f64::max`,
+/// which passes a NaN over, takes three (a NaN in either gives `y`). The fitness's box tests run
+/// for every vehicle at every fleet evaluation.
+#[inline]
+pub fn larger(x: f64, y: f64) -> f64 {
+    if x > y {
+        x
+    } else {
+        y
+    }
+}
+
+/// The smaller of `x` and `y` as `x < y ? x : y`, one `minsd`, as [`larger`] the larger.
+#[inline]
+pub fn smaller(x: f64, y: f64) -> f64 {
+    if x < y {
+        x
+    } else {
+        y
+    }
+}
+
+/// The lower corner of the box of `a` and `b`: each coordinate's [`smaller`]. The value of
 /// nalgebra's `a.inf(b)` (a NaN in either gives `b`'s coordinate too), except that of two zeros
 /// of opposite sign it gives `b`'s, not `a`'s, which no difference, square or comparison tells
-/// apart. `x < y ? x : y` is one `minsd` instruction where `inf`'s `x <= y ? x : y` takes
-/// four; bounding boxes are built for every vehicle at every fleet evaluation.
+/// apart; `inf`'s `x <= y ? x : y` takes four instructions per coordinate.
 #[inline]
 pub fn lower_corner(a: &Vec3, b: &Vec3) -> Vec3 {
-    let min = |x: f64, y: f64| if x < y { x } else { y };
-    Vec3::new(min(a.x, b.x), min(a.y, b.y), min(a.z, b.z))
+    Vec3::new(smaller(a.x, b.x), smaller(a.y, b.y), smaller(a.z, b.z))
 }
 
 /// The upper corner of the box of `a` and `b`, as [`lower_corner`] the lower: nalgebra's
 /// `a.sup(b)` but for the sign of a zero.
 #[inline]
 pub fn upper_corner(a: &Vec3, b: &Vec3) -> Vec3 {
-    let max = |x: f64, y: f64| if x > y { x } else { y };
-    Vec3::new(max(a.x, b.x), max(a.y, b.y), max(a.z, b.z))
+    Vec3::new(larger(a.x, b.x), larger(a.y, b.y), larger(a.z, b.z))
 }
 
 /// Parameter `u ∈ [0, 1]` of the point of segment `a→b` closest to `p`.
