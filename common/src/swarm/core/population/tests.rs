@@ -179,3 +179,99 @@ fn memories_are_kept_block_by_block() {
     assert_eq!(pop.elite_x, vec![1.0, 2.0]);
     assert_eq!(pop.elite_cost, 0.0);
 }
+
+/// [`update`] as eq. (5)–(6) first read here: the velocity limit as one `f64::max` chain and the
+/// clamp as branches. The update's faster form must give the same bits.
+fn update_as_written(
+    p: &mut Particle,
+    gbest: &[f64],
+    exchange: Option<&[f64]>,
+    c: Coefficients,
+    limits: &Limits,
+    rng: &mut StdRng,
+) {
+    for g in &limits.groups {
+        let (r1, r2): (f64, f64) = (rng.random(), rng.random());
+        let (a1, a2) = (c.c1 * r1, c.c2 * r2);
+        for d in g.clone() {
+            p.v[d] = c.w * p.v[d] + a1 * (p.best_x[d] - p.x[d]) + a2 * (gbest[d] - p.x[d]);
+        }
+        if let Some(f) = exchange {
+            let a3 = c.c3 * rng.random::<f64>();
+            for d in g.clone() {
+                p.v[d] += a3 * (f[d] - p.x[d]);
+            }
+        }
+        let over = g
+            .clone()
+            .fold(1.0f64, |m, d| m.max(p.v[d].abs() * limits.inv_vmax[d]));
+        for d in g.clone() {
+            let moved = p.v[d] * (1.0 / over);
+            let to = p.x[d] + moved;
+            if to < limits.lower[d] {
+                (p.x[d], p.v[d]) = (limits.lower[d], 0.0);
+            } else if to > limits.upper[d] {
+                (p.x[d], p.v[d]) = (limits.upper[d], 0.0);
+            } else {
+                (p.x[d], p.v[d]) = (to, moved);
+            }
+        }
+    }
+}
+
+/// A coordinate for the update's property test: mostly ordinary, sometimes a wall, a zero of
+/// either sign or a NaN.
+fn coordinate() -> impl proptest::strategy::Strategy<Value = f64> {
+    use proptest::prelude::*;
+    prop_oneof![
+        8 => -20.0..20.0f64,
+        1 => Just(-10.0),
+        1 => Just(10.0),
+        1 => Just(0.0),
+        1 => Just(-0.0),
+        1 => Just(f64::NAN),
+    ]
+}
+
+proptest::proptest! {
+    /// The vectorised limit and the branch-free clamp change no bit of a move, with or without
+    /// the exchange, whatever the group sizes (remainders of the four-wide loop included).
+    #[test]
+    fn the_update_moves_as_written_to_the_last_bit(
+        dims in proptest::collection::vec((coordinate(), coordinate(), coordinate(), coordinate(), coordinate()), 1..40),
+        cut in 0usize..40,
+        exchange in proptest::prelude::any::<bool>(),
+        seed in proptest::prelude::any::<u64>(),
+    ) {
+        let n = dims.len();
+        let cut = cut.min(n);
+        let groups: Vec<_> = [0..cut, cut..n].into_iter().filter(|g| !g.is_empty()).collect();
+        let vmax = vec![3.0; n];
+        let limits = Limits {
+            lower: vec![-10.0; n],
+            upper: vec![10.0; n],
+            inv_vmax: inverses(&vmax),
+            vmax,
+            groups,
+        };
+        let column = |k: usize| dims.iter().map(|d| [d.0, d.1, d.2, d.3, d.4][k]).collect::<Vec<f64>>();
+        let mut ours = Particle {
+            x: column(0),
+            v: column(1),
+            cost: 0.0,
+            parts: vec![0.0],
+            best_x: column(2),
+            best_parts: vec![0.0],
+            best_cost: 0.0,
+        };
+        let (gbest, followers) = (column(3), column(4));
+        let exchange = exchange.then_some(followers.as_slice());
+        let c = Coefficients { w: 0.9, c1: 1.5, c2: 1.7, c3: 1.1 };
+        let mut theirs = ours.clone();
+        update(&mut ours, &gbest, exchange, c, &limits, &mut StdRng::seed_from_u64(seed));
+        update_as_written(&mut theirs, &gbest, exchange, c, &limits, &mut StdRng::seed_from_u64(seed));
+        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<u64>>();
+        proptest::prop_assert_eq!(bits(&ours.x), bits(&theirs.x));
+        proptest::prop_assert_eq!(bits(&ours.v), bits(&theirs.v));
+    }
+}
