@@ -235,11 +235,18 @@ fn coordinate() -> impl proptest::strategy::Strategy<Value = f64> {
 
 proptest::proptest! {
     /// The vectorised limit and the branch-free clamp change no bit of a move, with or without
-    /// the exchange, whatever the group sizes (remainders of the four-wide loop included).
+    /// the exchange, whatever the group sizes (remainders of the four-wide loop included), at
+    /// walls of either sign and at walls of signed zeros.
     #[test]
     fn the_update_moves_as_written_to_the_last_bit(
         dims in proptest::collection::vec((coordinate(), coordinate(), coordinate(), coordinate(), coordinate()), 1..40),
         cut in 0usize..40,
+        (lo, hi) in proptest::prop_oneof![
+            proptest::strategy::Just((-10.0, 10.0)),
+            proptest::strategy::Just((0.0, 10.0)),
+            proptest::strategy::Just((-10.0, -0.0)),
+            proptest::strategy::Just((-0.0, 0.0)),
+        ],
         exchange in proptest::prelude::any::<bool>(),
         seed in proptest::prelude::any::<u64>(),
     ) {
@@ -248,8 +255,8 @@ proptest::proptest! {
         let groups: Vec<_> = [0..cut, cut..n].into_iter().filter(|g| !g.is_empty()).collect();
         let vmax = vec![3.0; n];
         let limits = Limits {
-            lower: vec![-10.0; n],
-            upper: vec![10.0; n],
+            lower: vec![lo; n],
+            upper: vec![hi; n],
             inv_vmax: inverses(&vmax),
             vmax,
             groups,
