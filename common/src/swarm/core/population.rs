@@ -293,7 +293,8 @@ pub fn update(
             }
         }
         let over = largest_ratio(v, &limits.inv_vmax[r.clone()]);
-        move_within(p, limits, r, 1.0 / over);
+        let (lower, upper) = (&limits.lower[r.clone()], &limits.upper[r.clone()]);
+        move_within(&mut p.x[r.clone()], &mut p.v[r], lower, upper, 1.0 / over);
     }
 }
 
@@ -330,21 +331,15 @@ fn largest_ratio(v: &[f64], inv: &[f64]) -> f64 {
     over
 }
 
-/// Scales the velocity of the dimensions `r` by `scale`, moves the position by it and clamps it
-/// into the bounds; a dimension that hits a wall stops there (its velocity becomes zero).
-/// Written without branches: which particles hit a wall is random, so branches mispredict. The
-/// clamp is `smaller(hi, larger(lo, to))`, one `maxpd` and one `minpd`, which gives what
-/// `if to < lo { lo } else if to > hi { hi } else { to }` gives for every `to`, NaN included
-/// (for `lo <= hi`, as every problem's bounds are).
+/// Scales the velocity `v` by `scale`, moves the position `x` by it and clamps it into
+/// `[lower, upper]`; a dimension that hits a wall stops there (its velocity becomes zero).
+/// Written without branches, two dimensions per instruction (the compiler vectorises the loop):
+/// which particles hit a wall is random, so branches mispredict. The clamp is
+/// `smaller(upper, larger(lower, to))`, one `maxpd` and one `minpd`, which gives what
+/// `if to < lower { lower } else if to > upper { upper } else { to }` gives for every `to`, NaN
+/// included (for `lower <= upper`, as every problem's bounds are).
 #[inline]
-fn move_within(p: &mut Particle, limits: &Limits, r: std::ops::Range<usize>, scale: f64) {
-    let (x, v) = (&mut p.x[r.clone()], &mut p.v[r.clone()]);
-    clamp_move(x, v, &limits.lower[r.clone()], &limits.upper[r], scale);
-}
-
-/// [`move_within`] of slices, two dimensions per instruction (the compiler vectorises the loop).
-#[inline]
-fn clamp_move(x: &mut [f64], v: &mut [f64], lower: &[f64], upper: &[f64], scale: f64) {
+fn move_within(x: &mut [f64], v: &mut [f64], lower: &[f64], upper: &[f64], scale: f64) {
     let n = x.len();
     // All four the same length, so the indexing below needs no checks and vectorises.
     let (v, lower, upper) = (&mut v[..n], &lower[..n], &upper[..n]);
