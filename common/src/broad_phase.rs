@@ -130,8 +130,7 @@ impl SlabBoxes {
         let slab = self.horizon / SLABS as f64;
         let per_slab = 1.0 / slab;
         let arrival = times[n - 1];
-        let mut seg = 0usize;
-        let mut start = position(times, points, &mut seg, 0.0);
+        let mut start = position(times, points, &mut 0, 0.0);
         self.bounds.push(start);
         // Slab 0's samples start at the first: a chain of samples at t = 0 the start position
         // skipped (the separation counts them).
@@ -143,30 +142,30 @@ impl SlabBoxes {
             } else {
                 (k + 1) as f64 * slab
             };
-            // Every sample up to and including t1 (a chain of samples at one instant too).
-            while seg + 1 < n && times[seg + 1] <= t1 {
-                seg += 1;
-            }
-            // `seg` is now the last sample at or before t1.
-            let end = position_on_leg(times, points, seg, t1);
+            // The slab's samples: every one at or before t1 not taken by an earlier slab (a
+            // chain of samples at one instant too; none in the slabs before a trajectory's
+            // first sample, where it holds there).
+            let from = first;
             let (mut lo, mut hi) = (start, start);
+            while first < n && times[first] <= t1 {
+                lo = lower_corner(&lo, &points[first]);
+                hi = upper_corner(&hi, &points[first]);
+                first += 1;
+            }
+            // The last sample at or before t1 is the slab's last (the times do not decrease),
+            // or the first sample when none is yet: one scan of the times finds both.
+            let end = position_on_leg(times, points, first.saturating_sub(1), t1);
             // The positions minus the chord are piecewise linear in time with corners only at
-            // the samples, so the farthest a slab strays from its chord is at one of them: every
-            // sample at or before t1 not taken by an earlier slab (none in the slabs before a
-            // trajectory's first sample, where it holds there).
+            // the samples, so the farthest a slab strays from its chord is at one of them.
             let run = end - start;
             let mut stray2 = 0.0f64;
-            while first < n && times[first] <= t1 {
-                let p = &points[first];
-                lo = lower_corner(&lo, p);
-                hi = upper_corner(&hi, p);
-                let off = (p - start - run * ((times[first] - t0) * per_slab)).norm_squared();
+            for (p, t) in points[from..first].iter().zip(&times[from..first]) {
+                let off = (p - start - run * ((t - t0) * per_slab)).norm_squared();
                 if off.is_nan() {
                     stray2 = f64::INFINITY;
                 } else if off > stray2 {
                     stray2 = off;
                 }
-                first += 1;
             }
             // The end last: a NaN sample makes the running box forget what came before it.
             self.lo.push(lower_corner(&lo, &end));

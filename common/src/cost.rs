@@ -27,7 +27,10 @@ use crate::trajectory::{common_arrival, leg_times, retime_legs, Layout, Path, Tr
 use spheres::{sphere_terms, SphereIndex};
 
 pub use coupling::{separation_penalty, space_term, PairTerms};
-pub use motion::{entry_turn_penalty, pitch_penalty, turn_and_pitch_penalty, turn_penalty};
+pub use motion::{
+    entry_turn_penalty, pitch_penalty, turn_and_pitch_penalty, turn_and_pitch_penalty_within,
+    turn_penalty, MotionLimits,
+};
 pub use spheres::Sphere;
 
 /// F_i(L) of eq. (9): path length over straight-line distance (1 for a straight path).
@@ -209,6 +212,8 @@ pub struct FleetModel {
     /// Per vehicle: the crawler cost model and its straight path's terms (the standardisation
     /// scales), or `None` for a swimmer.
     pub crawlers: Vec<Option<(CrawlerModel, CrawlerTerms)>>,
+    /// Every vehicle's turn and pitch limits, with their cosine and tangent.
+    pub motion_limits: Vec<MotionLimits>,
 }
 
 impl FleetModel {
@@ -240,6 +245,11 @@ impl FleetModel {
                         let r = m.reference();
                         (m, r)
                     })
+                })
+                .collect(),
+            motion_limits: (scenario.vehicles.iter())
+                .map(|v| {
+                    MotionLimits::new(v.max_turn_deg.to_radians(), v.max_pitch_deg.to_radians())
                 })
                 .collect(),
             scenario: scenario.clone(),
@@ -319,11 +329,7 @@ impl FleetModel {
             space: 0.0,
             separation: 0.0,
             hard: spheres.hard_penalty + seabed,
-            motion: turn_and_pitch_penalty(
-                points,
-                v.max_turn_deg.to_radians(),
-                v.max_pitch_deg.to_radians(),
-            ),
+            motion: turn_and_pitch_penalty_within(points, &self.motion_limits[i]),
             hard_hits: spheres.hard_hits,
             crawler: None,
         }

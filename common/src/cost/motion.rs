@@ -83,10 +83,43 @@ pub fn pitch_penalty(points: &[Vec3], max_pitch: f64) -> f64 {
     p
 }
 
+/// A vehicle's turn and pitch limits (radians) with the cosine and the tangent the penalties
+/// compare against first: taken once per vehicle, not at each of the swarm's evaluations, where
+/// `cos` and `tan` cost more than a short path's legs.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MotionLimits {
+    /// Largest heading change per waypoint, radians.
+    pub max_turn: f64,
+    /// Its cosine.
+    pub cos_max_turn: f64,
+    /// Largest |pitch| of a leg, radians.
+    pub max_pitch: f64,
+    /// Its tangent.
+    pub tan_max_pitch: f64,
+}
+
+impl MotionLimits {
+    /// The limits `max_turn` and `max_pitch` (radians) with their cosine and tangent.
+    pub fn new(max_turn: f64, max_pitch: f64) -> MotionLimits {
+        MotionLimits {
+            max_turn,
+            cos_max_turn: max_turn.cos(),
+            max_pitch,
+            tan_max_pitch: max_pitch.tan(),
+        }
+    }
+}
+
 /// `turn_penalty(points, max_turn) + pitch_penalty(points, max_pitch)` to the last bit, in one
 /// pass that takes each leg's horizontal extent once for both.
 pub fn turn_and_pitch_penalty(points: &[Vec3], max_turn: f64, max_pitch: f64) -> f64 {
-    let (cos_max, tan_max) = (max_turn.cos(), max_pitch.tan());
+    turn_and_pitch_penalty_within(points, &MotionLimits::new(max_turn, max_pitch))
+}
+
+/// [`turn_and_pitch_penalty`] against limits whose cosine and tangent are known.
+pub fn turn_and_pitch_penalty_within(points: &[Vec3], limits: &MotionLimits) -> f64 {
+    let (max_turn, max_pitch) = (limits.max_turn, limits.max_pitch);
+    let (cos_max, tan_max) = (limits.cos_max_turn, limits.tan_max_pitch);
     let (mut turn, mut climb) = (0.0, 0.0);
     let mut prev: Option<(f64, f64, f64)> = None;
     for w in points.windows(2) {

@@ -279,6 +279,31 @@ fn a_swimmer_through_the_seabed_pays_for_it() -> Result<(), crate::scenario::Sce
     Ok(())
 }
 
+/// The fitness takes each vehicle's own limits: the same 45° climb costs 1 + 25/20 against a
+/// 20° pitch limit and 1 + 15/30 against a 30° one, as the penalties give them from degrees.
+#[test]
+fn each_vehicle_is_held_to_its_own_turn_and_pitch_limits(
+) -> Result<(), crate::scenario::ScenarioError> {
+    use crate::fixtures::{scenario, vehicle_toml};
+    let a = vehicle_toml("a", [0.0, 100.0, 250.0], [200.0, 100.0, 250.0]);
+    let b = vehicle_toml("b", [0.0, 900.0, 250.0], [200.0, 900.0, 250.0])
+        .replace("max_pitch_deg = 20.0", "max_pitch_deg = 30.0");
+    let model = FleetModel::new(&scenario(400.0, "", &[a, b])?);
+    let climb = [v(0., 0., 0.), v(10., 0., 10.), v(20., 0., 10.)];
+    let legs: Vec<f64> = leg_lengths(&climb).collect();
+    let length: f64 = legs.iter().sum();
+    for (i, pitch_deg, by_hand) in [
+        (0, 20.0f64, 1.0 + 25.0 / 20.0),
+        (1, 30.0, 1.0 + 15.0 / 30.0),
+    ] {
+        let motion = model.vehicle_terms(i, &climb, &legs, length).motion;
+        assert_abs_diff_eq!(motion, by_hand, epsilon = 1e-9);
+        let direct = turn_and_pitch_penalty(&climb, 35f64.to_radians(), pitch_deg.to_radians());
+        assert_eq!(motion.to_bits(), direct.to_bits());
+    }
+    Ok(())
+}
+
 #[test]
 fn early_arrival_penalty_by_hand() {
     // 300 m at 0.5 m/s at the slowest: it cannot arrive later than 600 s.
