@@ -27,10 +27,8 @@ use crate::trajectory::{common_arrival, leg_times, retime_legs, Layout, Path, Tr
 use spheres::{sphere_terms, SphereIndex};
 
 pub use coupling::{separation_penalty, space_term, PairTerms};
-pub use motion::{
-    entry_turn_penalty, pitch_penalty, turn_and_pitch_penalty, turn_and_pitch_penalty_within,
-    turn_penalty, MotionLimits,
-};
+pub use motion::{entry_turn_penalty, pitch_penalty, turn_and_pitch_penalty, turn_penalty};
+use motion::{turn_and_pitch_penalty_within, MotionLimits};
 pub use spheres::Sphere;
 
 /// F_i(L) of eq. (9): path length over straight-line distance (1 for a straight path).
@@ -213,7 +211,7 @@ pub struct FleetModel {
     /// scales), or `None` for a swimmer.
     pub crawlers: Vec<Option<(CrawlerModel, CrawlerTerms)>>,
     /// Every vehicle's turn and pitch limits, with their cosine and tangent.
-    pub motion_limits: Vec<MotionLimits>,
+    motion_limits: Vec<MotionLimits>,
 }
 
 impl FleetModel {

