@@ -24,7 +24,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let out = lockstep::run(&s, None, &mut |_| {});
         let model = FleetModel::new(&s);
         let e = model.evaluate(&out.best_x);
-        let a = assess(&s, &e.trajectories);
+        let a = assess(&s, &e.trajectories.to_vec());
         println!(
             "seed {seed}: fitness {:.4} feasible {} min sep {:.1} time {:.2} s evals {}",
             out.best_cost,

@@ -20,10 +20,11 @@
 //! swarm feels both how many and how bad.
 
 use crate::crawler::{CrawlerModel, CrawlerTerms};
+use crate::fleet_trajectories::FleetTrajectories;
 use crate::geometry::{leg_lengths, polyline_length, Vec3};
 use crate::scenario::{Scenario, Vehicle};
 use crate::terrain::Terrain;
-use crate::trajectory::{common_arrival, leg_times, retime_legs, Layout, Path, Trajectory};
+use crate::trajectory::{common_arrival, leg_times, retime_legs, Layout, Path};
 use spheres::{sphere_terms, SphereIndex};
 
 pub use coupling::{separation_penalty, space_term, PairTerms};
@@ -169,8 +170,8 @@ pub struct VehicleTerms {
 /// Everything the fitness computed for one fleet particle.
 #[derive(Debug, Clone, Default)]
 pub struct FleetEvaluation {
-    /// Timed trajectories (what the vehicles fly), in vehicle order.
-    pub trajectories: Vec<Trajectory>,
+    /// Timed trajectories (what the vehicles fly), in vehicle order, in one buffer per kind.
+    pub trajectories: FleetTrajectories,
     /// The arrival time every vehicle was timed for, seconds.
     pub common_arrival: f64,
     /// Unweighted terms per vehicle.
@@ -370,9 +371,7 @@ impl FleetModel {
 
     fn evaluate_with(&self, x: &[f64], out: &mut FleetEvaluation, scratch: &mut Scratch) {
         let s = &self.scenario;
-        let n = s.vehicles.len();
-        out.trajectories.truncate(n);
-        out.trajectories.resize_with(n, Trajectory::default);
+        out.trajectories.clear();
         // Every vehicle's leg lengths and speeds in one buffer each, vehicle i's at `spans[i]`.
         let Scratch {
             legs,
@@ -387,17 +386,19 @@ impl FleetModel {
         // Each vehicle is taken through as much as it can be while its path is in the
         // first-level cache: decoded, measured and scored here, then timed and boxed below.
         out.vehicles.clear();
-        for (i, t) in out.trajectories.iter_mut().enumerate() {
-            t.points.clear();
-            self.decode_into(i, &x[self.layout.chromosome(i)], &mut t.points, speeds);
+        for i in 0..s.vehicles.len() {
+            let genes = &x[self.layout.chromosome(i)];
+            out.trajectories
+                .push_path(|points| self.decode_into(i, genes, points, speeds));
+            let points = out.trajectories.points(i);
             let start = legs.len();
-            legs.extend(leg_lengths(&t.points));
+            legs.extend(leg_lengths(points));
             spans.push(start..legs.len());
             let length = legs[start..].iter().sum();
             lengths.push(length);
             // Its own terms do not depend on the timing.
             out.vehicles
-                .push(self.vehicle_terms(i, &t.points, &legs[start..], length));
+                .push(self.vehicle_terms(i, points, &legs[start..], length));
         }
         let arrival = common_arrival(
             s.fleet.mission_time_s,
@@ -412,17 +413,11 @@ impl FleetModel {
             s.fleet.d_min_m,
             arrival * (1.0 + SLABS_PAST_ARRIVAL),
             &mut out.pairs,
-            |i, t| {
+            |i, times| {
                 let v = &s.vehicles[i];
                 vehicles[i].motion += early_arrival_penalty(lengths[i], v, arrival);
                 let span = spans[i].clone();
-                leg_times(
-                    &legs[span.clone()],
-                    &mut speeds[span],
-                    v,
-                    arrival,
-                    &mut t.times,
-                );
+                leg_times(&legs[span.clone()], &mut speeds[span], v, arrival, times);
             },
         );
         out.common_arrival = arrival;
@@ -443,11 +438,11 @@ impl FleetModel {
         let length: f64 = legs.iter().sum();
         let arrival = common_arrival(
             s.fleet.mission_time_s,
-            (base.trajectories.iter().enumerate()).map(|(k, t)| {
+            (base.trajectories.iter().enumerate()).map(|(k, (_, points))| {
                 let l = if k == i {
                     length
                 } else {
-                    polyline_length(&t.points)
+                    polyline_length(points)
                 };
                 l / s.vehicles[k].speed_max_mps
             }),
@@ -455,15 +450,16 @@ impl FleetModel {
         if arrival.to_bits() != base.common_arrival.to_bits() {
             return self.evaluate(x);
         }
+        let mut vehicles = base.vehicles.clone();
+        vehicles[i] = self.vehicle_terms(i, &path.points, &legs, length);
+        vehicles[i].motion += early_arrival_penalty(length, &s.vehicles[i], arrival);
+        let moved = retime_legs(path, &legs, &s.vehicles[i], arrival);
         let mut out = FleetEvaluation {
-            trajectories: base.trajectories.clone(),
+            trajectories: base.trajectories.with_replaced(i, &moved),
             common_arrival: arrival,
-            vehicles: base.vehicles.clone(),
+            vehicles,
             ..FleetEvaluation::default()
         };
-        out.vehicles[i] = self.vehicle_terms(i, &path.points, &legs, length);
-        out.vehicles[i].motion += early_arrival_penalty(length, &s.vehicles[i], arrival);
-        out.trajectories[i] = retime_legs(path, &legs, &s.vehicles[i], arrival);
         let d_min = s.fleet.d_min_m;
         coupling::pair_terms_changed(&out.trajectories, d_min, i, &base.pairs, &mut out.pairs);
         self.sum_into(&mut out);

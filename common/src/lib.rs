@@ -15,6 +15,7 @@ pub mod execution;
 #[cfg(test)]
 mod fixtures;
 pub mod fleet;
+pub mod fleet_trajectories;
 pub mod geo;
 pub mod geometry;
 pub mod gridsearch;

@@ -48,12 +48,18 @@ impl<'a> Motion<'a> {
         }
     }
 
-    /// `t` with its legs' velocities and top speed computed once by [`Motion::velocities_of`]:
-    /// a trajectory queried many times is prepared without allocating.
-    pub fn prepared(t: &'a Trajectory, velocities: &'a [Vec3], max_speed: f64) -> Motion<'a> {
+    /// The trajectory through `points` at `times` (at least one sample) with its legs'
+    /// velocities and top speed computed once by [`Motion::velocities_into`]: a trajectory
+    /// queried many times is prepared without allocating.
+    pub fn prepared(
+        times: &'a [f64],
+        points: &'a [Vec3],
+        velocities: &'a [Vec3],
+        max_speed: f64,
+    ) -> Motion<'a> {
         Motion {
-            times: &t.times,
-            points: &t.points,
+            times,
+            points,
             velocities: std::borrow::Cow::Borrowed(velocities),
             max_speed,
         }
@@ -62,17 +68,17 @@ impl<'a> Motion<'a> {
     /// Each leg's velocity and the fastest leg's speed, m/s.
     pub fn velocities_of(t: &Trajectory) -> (Vec<Vec3>, f64) {
         let mut velocities = Vec::with_capacity(t.times.len().saturating_sub(1));
-        let max_speed = Motion::velocities_into(t, &mut velocities);
+        let max_speed = Motion::velocities_into(&t.times, &t.points, &mut velocities);
         (velocities, max_speed)
     }
 
-    /// [`Motion::velocities_of`] appending the velocities to a buffer the caller reuses;
-    /// returns the fastest leg's speed.
-    pub fn velocities_into(t: &Trajectory, out: &mut Vec<Vec3>) -> f64 {
+    /// [`Motion::velocities_of`] of the trajectory through `points` at `times`, appending the
+    /// velocities to a buffer the caller reuses; returns the fastest leg's speed.
+    pub fn velocities_into(times: &[f64], points: &[Vec3], out: &mut Vec<Vec3>) -> f64 {
         // The top speed's square root once, not every leg's: the root is monotonic and
         // correctly rounded, so the result is the same to the last bit.
         let mut max_speed2 = 0.0f64;
-        for (tt, pp) in t.times.windows(2).zip(t.points.windows(2)) {
+        for (tt, pp) in times.windows(2).zip(points.windows(2)) {
             let dt = tt[1] - tt[0];
             let v = if dt > 0.0 {
                 (pp[1] - pp[0]) / dt

@@ -134,7 +134,8 @@ pub fn touch_up(
                 break 'rounds;
             }
             let range = model.layout.chromosome(v);
-            let problem = VehicleProblem::new(model, v, &eval.trajectories, eval.common_arrival);
+            let others = eval.trajectories.to_vec();
+            let problem = VehicleProblem::new(model, v, &others, eval.common_arrival);
             if !in_violation(&problem, &x[range.clone()]) {
                 continue;
             }
@@ -348,8 +349,8 @@ mod tests {
         let after = model.evaluate(&t.x);
         assert_eq!(after.total, t.total.1);
         let sep = crate::separation::pair_separation(
-            &after.trajectories[0],
-            &after.trajectories[1],
+            &after.trajectories.trajectory(0),
+            &after.trajectories.trajectory(1),
             50.0,
         );
         assert!(sep.min_distance >= 50.0, "{}", sep.min_distance);

@@ -188,7 +188,7 @@ impl<'a> VehicleProblem<'a> {
             if !near[k] {
                 continue;
             }
-            let other = Motion::prepared(other, velocities, *top);
+            let other = Motion::prepared(&other.times, &other.points, velocities, *top);
             let p = motion_separation(&mine, &other, d_min, false);
             terms.space += space_term(p.breach_s);
             terms.separation += separation_penalty(p.min_distance, s.fleet.d_min_m);
@@ -265,10 +265,15 @@ mod tests {
         let fleet = model.evaluate(&x);
         let layout = Layout::of(&model.scenario);
         for i in 0..2 {
-            let p = VehicleProblem::new(&model, i, &fleet.trajectories, fleet.common_arrival);
+            let p = VehicleProblem::new(
+                &model,
+                i,
+                &fleet.trajectories.to_vec(),
+                fleet.common_arrival,
+            );
             let e = p.evaluate(&x[layout.chromosome(i)]);
             let f = fleet.vehicles[i];
-            assert_eq!(e.trajectory, fleet.trajectories[i]);
+            assert_eq!(e.trajectory, fleet.trajectories.trajectory(i));
             assert!((e.terms.length - f.length).abs() < 1e-12);
             assert!((e.terms.space - f.space).abs() < 1e-9);
             // The whole pair penalty here, half of it in the fleet's share.
@@ -314,7 +319,12 @@ mod tests {
         let x = straight_particle(&model);
         let fleet = model.evaluate(&x);
         // b keeps its straight line and timing; a must avoid meeting it at the centre.
-        let p = VehicleProblem::new(&model, 0, &fleet.trajectories, fleet.common_arrival);
+        let p = VehicleProblem::new(
+            &model,
+            0,
+            &fleet.trajectories.to_vec(),
+            fleet.common_arrival,
+        );
         let mut rng = StdRng::seed_from_u64(9);
         assert!(p.sample(&mut rng).len() == p.dim());
         let mut solver = Pso::adaptive(40, 5);
@@ -385,7 +395,8 @@ mod tests {
         for _ in 0..30 {
             let e = model.evaluate(&model.sample(&mut rng));
             for i in 0..model.layout.vehicles {
-                let problem = VehicleProblem::new(&model, i, &e.trajectories, e.common_arrival);
+                let problem =
+                    VehicleProblem::new(&model, i, &e.trajectories.to_vec(), e.common_arrival);
                 let genes = model.sample(&mut rng)[model.layout.chromosome(i)].to_vec();
                 let got = problem.evaluate(&genes);
                 // Every other vehicle, as the fitness measures a pair.

@@ -6,9 +6,9 @@
 use std::cell::RefCell;
 
 use crate::broad_phase::{boxes_within, extent, PairSet, SlabBoxes, SlabMask};
+use crate::fleet_trajectories::FleetTrajectories;
 use crate::geometry::Vec3;
 use crate::separation::{closest_within, motion_separation, Motion};
-use crate::trajectory::Trajectory;
 
 /// The buffers of the pair terms, reused by every evaluation on a thread (the swarm evaluates
 /// on a few worker threads, hundreds of thousands of times), so measuring the pairs allocates
@@ -49,11 +49,12 @@ impl Velocities {
         self.of.resize(n, None);
     }
 
-    /// Computes vehicle `k`'s velocities from its trajectory `t`, unless they are known.
-    fn prepare(&mut self, k: usize, t: &Trajectory) {
+    /// Computes vehicle `k`'s velocities from its trajectory, unless they are known.
+    fn prepare(&mut self, k: usize, trajectories: &FleetTrajectories) {
         if self.of[k].is_none() {
             let start = self.all.len();
-            let top = Motion::velocities_into(t, &mut self.all);
+            let (times, points) = (trajectories.times(k), trajectories.points(k));
+            let top = Motion::velocities_into(times, points, &mut self.all);
             self.of[k] = Some((start, self.all.len(), top));
         }
     }
@@ -61,18 +62,19 @@ impl Velocities {
     /// The prepared motions of vehicles `i` and `j` of `trajectories`.
     fn pair<'a>(
         &'a mut self,
-        trajectories: &'a [Trajectory],
+        trajectories: &'a FleetTrajectories,
         i: usize,
         j: usize,
     ) -> (Motion<'a>, Motion<'a>) {
         for k in [i, j] {
-            self.prepare(k, &trajectories[k]);
+            self.prepare(k, trajectories);
         }
         let this = &*self;
         let motion = |k: usize| {
             // Both were prepared just above.
             let (from, to, top) = this.of[k].unwrap_or((0, 0, 0.0));
-            Motion::prepared(&trajectories[k], &this.all[from..to], top)
+            let (times, points) = (trajectories.times(k), trajectories.points(k));
+            Motion::prepared(times, points, &this.all[from..to], top)
         };
         (motion(i), motion(j))
     }
@@ -109,7 +111,8 @@ pub struct PairTerms {
 
 /// The terms of every pair the broad phase cannot rule out, in row order, into `out` (cleared
 /// first), after `time` has given each vehicle its timing (called once per vehicle, in order,
-/// with its index and trajectory).
+/// with its index and the fleet's times buffer to append its sample times to, as
+/// [`FleetTrajectories::time_each`]).
 ///
 /// Each vehicle's slab boxes are built as soon as it is timed, while its samples are still in
 /// the first-level cache: a fleet of 32 outgrows that cache, and boxing the fleet in a pass of
@@ -119,23 +122,23 @@ pub struct PairTerms {
 /// mission. One just after the last arrival prunes most; when a trajectory ends later than
 /// `horizon` the boxes are built again over the time to its arrival.
 pub(super) fn pair_terms_into(
-    trajectories: &mut [Trajectory],
+    trajectories: &mut FleetTrajectories,
     d_min: f64,
     horizon: f64,
     out: &mut Vec<PairTerms>,
-    mut time: impl FnMut(usize, &mut Trajectory),
+    time: impl FnMut(usize, &mut Vec<f64>),
 ) {
     out.clear();
     with_scratch(|scratch| {
         let small = trajectories.len() <= SMALL_FLEET;
         scratch.velocities.reset(trajectories.len());
         scratch.boxes.reset(horizon);
-        for (i, t) in trajectories.iter_mut().enumerate() {
-            time(i, t);
+        let boxes = &mut scratch.boxes;
+        trajectories.time_each(time, |times, points| {
             if !small {
-                scratch.boxes.push(&t.times, &t.points);
+                boxes.push(times, points);
             }
-        }
+        });
         let trajectories = &*trajectories;
         if small {
             return all_pair_terms_into(trajectories, d_min, &mut scratch.velocities, out);
@@ -171,7 +174,7 @@ pub(super) fn pair_terms_into(
 /// changed one's, since no slab box of the rest can. The slabs span the time to the fleet's
 /// last arrival.
 pub(super) fn pair_terms_changed(
-    trajectories: &[Trajectory],
+    trajectories: &FleetTrajectories,
     d_min: f64,
     changed: usize,
     base: &[PairTerms],
@@ -189,18 +192,18 @@ pub(super) fn pair_terms_changed(
             base.iter()
                 .filter(|p| p.i as usize != changed && p.j as usize != changed),
         );
-        let Some(moved) = trajectories.get(changed) else {
+        if changed >= trajectories.len() {
             return;
-        };
-        let mine = extent(&moved.points);
+        }
+        let mine = extent(trajectories.points(changed));
         built.clear();
         built.push(changed);
         built.extend((0..trajectories.len()).filter(|&j| {
-            j != changed && boxes_within(&mine, &extent(&trajectories[j].points), d_min)
+            j != changed && boxes_within(&mine, &extent(trajectories.points(j)), d_min)
         }));
         boxes.reset(horizon_of(trajectories));
         for &j in built.iter() {
-            boxes.push(&trajectories[j].times, &trajectories[j].points);
+            boxes.push(trajectories.times(j), trajectories.points(j));
         }
         let fleet = Fleet {
             trajectories,
@@ -219,7 +222,7 @@ pub(super) fn pair_terms_changed(
 /// Clears `out`, then runs `measure` on this thread's buffers (prepared for the fleet's
 /// vehicles); a small fleet ([`SMALL_FLEET`]) gets every pair measured instead.
 fn with_measure(
-    trajectories: &[Trajectory],
+    trajectories: &FleetTrajectories,
     d_min: f64,
     out: &mut Vec<PairTerms>,
     measure: impl FnOnce(&mut Scratch, &mut Vec<PairTerms>),
@@ -243,24 +246,23 @@ fn with_scratch<T>(f: impl FnOnce(&mut Scratch) -> T) -> T {
 }
 
 /// The time to the last arrival: what the slabs span.
-fn horizon_of(trajectories: &[Trajectory]) -> f64 {
-    trajectories
-        .iter()
-        .filter_map(|t| t.times.last())
-        .fold(0.0f64, |a, b| a.max(*b))
+fn horizon_of(trajectories: &FleetTrajectories) -> f64 {
+    (0..trajectories.len())
+        .map(|i| trajectories.arrival(i))
+        .fold(0.0f64, f64::max)
 }
 
 /// Every trajectory's slab boxes, over the time to the last arrival.
-fn boxes_of(trajectories: &[Trajectory], boxes: &mut SlabBoxes) {
+fn boxes_of(trajectories: &FleetTrajectories, boxes: &mut SlabBoxes) {
     boxes.reset(horizon_of(trajectories));
-    for t in trajectories {
-        boxes.push(&t.times, &t.points);
+    for (times, points) in trajectories.iter() {
+        boxes.push(times, points);
     }
 }
 
 /// A fleet's trajectories with their slab boxes: what the narrow phase measures.
 struct Fleet<'a> {
-    trajectories: &'a [Trajectory],
+    trajectories: &'a FleetTrajectories,
     d_min: f64,
     boxes: &'a SlabBoxes,
 }
@@ -320,7 +322,7 @@ const SMALL_FLEET: usize = 5;
 /// Every pair by the exact separation (small fleets, and what the tests check the pruned
 /// terms against), appended to `out`.
 fn all_pair_terms_into(
-    trajectories: &[Trajectory],
+    trajectories: &FleetTrajectories,
     d_min: f64,
     velocities: &mut Velocities,
     out: &mut Vec<PairTerms>,
@@ -338,34 +340,32 @@ fn all_pair_terms_into(
 mod tests {
     use super::*;
     use crate::strategies::crossing;
+    use crate::trajectory::Trajectory;
     use proptest::prelude::*;
 
     /// [`pair_terms_into`] of `fleet` with its slabs ending at `horizon`, each vehicle's
     /// samples given to it by the timing (so boxes built before it would be empty).
     fn pair_terms_at(fleet: &[Trajectory], d_min: f64, horizon: f64) -> Vec<PairTerms> {
-        let mut untimed: Vec<Trajectory> = fleet
-            .iter()
-            .map(|t| Trajectory {
-                times: Vec::new(),
-                points: t.points.clone(),
-            })
-            .collect();
+        let mut untimed = FleetTrajectories::default();
+        for t in fleet {
+            untimed.push_path(|points| points.extend_from_slice(&t.points));
+        }
         let mut out = Vec::new();
-        pair_terms_into(&mut untimed, d_min, horizon, &mut out, |i, t| {
-            t.times.clone_from(&fleet[i].times)
+        pair_terms_into(&mut untimed, d_min, horizon, &mut out, |i, times| {
+            times.extend_from_slice(&fleet[i].times)
         });
         out
     }
 
     fn pair_terms(fleet: &[Trajectory], d_min: f64) -> Vec<PairTerms> {
-        pair_terms_at(fleet, d_min, horizon_of(fleet))
+        pair_terms_at(fleet, d_min, horizon_of(&FleetTrajectories::from(fleet)))
     }
 
     fn all_pair_terms(fleet: &[Trajectory], d_min: f64) -> Vec<PairTerms> {
         let mut out = Vec::new();
         let mut velocities = Velocities::default();
         velocities.reset(fleet.len());
-        all_pair_terms_into(fleet, d_min, &mut velocities, &mut out);
+        all_pair_terms_into(&fleet.into(), d_min, &mut velocities, &mut out);
         out
     }
 
@@ -398,7 +398,8 @@ mod tests {
                 pairs.into_iter().filter(|p| p.breach_s != 0.0 || p.penalty != 0.0).collect()
             };
             let all = nonzero(all_pair_terms(&fleet, d_min));
-            let at = pair_terms_at(&fleet, d_min, horizon_of(&fleet) * scale);
+            let horizon = horizon_of(&FleetTrajectories::from(&fleet[..]));
+            let at = pair_terms_at(&fleet, d_min, horizon * scale);
             prop_assert_eq!(nonzero(at), all);
         }
     }

@@ -337,7 +337,7 @@ fn the_fleet_fitness_adds_the_weighted_terms_by_hand() -> Result<(), crate::scen
     let e = model.evaluate(&straight_particle(&model));
     // b needs 600 s at 1.5 m/s, so everyone is timed for 600 s; a at 0.5 m/s takes 400 s.
     assert_abs_diff_eq!(e.common_arrival, 600.0, epsilon = 1e-9);
-    assert_abs_diff_eq!(e.trajectories[0].arrival(), 400.0, epsilon = 1e-6);
+    assert_abs_diff_eq!(e.trajectories.arrival(0), 400.0, epsilon = 1e-6);
     // Per vehicle: λ1·F(L) + λ2·F(D) = 0.2·1 + 0.1·0.5 = 0.25; b also λ4·F(T) = 0.1 · (600 −
     // 400) / 400 = 0.05. F(O) = F(S) = 0.
     assert_abs_diff_eq!(e.vehicles[1].time, 0.5, epsilon = 1e-9);

@@ -40,7 +40,7 @@ impl Context {
         Context {
             round,
             arrival: e.common_arrival,
-            trajectories: e.trajectories.clone(),
+            trajectories: e.trajectories.to_vec(),
         }
     }
 }

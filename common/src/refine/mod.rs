@@ -48,6 +48,7 @@ mod search;
 mod settings;
 pub mod vehicle;
 
+use std::borrow::Cow;
 use std::ops::Range;
 use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
@@ -142,7 +143,7 @@ pub fn refine(
         // The latest vehicles first: they hold the fleet's arrival.
         let mut order = swimmers.clone();
         let lateness = |i: usize| {
-            polyline_length(&search.eval.trajectories[i].points)
+            polyline_length(search.eval.trajectories.points(i))
                 / model.scenario.vehicles[i].speed_max_mps
         };
         order.sort_by(|a, b| lateness(*b).total_cmp(&lateness(*a)));
@@ -194,7 +195,7 @@ pub fn refine(
 fn fleet_length(eval: &FleetEvaluation) -> f64 {
     eval.trajectories
         .iter()
-        .map(|t| polyline_length(&t.points))
+        .map(|(_, points)| polyline_length(points))
         .sum()
 }
 
@@ -235,14 +236,14 @@ impl Arena for FleetArena<'_> {
         Some(e.common_arrival)
     }
 
-    fn mine<'e>(&'e self, e: &'e FleetEvaluation, i: usize) -> &'e Trajectory {
-        &e.trajectories[i]
+    fn mine<'e>(&'e self, e: &'e FleetEvaluation, i: usize) -> Cow<'e, Trajectory> {
+        Cow::Owned(e.trajectories.trajectory(i))
     }
 
-    fn others<'e>(&'e self, e: &'e FleetEvaluation, i: usize) -> Vec<&'e Trajectory> {
-        (e.trajectories.iter().enumerate())
-            .filter(|(j, _)| *j != i)
-            .map(|(_, t)| t)
+    fn others<'e>(&'e self, e: &'e FleetEvaluation, i: usize) -> Vec<Cow<'e, Trajectory>> {
+        (0..e.trajectories.len())
+            .filter(|&j| j != i)
+            .map(|j| Cow::Owned(e.trajectories.trajectory(j)))
             .collect()
     }
 }
@@ -250,7 +251,7 @@ impl Arena for FleetArena<'_> {
 /// Vehicle `i`'s path is too long to arrive by the target at its top speed.
 fn late(search: &Search<FleetArena>, i: usize) -> bool {
     let v = &search.arena.model.scenario.vehicles[i];
-    let length = polyline_length(&search.eval.trajectories[i].points);
+    let length = polyline_length(search.eval.trajectories.points(i));
     length / v.speed_max_mps > search.target * (1.0 + 1e-9)
 }
 
@@ -279,7 +280,7 @@ fn reroute_if_late(search: &mut Search<FleetArena>, i: usize) {
 fn tighten_if_long(search: &mut Search<FleetArena>, i: usize) {
     let model = search.arena.model;
     let v = &model.scenario.vehicles[i];
-    let length = polyline_length(&search.eval.trajectories[i].points);
+    let length = polyline_length(search.eval.trajectories.points(i));
     if length <= shortest_pitch_feasible_length(v) * (1.0 + pitch_routes::SLACK) {
         return;
     }

@@ -2,6 +2,7 @@
 //! judges it: the whole fleet's fitness when a plan is refined ([`super::refine`]), or one
 //! vehicle's cost against fixed others when a replan is ([`super::vehicle`]).
 
+use std::borrow::Cow;
 use std::ops::Range;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
@@ -39,10 +40,11 @@ pub(super) trait Arena {
     /// The arrival the others keep, seconds: with the slowest speed, the shortest a path may
     /// be (`None`: an early arrival is allowed).
     fn common_arrival(&self, e: &Self::Eval) -> Option<f64>;
-    /// Vehicle `i`'s timed trajectory.
-    fn mine<'e>(&'e self, e: &'e Self::Eval, i: usize) -> &'e Trajectory;
+    /// Vehicle `i`'s timed trajectory (borrowed, or a copy where an evaluation keeps the
+    /// fleet's in one buffer).
+    fn mine<'e>(&'e self, e: &'e Self::Eval, i: usize) -> Cow<'e, Trajectory>;
     /// The other vehicles' timed trajectories.
-    fn others<'e>(&'e self, e: &'e Self::Eval, i: usize) -> Vec<&'e Trajectory>;
+    fn others<'e>(&'e self, e: &'e Self::Eval, i: usize) -> Vec<Cow<'e, Trajectory>>;
     /// Rows only this arena has (a replan's turn off the vehicle's present course).
     fn extra_rows(&self, _points: &[Vec3], _limits: &Limits, _rows: &mut Vec<Row>) {}
 }
@@ -236,8 +238,8 @@ impl<'a, A: Arena> Search<'a, A> {
         let mine = self.arena.mine(&self.eval, i);
         let step = self.settings.sample_step_s;
         let others = self.arena.others(&self.eval, i);
-        for (other, windows) in coming_near(mine, others, limits.separation + reach) {
-            constraints::separation_rows(mine, other, limits, step, reach, &windows, &mut rows);
+        for (other, windows) in coming_near(&mine, others, limits.separation + reach) {
+            constraints::separation_rows(&mine, &other, limits, step, reach, &windows, &mut rows);
         }
         let latest = v.speed_max_mps * self.target;
         rows.extend(constraints::length_row(points, latest, 1.0));
@@ -255,9 +257,9 @@ impl<'a, A: Arena> Search<'a, A> {
 /// sampling every one over the whole mission would find out far more slowly).
 fn coming_near<'e>(
     mine: &Trajectory,
-    others: Vec<&'e Trajectory>,
+    others: Vec<Cow<'e, Trajectory>>,
     reach: f64,
-) -> impl Iterator<Item = (&'e Trajectory, Vec<(f64, f64)>)> {
+) -> impl Iterator<Item = (Cow<'e, Trajectory>, Vec<(f64, f64)>)> {
     let horizon = others
         .iter()
         .map(|t| t.arrival())
@@ -311,14 +313,11 @@ mod tests {
             d_min: 50.0,
         };
         let reach = 60.0;
-        let kept: Vec<(&Trajectory, Vec<(f64, f64)>)> = coming_near(
-            &mine,
-            vec![&near, &parallel, &late],
-            limits.separation + reach,
-        )
-        .collect();
-        assert_eq!(kept.len(), 1);
-        assert_eq!(kept[0].0, &near);
+        let others = [&near, &parallel, &late].map(Cow::Borrowed).to_vec();
+        let kept: Vec<_> = coming_near(&mine, others, limits.separation + reach)
+            .map(|(t, _)| t.into_owned())
+            .collect();
+        assert_eq!(kept, std::slice::from_ref(&near));
         let whole = constraints::WHOLE_MISSION;
         for other in [&parallel, &late] {
             let mut rows = Vec::new();

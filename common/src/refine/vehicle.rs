@@ -6,6 +6,7 @@
 //! its penalties and its pairs' separation), plus the penalty weight times its lateness past
 //! the target over the target, gets lower, so the answer is never worse by that measure.
 
+use std::borrow::Cow;
 use std::ops::Range;
 use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
@@ -107,12 +108,12 @@ impl Arena for VehicleArena<'_, '_> {
             .then_some(self.problem.arrival())
     }
 
-    fn mine<'e>(&'e self, e: &'e VehicleEvaluation, _i: usize) -> &'e Trajectory {
-        &e.trajectory
+    fn mine<'e>(&'e self, e: &'e VehicleEvaluation, _i: usize) -> Cow<'e, Trajectory> {
+        Cow::Borrowed(&e.trajectory)
     }
 
-    fn others<'e>(&'e self, _e: &'e VehicleEvaluation, _i: usize) -> Vec<&'e Trajectory> {
-        self.problem.others().iter().collect()
+    fn others<'e>(&'e self, _e: &'e VehicleEvaluation, _i: usize) -> Vec<Cow<'e, Trajectory>> {
+        self.problem.others().iter().map(Cow::Borrowed).collect()
     }
 
     fn extra_rows(&self, points: &[Vec3], limits: &Limits, rows: &mut Vec<Row>) {

@@ -21,9 +21,9 @@ pub fn common_arrival(mission_time: f64, earliest: impl IntoIterator<Item = f64>
 }
 
 /// The sample times of [`retime`](super::retime) for legs of `lengths` at the requested
-/// `speeds` (one per leg, overwritten with the legs' requested paces), into `times` (cleared
-/// first; one more than legs): what the fitness calls on buffers it reuses, so timing a path
-/// allocates nothing.
+/// `speeds` (one per leg, overwritten with the legs' requested paces), appended to `times` (one
+/// more than legs; what it held before stays): what the fitness calls on the one buffer it
+/// times the whole fleet into, so timing a path allocates nothing.
 pub fn leg_times(
     lengths: &[f64],
     speeds: &mut [f64],
@@ -32,6 +32,7 @@ pub fn leg_times(
     times: &mut Vec<f64>,
 ) {
     let (p_lo, p_hi) = (1.0 / vehicle.speed_max_mps, 1.0 / vehicle.speed_min_mps);
+    let kept = times.len();
     let total: f64 = lengths.iter().sum();
     // Each leg's requested pace (s/m), computed once: the search below revisits every leg
     // several times.
@@ -41,12 +42,12 @@ pub fn leg_times(
     let paces = &*speeds;
     if total * p_lo >= target {
         // Too long to make it: flat out.
-        time_legs(lengths, p_lo, times);
+        time_legs(lengths, p_lo, kept, times);
         return;
     }
     if total * p_hi <= target {
         // Too short to be late: as slow as it goes.
-        time_legs(lengths, p_hi, times);
+        time_legs(lengths, p_hi, kept, times);
         return;
     }
     // The paces at `α` (selects, not branches: which legs are clamped changes from leg to leg,
@@ -56,7 +57,7 @@ pub fn leg_times(
     times.reserve(lengths.len() + 1);
     let timed_at = |a: f64, times: &mut Vec<f64>| -> (f64, f64) {
         let (mut t, mut slope) = (0.0, 0.0);
-        times.clear();
+        times.truncate(kept);
         times.push(0.0);
         for (l, &p) in lengths.iter().zip(paces) {
             let q = a * p;
@@ -109,11 +110,11 @@ pub fn leg_times(
     timed_at(a, times);
 }
 
-/// The sample times of legs of `lengths` all flown at `pace` (s/m), into `times` (cleared
-/// first; from 0, one more than legs).
-fn time_legs(lengths: &[f64], pace: f64, times: &mut Vec<f64>) {
+/// The sample times of legs of `lengths` all flown at `pace` (s/m), into `times` after its
+/// first `kept` (from 0, one more than legs).
+fn time_legs(lengths: &[f64], pace: f64, kept: usize, times: &mut Vec<f64>) {
     let mut t = 0.0;
-    times.clear();
+    times.truncate(kept);
     times.push(0.0);
     times.extend(lengths.iter().map(|l| {
         t += l * pace;

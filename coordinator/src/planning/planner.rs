@@ -86,8 +86,9 @@ pub fn to_plan(
     let finished = finish(model, &run, o, stop);
     let local_s = started.elapsed().as_secs_f64();
     let eval = &finished.eval;
-    let assessment = assess(scenario, &eval.trajectories);
-    let mut notices = notices(scenario, &eval.trajectories, eval.common_arrival);
+    let trajectories = eval.trajectories.to_vec();
+    let assessment = assess(scenario, &trajectories);
+    let mut notices = notices(scenario, &trajectories, eval.common_arrival);
     notices.extend(finished.notices(scenario, assessment.violations.is_empty()));
     if run.termination == Termination::Interrupted {
         notices.push(format!(
