@@ -132,10 +132,7 @@ impl FleetTrajectories {
         for i in 0..self.len() {
             let (from, to) = (self.starts[i], self.starts[i + 1]);
             time(i, &mut self.times);
-            let last = self
-                .times
-                .get(from)
-                .map_or(0.0, |_| self.times[self.times.len() - 1]);
+            let last = (self.times.get(from..).and_then(|t| t.last())).map_or(0.0, |t| *t);
             self.times.resize(to, last);
             timed(&self.times[from..to], &self.points[from..to]);
         }

@@ -50,22 +50,83 @@ pub fn leg_times(
         time_legs(lengths, p_hi, kept, times);
         return;
     }
-    // The paces at `α` (selects, not branches: which legs are clamped changes from leg to leg,
-    // so branches mispredict), the samples' times into `times`, and T(α) with its slope on the
-    // current piece (the free legs' Σ l p; adding 0.0 leaves it as it was). The search stops on
-    // a step it has just timed, so its times are the answer.
     times.reserve(lengths.len() + 1);
-    let timed_at = |a: f64, times: &mut Vec<f64>| -> (f64, f64) {
+    let legs = PacedLegs {
+        lengths,
+        paces,
+        p_lo,
+        p_hi,
+        kept,
+    };
+    legs.time_to(target, times);
+}
+
+/// Legs of `lengths` at their requested `paces` (s/m), each pace clamped to `[p_lo, p_hi]`
+/// once scaled, timed into a buffer after its first `kept` entries.
+struct PacedLegs<'a> {
+    lengths: &'a [f64],
+    paces: &'a [f64],
+    p_lo: f64,
+    p_hi: f64,
+    kept: usize,
+}
+
+impl PacedLegs<'_> {
+    /// Times the legs so the last arrives at `target` (which the clamped paces can reach): a
+    /// Newton step on the current linear piece of `T(α)`, safeguarded by a bisection bracket.
+    /// The search stops on a step it has just timed, so `times` holds its answer.
+    fn time_to(&self, target: f64, times: &mut Vec<f64>) {
+        let (max_p, min_p) =
+            (self.paces.iter()).fold((f64::MIN, f64::MAX), |(hi, lo), p| (hi.max(*p), lo.min(*p)));
+        let (mut lo, mut hi) = (self.p_lo / max_p, self.p_hi / min_p);
+        // Start from the unclamped solution.
+        let free: f64 = (self.lengths.iter().zip(self.paces))
+            .map(|(l, p)| l * p)
+            .sum();
+        let mut a = (target / free).clamp(lo, hi);
+        for _ in 0..100 {
+            let (t, slope) = self.time_at(a, times);
+            let err = t - target;
+            if err.abs() <= 1e-12 * target {
+                return;
+            }
+            if err < 0.0 {
+                lo = a;
+            } else {
+                hi = a;
+            }
+            let newton = if slope > 0.0 {
+                a - err / slope
+            } else {
+                f64::NAN
+            };
+            a = if newton > lo && newton < hi {
+                newton
+            } else {
+                0.5 * (lo + hi)
+            };
+            if hi - lo <= 1e-15 * hi {
+                break;
+            }
+        }
+        self.time_at(a, times);
+    }
+
+    /// The samples' times at pace factor `α` into `times`, and `T(α)` with its slope on the
+    /// current piece (the free legs' `Σ l p`; adding 0.0 leaves it as it was). Selects, not
+    /// branches: which legs are clamped changes from leg to leg, so branches mispredict.
+    #[inline]
+    fn time_at(&self, a: f64, times: &mut Vec<f64>) -> (f64, f64) {
         let (mut t, mut slope) = (0.0, 0.0);
-        times.truncate(kept);
+        times.truncate(self.kept);
         times.push(0.0);
-        for (l, &p) in lengths.iter().zip(paces) {
+        for (l, &p) in self.lengths.iter().zip(self.paces) {
             let q = a * p;
-            let (slow, fast) = (q <= p_lo, q >= p_hi);
+            let (slow, fast) = (q <= self.p_lo, q >= self.p_hi);
             let pace = if slow {
-                p_lo
+                self.p_lo
             } else if fast {
-                p_hi
+                self.p_hi
             } else {
                 q
             };
@@ -74,40 +135,7 @@ pub fn leg_times(
             times.push(t);
         }
         (t, slope)
-    };
-    let (max_p, min_p) = paces
-        .iter()
-        .fold((f64::MIN, f64::MAX), |(hi, lo), p| (hi.max(*p), lo.min(*p)));
-    let (mut lo, mut hi) = (p_lo / max_p, p_hi / min_p);
-    // Start from the unclamped solution.
-    let free: f64 = lengths.iter().zip(paces).map(|(l, p)| l * p).sum();
-    let mut a = (target / free).clamp(lo, hi);
-    for _ in 0..100 {
-        let (t, slope) = timed_at(a, times);
-        let err = t - target;
-        if err.abs() <= 1e-12 * target {
-            return;
-        }
-        if err < 0.0 {
-            lo = a;
-        } else {
-            hi = a;
-        }
-        let newton = if slope > 0.0 {
-            a - err / slope
-        } else {
-            f64::NAN
-        };
-        a = if newton > lo && newton < hi {
-            newton
-        } else {
-            0.5 * (lo + hi)
-        };
-        if hi - lo <= 1e-15 * hi {
-            break;
-        }
     }
-    timed_at(a, times);
 }
 
 /// The sample times of legs of `lengths` all flown at `pace` (s/m), into `times` after its
