@@ -148,6 +148,14 @@ impl FleetTrajectories {
 
 impl From<&[Trajectory]> for FleetTrajectories {
     fn from(trajectories: &[Trajectory]) -> FleetTrajectories {
+        trajectories.iter().collect()
+    }
+}
+
+impl<'a> FromIterator<&'a Trajectory> for FleetTrajectories {
+    /// The trajectories in the order given (each cut to the shorter of its times and
+    /// positions).
+    fn from_iter<I: IntoIterator<Item = &'a Trajectory>>(trajectories: I) -> FleetTrajectories {
         let mut out = FleetTrajectories::default();
         for t in trajectories {
             let samples = t.times.len().min(t.points.len());

@@ -19,6 +19,7 @@ use crate::cost::{
     early_arrival_penalty, entry_turn_penalty, separation_penalty, space_term, FleetModel,
     VehicleTerms,
 };
+use crate::fleet_trajectories::FleetTrajectories;
 use crate::geometry::Vec3;
 use crate::separation::{motion_separation, Motion};
 use crate::swarm::Problem;
@@ -31,10 +32,14 @@ pub struct VehicleProblem<'a> {
     model: &'a FleetModel,
     /// Which vehicle, in scenario order.
     vehicle: usize,
-    /// The other vehicles' trajectories, in scenario order without `vehicle`.
-    others: Vec<Trajectory>,
-    /// Their legs' velocities and top speeds ([`Motion::velocities_of`]), computed once.
-    other_velocities: Vec<(Vec<Vec3>, f64)>,
+    /// The other vehicles' trajectories, in scenario order without `vehicle`, in one buffer
+    /// per kind (every candidate path is measured against them).
+    others: FleetTrajectories,
+    /// Their legs' velocities ([`Motion::velocities_into`]), computed once, one vehicle after
+    /// another.
+    other_velocities: Vec<Vec3>,
+    /// Where each other vehicle's velocities are in `other_velocities`, and its top speed.
+    other_legs: Vec<(std::ops::Range<usize>, f64)>,
     /// Their space-time boxes ([`SlabBoxes`]) over `[0, horizon]`: a pair whose boxes never come
     /// within d_min is skipped (its terms are exactly zero).
     other_boxes: SlabBoxes,
@@ -82,25 +87,27 @@ impl<'a> VehicleProblem<'a> {
         arrival: f64,
     ) -> Self {
         let range = model.layout.chromosome(vehicle);
-        let others: Vec<Trajectory> = context
-            .iter()
-            .enumerate()
+        let others: FleetTrajectories = (context.iter().enumerate())
             .filter(|(j, _)| *j != vehicle)
-            .map(|(_, t)| t.clone())
+            .map(|(_, t)| t)
             .collect();
-        let horizon = others
-            .iter()
-            .filter_map(|t| t.times.last())
-            .fold(arrival, |a, b| a.max(*b));
+        let horizon = (0..others.len())
+            .map(|k| others.arrival(k))
+            .fold(arrival, f64::max);
+        let (mut other_velocities, mut other_legs) = (Vec::new(), Vec::new());
         let mut other_boxes = SlabBoxes::new();
         other_boxes.reset(horizon);
-        for t in &others {
-            other_boxes.push(&t.times, &t.points);
+        for (times, points) in others.iter() {
+            other_boxes.push(times, points);
+            let start = other_velocities.len();
+            let top = Motion::velocities_into(times, points, &mut other_velocities);
+            other_legs.push((start..other_velocities.len(), top));
         }
         VehicleProblem {
             model,
             vehicle,
-            other_velocities: others.iter().map(Motion::velocities_of).collect(),
+            other_velocities,
+            other_legs,
             other_index: SlabIndex::new(&other_boxes),
             other_boxes,
             horizon,
@@ -136,7 +143,7 @@ impl<'a> VehicleProblem<'a> {
     }
 
     /// The other vehicles' trajectories, in scenario order without this one.
-    pub fn others(&self) -> &[Trajectory] {
+    pub fn others(&self) -> &FleetTrajectories {
         &self.others
     }
 
@@ -182,13 +189,14 @@ impl<'a> VehicleProblem<'a> {
         self.other_index
             .near(&self.other_boxes, &own, 0, d_min, &mut near);
         let mut min_separation = f64::INFINITY;
-        for (k, (other, (velocities, top))) in
-            self.others.iter().zip(&self.other_velocities).enumerate()
+        for (k, ((times, points), (legs, top))) in
+            self.others.iter().zip(&self.other_legs).enumerate()
         {
             if !near[k] {
                 continue;
             }
-            let other = Motion::prepared(&other.times, &other.points, velocities, *top);
+            let velocities = &self.other_velocities[legs.clone()];
+            let other = Motion::prepared(times, points, velocities, *top);
             let p = motion_separation(&mine, &other, d_min, false);
             terms.space += space_term(p.breach_s);
             terms.separation += separation_penalty(p.min_distance, s.fleet.d_min_m);
@@ -402,8 +410,8 @@ mod tests {
                 // Every other vehicle, as the fitness measures a pair.
                 let mine = Motion::new(&got.trajectory);
                 let (mut space, mut penalty, mut min) = (0.0, 0.0, f64::INFINITY);
-                for other in problem.others() {
-                    let p = motion_separation(&mine, &Motion::new(other), d_min, false);
+                for other in problem.others().to_vec() {
+                    let p = motion_separation(&mine, &Motion::new(&other), d_min, false);
                     space += space_term(p.breach_s);
                     penalty += separation_penalty(p.min_distance, d_min);
                     min = min.min(p.min_distance);

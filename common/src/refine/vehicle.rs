@@ -113,7 +113,12 @@ impl Arena for VehicleArena<'_, '_> {
     }
 
     fn others<'e>(&'e self, _e: &'e VehicleEvaluation, _i: usize) -> Vec<Cow<'e, Trajectory>> {
-        self.problem.others().iter().map(Cow::Borrowed).collect()
+        self.problem
+            .others()
+            .to_vec()
+            .into_iter()
+            .map(Cow::Owned)
+            .collect()
     }
 
     fn extra_rows(&self, points: &[Vec3], limits: &Limits, rows: &mut Vec<Row>) {
