@@ -93,6 +93,6 @@ where
 /// The box of every vehicle's trajectory, indexed by vehicle.
 pub(super) fn trajectory_extents<A: Arena>(search: &Search<A>) -> Vec<(Vec3, Vec3)> {
     (0..search.arena.model().layout.vehicles)
-        .map(|i| extent(&search.arena.mine(&search.eval, i).points))
+        .map(|i| extent(search.arena.mine(&search.eval, i).1))
         .collect()
 }

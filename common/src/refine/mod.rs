@@ -48,7 +48,6 @@ mod search;
 mod settings;
 pub mod vehicle;
 
-use std::borrow::Cow;
 use std::ops::Range;
 use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
@@ -57,8 +56,8 @@ use crate::cost::{FleetEvaluation, FleetModel};
 use crate::geometry::polyline_length;
 use crate::scenario::Scenario;
 use crate::swarm::core::parallel;
-use crate::trajectory::{shortest_pitch_feasible_length, Trajectory};
-use search::{Arena, Search};
+use crate::trajectory::shortest_pitch_feasible_length;
+use search::{Arena, Samples, Search};
 pub use settings::RefineSettings;
 pub use vehicle::refine_vehicle;
 
@@ -236,14 +235,14 @@ impl Arena for FleetArena<'_> {
         Some(e.common_arrival)
     }
 
-    fn mine<'e>(&'e self, e: &'e FleetEvaluation, i: usize) -> Cow<'e, Trajectory> {
-        Cow::Owned(e.trajectories.trajectory(i))
+    fn mine<'e>(&'e self, e: &'e FleetEvaluation, i: usize) -> Samples<'e> {
+        (e.trajectories.times(i), e.trajectories.points(i))
     }
 
-    fn others<'e>(&'e self, e: &'e FleetEvaluation, i: usize) -> Vec<Cow<'e, Trajectory>> {
-        (0..e.trajectories.len())
-            .filter(|&j| j != i)
-            .map(|j| Cow::Owned(e.trajectories.trajectory(j)))
+    fn others<'e>(&'e self, e: &'e FleetEvaluation, i: usize) -> Vec<Samples<'e>> {
+        (e.trajectories.iter().enumerate())
+            .filter(|(j, _)| *j != i)
+            .map(|(_, t)| t)
             .collect()
     }
 }

@@ -2,7 +2,6 @@
 //! judges it: the whole fleet's fitness when a plan is refined ([`super::refine`]), or one
 //! vehicle's cost against fixed others when a replan is ([`super::vehicle`]).
 
-use std::borrow::Cow;
 use std::ops::Range;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
@@ -16,6 +15,9 @@ use crate::broad_phase::{boxes_within, extent, SlabBoxes};
 use crate::cost::FleetModel;
 use crate::geometry::Vec3;
 use crate::trajectory::Trajectory;
+
+/// A timed trajectory as an arena holds it, borrowed: its sample times and positions.
+pub(super) type Samples<'e> = (&'e [f64], &'e [Vec3]);
 
 /// What a search steps in: how a position is scored and what the rows see of it.
 pub(super) trait Arena {
@@ -40,11 +42,10 @@ pub(super) trait Arena {
     /// The arrival the others keep, seconds: with the slowest speed, the shortest a path may
     /// be (`None`: an early arrival is allowed).
     fn common_arrival(&self, e: &Self::Eval) -> Option<f64>;
-    /// Vehicle `i`'s timed trajectory (borrowed, or a copy where an evaluation keeps the
-    /// fleet's in one buffer).
-    fn mine<'e>(&'e self, e: &'e Self::Eval, i: usize) -> Cow<'e, Trajectory>;
+    /// Vehicle `i`'s timed trajectory.
+    fn mine<'e>(&'e self, e: &'e Self::Eval, i: usize) -> Samples<'e>;
     /// The other vehicles' timed trajectories.
-    fn others<'e>(&'e self, e: &'e Self::Eval, i: usize) -> Vec<Cow<'e, Trajectory>>;
+    fn others<'e>(&'e self, e: &'e Self::Eval, i: usize) -> Vec<Samples<'e>>;
     /// Rows only this arena has (a replan's turn off the vehicle's present course).
     fn extra_rows(&self, _points: &[Vec3], _limits: &Limits, _rows: &mut Vec<Row>) {}
 }
@@ -238,8 +239,16 @@ impl<'a, A: Arena> Search<'a, A> {
         let mine = self.arena.mine(&self.eval, i);
         let step = self.settings.sample_step_s;
         let others = self.arena.others(&self.eval, i);
-        for (other, windows) in coming_near(&mine, others, limits.separation + reach) {
-            constraints::separation_rows(&mine, &other, limits, step, reach, &windows, &mut rows);
+        // Only the trajectories that come near are copied for the rows' sampling.
+        let mut near = coming_near(mine, others, limits.separation + reach).peekable();
+        if near.peek().is_some() {
+            let mine = owned(mine);
+            for (other, windows) in near {
+                let other = owned(other);
+                constraints::separation_rows(
+                    &mine, &other, limits, step, reach, &windows, &mut rows,
+                );
+            }
         }
         let latest = v.speed_max_mps * self.target;
         rows.extend(constraints::length_row(points, latest, 1.0));
@@ -256,25 +265,25 @@ impl<'a, A: Arena> Search<'a, A> {
 /// can come within `reach` of it, and only then, so only they add a separation row (which
 /// sampling every one over the whole mission would find out far more slowly).
 fn coming_near<'e>(
-    mine: &Trajectory,
-    others: Vec<Cow<'e, Trajectory>>,
+    (times, points): Samples<'_>,
+    others: Vec<Samples<'e>>,
     reach: f64,
-) -> impl Iterator<Item = (Cow<'e, Trajectory>, Vec<(f64, f64)>)> {
-    let horizon = others
-        .iter()
-        .map(|t| t.arrival())
-        .fold(mine.arrival(), f64::max);
+) -> impl Iterator<Item = (Samples<'e>, Vec<(f64, f64)>)> {
+    let arrival = |times: &[f64]| times.last().copied().unwrap_or(0.0);
+    let horizon = (others.iter())
+        .map(|t| arrival(t.0))
+        .fold(arrival(times), f64::max);
     let (mut own, mut other_boxes) = (SlabBoxes::new(), SlabBoxes::new());
     own.reset(horizon);
-    own.push(&mine.times, &mine.points);
-    let whole = extent(&mine.points);
+    own.push(times, points);
+    let whole = extent(points);
     others.into_iter().filter_map(move |t| {
         // Whole trajectories apart prove every slab apart, for a box test instead of a slab pass.
-        if !boxes_within(&whole, &extent(&t.points), reach) {
+        if !boxes_within(&whole, &extent(t.1), reach) {
             return None;
         }
         other_boxes.reset(horizon);
-        other_boxes.push(&t.times, &t.points);
+        other_boxes.push(t.0, t.1);
         let slabs = own.near_slabs_other(0, &other_boxes, 0, reach);
         if slabs == 0 {
             return None;
@@ -283,6 +292,14 @@ fn coming_near<'e>(
         own.windows(slabs, &mut windows);
         Some((t, windows))
     })
+}
+
+/// A copy of borrowed samples as a trajectory of its own.
+fn owned((times, points): Samples<'_>) -> Trajectory {
+    Trajectory {
+        times: times.to_vec(),
+        points: points.to_vec(),
+    }
 }
 
 #[cfg(test)]
@@ -313,9 +330,12 @@ mod tests {
             d_min: 50.0,
         };
         let reach = 60.0;
-        let others = [&near, &parallel, &late].map(Cow::Borrowed).to_vec();
-        let kept: Vec<_> = coming_near(&mine, others, limits.separation + reach)
-            .map(|(t, _)| t.into_owned())
+        fn samples(t: &Trajectory) -> Samples<'_> {
+            (&t.times, &t.points)
+        }
+        let others = [&near, &parallel, &late].map(samples).to_vec();
+        let kept: Vec<_> = coming_near(samples(&mine), others, limits.separation + reach)
+            .map(|(t, _)| owned(t))
             .collect();
         assert_eq!(kept, std::slice::from_ref(&near));
         let whole = constraints::WHOLE_MISSION;

@@ -1,6 +1,7 @@
 use super::*;
 use crate::geometry::Vec3;
 use crate::scenario::ScenarioError;
+use crate::trajectory::Trajectory;
 use std::f64::consts::PI;
 use std::time::Instant;
 

@@ -6,17 +6,15 @@
 //! its penalties and its pairs' separation), plus the penalty weight times its lateness past
 //! the target over the target, gets lower, so the answer is never worse by that measure.
 
-use std::borrow::Cow;
 use std::ops::Range;
 use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
 
 use super::constraints::{entry_turn_row, Limits, Row};
-use super::search::{Arena, Search};
+use super::search::{Arena, Samples, Search};
 use super::settings::RefineSettings;
 use crate::cost::FleetModel;
 use crate::geometry::{polyline_length, Vec3};
-use crate::trajectory::Trajectory;
 use crate::vehicle_problem::{VehicleEvaluation, VehicleProblem};
 
 /// What the refinement of one vehicle did.
@@ -108,17 +106,12 @@ impl Arena for VehicleArena<'_, '_> {
             .then_some(self.problem.arrival())
     }
 
-    fn mine<'e>(&'e self, e: &'e VehicleEvaluation, _i: usize) -> Cow<'e, Trajectory> {
-        Cow::Borrowed(&e.trajectory)
+    fn mine<'e>(&'e self, e: &'e VehicleEvaluation, _i: usize) -> Samples<'e> {
+        (&e.trajectory.times, &e.trajectory.points)
     }
 
-    fn others<'e>(&'e self, _e: &'e VehicleEvaluation, _i: usize) -> Vec<Cow<'e, Trajectory>> {
-        self.problem
-            .others()
-            .to_vec()
-            .into_iter()
-            .map(Cow::Owned)
-            .collect()
+    fn others<'e>(&'e self, _e: &'e VehicleEvaluation, _i: usize) -> Vec<Samples<'e>> {
+        self.problem.others().iter().collect()
     }
 
     fn extra_rows(&self, points: &[Vec3], limits: &Limits, rows: &mut Vec<Row>) {
