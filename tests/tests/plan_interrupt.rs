@@ -1,29 +1,32 @@
 //! Ctrl-C during a long plan: the coordinator stops after the current iteration and still writes
 //! the best plan so far, saying it was interrupted; `run` then does not execute it. A coverage
-//! mission cuts its tracking simulation short and still writes its (whole) plan.
+//! mission cuts its tracking simulation short and still writes its (whole) plan. A coordinator
+//! killed outright (SIGKILL), which can neither write nor stop anything, leaves no agent behind:
+//! each watches its parent (`--parent-pid`).
 
 mod common;
 
 use std::error::Error;
 use std::fs::File;
+use std::io::{BufRead, BufReader};
 use std::path::Path;
-use std::process::{Command, ExitStatus, Stdio};
+use std::process::{Child, Command, ExitStatus, Stdio};
 use std::thread;
 use std::time::{Duration, Instant};
 
-use common::{coordinator, key, root, scenario};
+use common::{agent, coordinator, key, root, scenario};
 
-/// Runs `shoal-coordinator COMMAND SCENARIO ARGS… --out OUT` with a budget far too large to
-/// finish within the test, sends SIGINT once `started` is on stderr, and returns its exit status
-/// and stderr.
-fn interrupted(
+/// Starts `shoal-coordinator COMMAND SCENARIO ARGS… --out OUT` with a budget far too large to
+/// finish within the test, and returns it once `started` is on its stderr (written to
+/// `stderr_path`), with the time it was started.
+fn started(
     command: &str,
     name: &str,
     args: &[&str],
     started: &str,
     out: &Path,
     stderr_path: &Path,
-) -> Result<(ExitStatus, String), Box<dyn Error>> {
+) -> Result<(Child, Instant), Box<dyn Error>> {
     let mut cmd = Command::new(coordinator());
     for (k, _) in std::env::vars_os() {
         if k.to_string_lossy().starts_with("SHOAL_") {
@@ -45,12 +48,26 @@ fn interrupted(
     // Wait for the progress line, so the handler is installed and the long work has begun.
     let since = Instant::now();
     while !std::fs::read_to_string(stderr_path)?.contains(started) {
-        assert!(
-            since.elapsed() < Duration::from_secs(60),
-            "no {started:?} on stderr"
-        );
+        if since.elapsed() > Duration::from_secs(60) {
+            let _ = child.kill();
+            panic!("no {started:?} on stderr");
+        }
         thread::sleep(Duration::from_millis(50));
     }
+    Ok((child, since))
+}
+
+/// Runs [`started`]'s command, sends SIGINT once `started` is on stderr, and returns its exit
+/// status and stderr.
+fn interrupted(
+    command: &str,
+    name: &str,
+    args: &[&str],
+    started_on: &str,
+    out: &Path,
+    stderr_path: &Path,
+) -> Result<(ExitStatus, String), Box<dyn Error>> {
+    let (mut child, since) = started(command, name, args, started_on, out, stderr_path)?;
     let pid = child.id().to_string();
     let killed = Command::new("kill").args(["-INT", &pid]).status()?;
     assert!(killed.success(), "kill -INT {pid} failed");
@@ -68,6 +85,45 @@ fn interrupted(
         thread::sleep(Duration::from_millis(50));
     };
     Ok((status, std::fs::read_to_string(stderr_path)?))
+}
+
+/// The running processes whose parent is `parent` (from `/proc`; a zombie is not running).
+fn running_children(parent: u32) -> Vec<u32> {
+    let Ok(entries) = std::fs::read_dir("/proc") else {
+        return Vec::new();
+    };
+    entries
+        .filter_map(|e| e.ok()?.file_name().to_str()?.parse::<u32>().ok())
+        .filter(|pid| {
+            let Ok(stat) = std::fs::read_to_string(format!("/proc/{pid}/stat")) else {
+                return false;
+            };
+            // After the command name: the state, then the parent's pid.
+            let Some((_, rest)) = stat.rsplit_once(')') else {
+                return false;
+            };
+            let mut fields = rest.split_whitespace();
+            let state = fields.next().unwrap_or("Z");
+            let ppid = fields.next().and_then(|p| p.parse::<u32>().ok());
+            state != "Z" && state != "X" && ppid == Some(parent)
+        })
+        .collect()
+}
+
+/// Whether process `pid` runs (not gone, not a zombie).
+fn running(pid: u32) -> bool {
+    std::fs::read_to_string(format!("/proc/{pid}/stat"))
+        .ok()
+        .and_then(|stat| {
+            let state = stat
+                .rsplit_once(')')?
+                .1
+                .split_whitespace()
+                .next()?
+                .to_string();
+            Some(state != "Z" && state != "X")
+        })
+        .unwrap_or(false)
 }
 
 /// The plan written after the interrupt says so.
@@ -172,5 +228,85 @@ fn sigint_cuts_a_coverage_missions_tracking_short() -> Result<(), Box<dyn Error>
         "{simulated} s simulated for {planned} m"
     );
     assert!(out.join("plan.svg").is_file());
+    Ok(())
+}
+
+#[test]
+fn sigkill_of_a_distributed_plan_leaves_no_agent_behind() -> Result<(), Box<dyn Error>> {
+    let dir = tempfile::tempdir()?;
+    let out = dir.path().join("out");
+    let stderr_path = dir.path().join("stderr.log");
+    // The progress line of a distributed plan comes once every agent has joined.
+    let (mut child, _) = started(
+        "plan",
+        "amp-pso-2",
+        &["--populations", "2", "--particles", "10"],
+        "iteration",
+        &out,
+        &stderr_path,
+    )?;
+    let agents = running_children(child.id());
+    child.kill()?;
+    child.wait()?;
+    let stderr = std::fs::read_to_string(&stderr_path)?;
+    // Scenario 2 has three vehicles, one embedded agent each.
+    assert_eq!(agents.len(), 3, "{agents:?}\n{stderr}");
+    let since = Instant::now();
+    while agents.iter().any(|&pid| running(pid)) {
+        if since.elapsed() > Duration::from_secs(10) {
+            for pid in &agents {
+                let _ = Command::new("kill").args(["-9", &pid.to_string()]).status();
+            }
+            panic!("agents {agents:?} outlived their killed coordinator by 10 s\n{stderr}");
+        }
+        thread::sleep(Duration::from_millis(50));
+    }
+    Ok(())
+}
+
+#[test]
+fn an_agent_leaves_when_its_parent_is_killed_and_not_before() -> Result<(), Box<dyn Error>> {
+    // A shell starts the agent in the background, watching the shell, prints the agent's pid
+    // and waits. Nothing listens on the endpoint: the agent waits for its router.
+    let mut shell = Command::new("sh")
+        .args(["-c", r#""$0" --vehicle auv1 --connect tcp/127.0.0.1:9 --parent-pid $$ >/dev/null 2>&1 & echo $!; wait"#])
+        .arg(agent())
+        .stdout(Stdio::piped())
+        .spawn()?;
+    let mut line = String::new();
+    BufReader::new(shell.stdout.take().ok_or("no stdout")?).read_line(&mut line)?;
+    let pid: u32 = line.trim().parse()?;
+    // The control: while the shell lives, the agent stays.
+    thread::sleep(Duration::from_millis(1500));
+    let stayed = running(pid);
+    shell.kill()?;
+    shell.wait()?;
+    let since = Instant::now();
+    while running(pid) && since.elapsed() < Duration::from_secs(10) {
+        thread::sleep(Duration::from_millis(50));
+    }
+    let left = !running(pid);
+    if !left {
+        let _ = Command::new("kill").args(["-9", &pid.to_string()]).status();
+    }
+    assert!(stayed, "the agent left while its parent was alive");
+    assert!(left, "the agent outlived its parent by 10 s");
+    Ok(())
+}
+
+#[test]
+fn a_parent_pid_that_is_not_the_parent_is_refused() -> Result<(), Box<dyn Error>> {
+    let out = Command::new(agent())
+        .args(["--vehicle", "auv1", "--connect", "tcp/127.0.0.1:9"])
+        .args(["--parent-pid", &u32::MAX.to_string()])
+        .output()?;
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    let expected = format!(
+        "--parent-pid {}: this agent's parent is process {}",
+        u32::MAX,
+        std::process::id()
+    );
+    assert!(stderr.contains(&expected), "{stderr}");
     Ok(())
 }

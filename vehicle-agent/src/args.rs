@@ -31,6 +31,10 @@ pub struct AgentArgs {
     /// Leave after the first mission ends (the coordinator's own agents do).
     #[arg(long, env = "SHOAL_ONCE")]
     pub once: bool,
+    /// Leave when process PID is no longer this agent's parent: the coordinator passes its own
+    /// process id to the agents it starts, so they do not outlive it even when it is killed.
+    #[arg(long, value_name = "PID")]
+    pub parent_pid: Option<u32>,
     /// Threads stepping the follower populations.
     #[arg(long, env = "SHOAL_THREADS", default_value_t = DEFAULT_THREADS)]
     pub threads: usize,
@@ -99,6 +103,15 @@ impl AgentArgs {
                 self.position_noise
             );
         }
+        if let Some(pid) = self.parent_pid {
+            match crate::parent_watch::parent_id() {
+                Some(parent) if parent != pid => anyhow::bail!(
+                    "--parent-pid {pid}: this agent's parent is process {parent} (gone already?)"
+                ),
+                Some(_) => {}
+                None => anyhow::bail!("--parent-pid: not supported on this platform"),
+            }
+        }
         if self.link == LinkKind::Mavlink && self.mavlink_address.is_none() {
             anyhow::bail!("--link mavlink needs --mavlink-address (SHOAL_MAVLINK_ADDRESS)");
         }
@@ -113,6 +126,7 @@ impl AgentArgs {
                 .unwrap_or(Duration::from_secs_f64(DEFAULT_IDLE_TIMEOUT_S)),
             health_file: self.health_file.clone(),
             link: self.link_settings(),
+            parent: self.parent_pid,
         })
     }
 

@@ -34,6 +34,9 @@ pub struct AgentConfig {
     pub health_file: Option<PathBuf>,
     /// How the agent drives its vehicle when a plan is executed.
     pub link: LinkSettings,
+    /// Leave when this process is no longer the agent's parent (a coordinator's own agents
+    /// are given the coordinator's process id).
+    pub parent: Option<u32>,
 }
 
 impl AgentConfig {
@@ -54,6 +57,7 @@ impl AgentConfig {
                 position_noise_m: DEFAULT_POSITION_NOISE_M,
                 mavlink: None,
             },
+            parent: None,
         }
     }
 }

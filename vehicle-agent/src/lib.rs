@@ -15,7 +15,8 @@
 //!   through a closure, with no knowledge of Zenoh;
 //! - [`execute`]: one execution: the vehicle drives its plan through its [`link::VehicleLink`]
 //!   and the agent reports telemetry;
-//! - [`link`]: the vehicle-link seam (a simulator now; real vehicles plug in there).
+//! - [`link`]: the vehicle-link seam (a simulator now; real vehicles plug in there);
+//! - [`parent_watch`]: an embedded agent leaves when the coordinator that started it is gone.
 
 pub mod args;
 pub mod assignment;
@@ -25,6 +26,7 @@ pub mod link;
 pub mod mission;
 pub mod network;
 mod one_shot;
+pub mod parent_watch;
 
 use std::path::Path;
 use std::sync::atomic::AtomicBool;
@@ -47,6 +49,10 @@ pub fn health_check(file: Option<&Path>) -> anyhow::Result<()> {
 }
 
 /// Runs the agent until `shutdown` is raised (or, with `once`, until its first mission ends).
+/// With a `parent`, it also stops when that process is no longer its parent ([`parent_watch`]).
 pub fn run(config: AgentConfig, shutdown: Arc<AtomicBool>) -> anyhow::Result<()> {
+    if let Some(parent) = config.parent {
+        parent_watch::start(parent, &config.vehicle, Arc::clone(&shutdown));
+    }
     network::serve(&config, &shutdown)
 }

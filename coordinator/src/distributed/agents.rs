@@ -1,6 +1,7 @@
 //! The coordinator's own agents (`--agents embedded`, the default): one `shoal-agent` process
 //! per vehicle, connected to the embedded router, each logging to `<out>/logs/<vehicle>.log`.
-//! They are killed when the plan is done (they also leave by themselves: `--once`).
+//! They are killed when the plan is done (they also leave by themselves: `--once`), and they
+//! leave when this process is gone (`--parent-pid`), however it ended.
 
 use std::fs::File;
 use std::path::{Path, PathBuf};
@@ -68,6 +69,9 @@ impl LocalAgents {
             }
             let child = command
                 .args(["--vehicle", v, "--connect", endpoint, "--once"])
+                // They leave by themselves when this process is gone, even killed by SIGKILL
+                // (then `Drop` below cannot run).
+                .args(["--parent-pid", &std::process::id().to_string()])
                 .args(extra_args)
                 // The coordinator's settings must not leak into the agents through SHOAL_*.
                 .env_remove("SHOAL_VEHICLE")
