@@ -87,43 +87,47 @@ fn interrupted(
     Ok((status, std::fs::read_to_string(stderr_path)?))
 }
 
-/// The running processes whose parent is `parent` (from `/proc`; a zombie is not running).
+/// Process `pid`'s parent, if it runs (not gone, not a zombie): the state and the parent's pid
+/// follow the command name in `/proc/PID/stat`.
+fn running_parent(pid: u32) -> Option<u32> {
+    let stat = std::fs::read_to_string(format!("/proc/{pid}/stat")).ok()?;
+    let mut fields = stat.rsplit_once(')')?.1.split_whitespace();
+    let state = fields.next()?;
+    (state != "Z" && state != "X")
+        .then(|| fields.next()?.parse().ok())
+        .flatten()
+}
+
+/// Whether process `pid` runs.
+fn running(pid: u32) -> bool {
+    running_parent(pid).is_some()
+}
+
+/// The running processes whose parent is `parent`.
 fn running_children(parent: u32) -> Vec<u32> {
     let Ok(entries) = std::fs::read_dir("/proc") else {
         return Vec::new();
     };
     entries
         .filter_map(|e| e.ok()?.file_name().to_str()?.parse::<u32>().ok())
-        .filter(|pid| {
-            let Ok(stat) = std::fs::read_to_string(format!("/proc/{pid}/stat")) else {
-                return false;
-            };
-            // After the command name: the state, then the parent's pid.
-            let Some((_, rest)) = stat.rsplit_once(')') else {
-                return false;
-            };
-            let mut fields = rest.split_whitespace();
-            let state = fields.next().unwrap_or("Z");
-            let ppid = fields.next().and_then(|p| p.parse::<u32>().ok());
-            state != "Z" && state != "X" && ppid == Some(parent)
-        })
+        .filter(|&pid| running_parent(pid) == Some(parent))
         .collect()
 }
 
-/// Whether process `pid` runs (not gone, not a zombie).
-fn running(pid: u32) -> bool {
-    std::fs::read_to_string(format!("/proc/{pid}/stat"))
-        .ok()
-        .and_then(|stat| {
-            let state = stat
-                .rsplit_once(')')?
-                .1
-                .split_whitespace()
-                .next()?
-                .to_string();
-            Some(state != "Z" && state != "X")
-        })
-        .unwrap_or(false)
+/// Whether every process of `pids` stops running within `limit`; those still running then are
+/// killed, so a failing test leaves nothing behind.
+fn all_stop_within(pids: &[u32], limit: Duration) -> bool {
+    let since = Instant::now();
+    while pids.iter().any(|&pid| running(pid)) {
+        if since.elapsed() > limit {
+            for pid in pids {
+                let _ = Command::new("kill").args(["-9", &pid.to_string()]).status();
+            }
+            return false;
+        }
+        thread::sleep(Duration::from_millis(50));
+    }
+    true
 }
 
 /// The plan written after the interrupt says so.
@@ -251,16 +255,10 @@ fn sigkill_of_a_distributed_plan_leaves_no_agent_behind() -> Result<(), Box<dyn 
     let stderr = std::fs::read_to_string(&stderr_path)?;
     // Scenario 2 has three vehicles, one embedded agent each.
     assert_eq!(agents.len(), 3, "{agents:?}\n{stderr}");
-    let since = Instant::now();
-    while agents.iter().any(|&pid| running(pid)) {
-        if since.elapsed() > Duration::from_secs(10) {
-            for pid in &agents {
-                let _ = Command::new("kill").args(["-9", &pid.to_string()]).status();
-            }
-            panic!("agents {agents:?} outlived their killed coordinator by 10 s\n{stderr}");
-        }
-        thread::sleep(Duration::from_millis(50));
-    }
+    assert!(
+        all_stop_within(&agents, Duration::from_secs(10)),
+        "agents {agents:?} outlived their killed coordinator by 10 s\n{stderr}"
+    );
     Ok(())
 }
 
@@ -281,14 +279,7 @@ fn an_agent_leaves_when_its_parent_is_killed_and_not_before() -> Result<(), Box<
     let stayed = running(pid);
     shell.kill()?;
     shell.wait()?;
-    let since = Instant::now();
-    while running(pid) && since.elapsed() < Duration::from_secs(10) {
-        thread::sleep(Duration::from_millis(50));
-    }
-    let left = !running(pid);
-    if !left {
-        let _ = Command::new("kill").args(["-9", &pid.to_string()]).status();
-    }
+    let left = all_stop_within(&[pid], Duration::from_secs(10));
     assert!(stayed, "the agent left while its parent was alive");
     assert!(left, "the agent outlived its parent by 10 s");
     Ok(())
